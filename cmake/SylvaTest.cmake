@@ -1,0 +1,25 @@
+# sylva_add_test(NAME <name> SOURCES <files...> LABELS <labels...> [LIBS <targets...>] [TIMEOUT <s>])
+# One Qt Test executable per unit, registered with CTest under its labels (unit, pipeline, gui, gpu, slow).
+function(sylva_add_test)
+  cmake_parse_arguments(T "" "NAME;TIMEOUT" "SOURCES;LABELS;LIBS" ${ARGN})
+  add_executable(${T_NAME} ${T_SOURCES})
+  target_link_libraries(${T_NAME} PRIVATE sylva_pipeline Qt6::Test ${T_LIBS})
+  target_compile_definitions(${T_NAME} PRIVATE
+    SYLVA_SHARED_DATA="${SYLVA_SHARED_DATA}"
+    SYLVA_TEST_DATA="${CMAKE_SOURCE_DIR}/tests/data"
+    SYLVA_TEST_OUTPUT="${CMAKE_BINARY_DIR}/test-output")
+  add_test(NAME ${T_NAME} COMMAND ${T_NAME})
+  if(NOT T_TIMEOUT)
+    set(T_TIMEOUT 600)
+  endif()
+  set_tests_properties(${T_NAME} PROPERTIES LABELS "${T_LABELS}" TIMEOUT ${T_TIMEOUT}
+    ENVIRONMENT "QT_QPA_PLATFORM=offscreen;XDG_CACHE_HOME=${CMAKE_BINARY_DIR}/test-cache")
+endfunction()
+
+# sylva_add_bench(NAME <name> SOURCES <files...>): a benchmark program (not a test); run it by hand.
+function(sylva_add_bench)
+  cmake_parse_arguments(B "" "NAME" "SOURCES;LIBS" ${ARGN})
+  add_executable(${B_NAME} ${B_SOURCES})
+  target_link_libraries(${B_NAME} PRIVATE sylva_pipeline ${B_LIBS})
+  target_compile_definitions(${B_NAME} PRIVATE SYLVA_SHARED_DATA="${SYLVA_SHARED_DATA}")
+endfunction()

@@ -1,0 +1,19 @@
+// Host/device annotation and kernel assert: the only place that spells __device__.
+#pragma once
+
+#if defined(__CUDACC__)
+#define SYLVA_HD __host__ __device__
+#define SYLVA_DEVICE __device__
+#define SYLVA_INLINE __forceinline__
+#else
+#define SYLVA_HD
+#define SYLVA_DEVICE
+#define SYLVA_INLINE inline
+#endif
+
+#if defined(__CUDA_ARCH__)
+#define SYLVA_KERNEL_ASSERT(cond) ((void)0)
+#else
+#include <cassert>
+#define SYLVA_KERNEL_ASSERT(cond) assert(cond)
+#endif

@@ -1,0 +1,6 @@
+// Product version string.
+#pragma once
+
+namespace sylva {
+const char* versionString();
+}
