@@ -1,0 +1,104 @@
+// Image files through OpenImageIO.
+#include "pipeline/io/image_io.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <unistd.h>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+
+#include "core/base/error.h"
+
+namespace sylva {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lowerExtension(const std::string& path)
+{
+    std::string ext = fs::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    return ext;
+}
+
+} // namespace
+
+ImageRgba readImage(const std::string& path)
+{
+    if (!fs::exists(path)) throw Error(path + ": no such image file");
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw Error(path + ": cannot read image (" + OIIO::geterror() + ")");
+    const OIIO::ImageSpec& spec = in->spec();
+    const int w = spec.width, h = spec.height, nc = spec.nchannels;
+    if (w <= 0 || h <= 0 || nc <= 0 || size_t(w) * size_t(h) > (size_t(1) << 28))
+        throw Error(path + ": image has an unsupported size " + std::to_string(w) + "x" + std::to_string(h));
+    std::vector<float> data(size_t(w) * size_t(h) * size_t(nc));
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data()))
+        throw Error(path + ": cannot decode image (" + in->geterror() + ")");
+    in->close();
+    const int alphaChannel = spec.alpha_channel >= 0 ? spec.alpha_channel : (nc == 2 ? 1 : (nc >= 4 ? 3 : -1));
+    ImageRgba img(w, h);
+    for (size_t p = 0; p < size_t(w) * size_t(h); ++p) {
+        const float* s = &data[p * size_t(nc)];
+        float* d = &img.pixels[p * 4];
+        if (nc <= 2) {
+            d[0] = d[1] = d[2] = s[0];
+        } else {
+            d[0] = s[0];
+            d[1] = s[1];
+            d[2] = s[2];
+        }
+        d[3] = alphaChannel >= 0 ? s[alphaChannel] : 1.0f;
+    }
+    return img;
+}
+
+bool imageHasAlpha(const std::string& path)
+{
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw Error(path + ": cannot read image (" + OIIO::geterror() + ")");
+    const OIIO::ImageSpec& spec = in->spec();
+    return spec.alpha_channel >= 0 || spec.nchannels == 2 || spec.nchannels >= 4;
+}
+
+void writeImage(const std::string& path, const ImageRgba& image, int channels)
+{
+    if (image.empty()) throw Error(path + ": refusing to write an empty image");
+    if (channels != 3 && channels != 4) throw Error(path + ": images are written with 3 or 4 channels");
+    const std::string ext = lowerExtension(path);
+    const bool isFloat = ext == ".exr" || ext == ".hdr";
+    fs::path target(path);
+    fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    // Keep the extension on the temporary name so OIIO picks the same format.
+    fs::path tmp = dir / (".tmp." + std::to_string(::getpid()) + "." + target.filename().string());
+
+    auto out = OIIO::ImageOutput::create(tmp.string());
+    if (!out) throw Error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
+    OIIO::ImageSpec spec(image.width, image.height, channels, isFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
+    if (channels == 4) spec.alpha_channel = 3;
+    std::vector<float> data(size_t(image.width) * size_t(image.height) * size_t(channels));
+    for (size_t p = 0; p < size_t(image.width) * size_t(image.height); ++p)
+        for (int c = 0; c < channels; ++c) {
+            float v = image.pixels[p * 4 + size_t(c)];
+            data[p * size_t(channels) + size_t(c)] = isFloat ? v : std::clamp(v, 0.0f, 1.0f);
+        }
+    if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data.data()) || !out->close()) {
+        std::string why = out->geterror();
+        fs::remove(tmp, ec);
+        throw Error(path + ": cannot write image (" + why + ")");
+    }
+    fs::rename(tmp, target, ec);
+    if (ec) {
+        fs::remove(tmp, ec);
+        throw Error(path + ": cannot move the written image into place (" + ec.message() + ")");
+    }
+}
+
+} // namespace sylva
