@@ -1,9 +1,15 @@
-# sylva_add_test(NAME <name> SOURCES <files...> LABELS <labels...> [LIBS <targets...>] [TIMEOUT <s>])
+# sylva_add_test(NAME <name> SOURCES <files...> LABELS <labels...> [CORE] [LIBS <targets...>] [TIMEOUT <s>])
+# CORE links only sylva_core (no Qt beyond Qt Test, no Assimp/OIIO).
 # One Qt Test executable per unit, registered with CTest under its labels (unit, pipeline, gui, gpu, slow).
 function(sylva_add_test)
-  cmake_parse_arguments(T "" "NAME;TIMEOUT" "SOURCES;LABELS;LIBS" ${ARGN})
+  cmake_parse_arguments(T "CORE" "NAME;TIMEOUT" "SOURCES;LABELS;LIBS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
-  target_link_libraries(${T_NAME} PRIVATE sylva_pipeline Qt6::Test ${T_LIBS})
+  set_target_properties(${T_NAME} PROPERTIES AUTOMOC ON)
+  if(T_CORE)
+    target_link_libraries(${T_NAME} PRIVATE sylva_core Qt6::Test ${T_LIBS})
+  else()
+    target_link_libraries(${T_NAME} PRIVATE sylva_pipeline Qt6::Test ${T_LIBS})
+  endif()
   target_compile_definitions(${T_NAME} PRIVATE
     SYLVA_SHARED_DATA="${SYLVA_SHARED_DATA}"
     SYLVA_TEST_DATA="${CMAKE_SOURCE_DIR}/tests/data"

@@ -2,10 +2,12 @@
 #pragma once
 
 #if defined(__CUDACC__)
+#define SYLVA_UNROLL _Pragma("unroll")
 #define SYLVA_HD __host__ __device__
 #define SYLVA_DEVICE __device__
 #define SYLVA_INLINE __forceinline__
 #else
+#define SYLVA_UNROLL
 #define SYLVA_HD
 #define SYLVA_DEVICE
 #define SYLVA_INLINE inline

@@ -1,0 +1,31 @@
+// The D3Q19 lattice of the LB lighting model: directions, weights, antipodes (LB_MODEL.md "Lattice").
+#pragma once
+
+#include "core/base/defines.h"
+
+namespace sylva::lb {
+
+inline constexpr int kDirections = 19;
+inline constexpr int kPairs = 9;   // antipodal pairs of the 18 moving directions
+
+// c_m: 0 rest; 1-6 axial (+x,-x,+y,-y,+z,-z); 7-18 face diagonals.
+inline constexpr int kC[kDirections][3] = {
+    {0, 0, 0},
+    {1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1},
+    {1, 1, 0}, {1, -1, 0}, {-1, 1, 0}, {-1, -1, 0},
+    {1, 0, 1}, {1, 0, -1}, {-1, 0, 1}, {-1, 0, -1},
+    {0, 1, 1}, {0, 1, -1}, {0, -1, 1}, {0, -1, -1},
+};
+
+// Opposite direction of each m (c_opp = -c_m).
+inline constexpr int kOpposite[kDirections] = {0, 2, 1, 4, 3, 6, 5, 10, 9, 8, 7, 14, 13, 12, 11, 18, 17, 16, 15};
+
+// Antipodal pairs (positive member, negative member); pairs 0-2 axial, 3-8 diagonal.
+inline constexpr int kPairPos[kPairs] = {1, 3, 5, 7, 8, 11, 12, 15, 16};
+inline constexpr int kPairNeg[kPairs] = {2, 4, 6, 10, 9, 14, 13, 18, 17};
+
+// w_m: 0 for rest (handled by row/column 0 of Omega), 1/12 axial, 1/24 diagonal.
+SYLVA_HD constexpr double weight(int m) { return m == 0 ? 0.0 : (m <= 6 ? 1.0 / 12.0 : 1.0 / 24.0); }
+SYLVA_HD constexpr bool isAxial(int m) { return m >= 1 && m <= 6; }
+
+} // namespace sylva::lb

@@ -1,0 +1,53 @@
+// Parameters of an LB lighting solve: per-channel optics, sun boundary condition, steps or tolerance, storage.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/lb/omega.h"
+
+namespace sylva {
+struct DensityGrid;
+}
+
+namespace sylva::lb {
+
+enum class Storage { Fp32, Fp16 };
+
+struct LbParams {
+    std::array<ChannelParams, 3> channels{};   // R, G, B
+    bool zeroF0 = true;                        // plants: true; clouds and plastics keep f_0
+    glm::vec3 sun{0.0f, 1.0f, 0.0f};           // direction toward the sun, any length
+    glm::vec3 intensity{1.0f};                 // sun intensity per channel
+    int steps = 0;                             // 0 = default: 2 x the longest edge
+    double tolerance = 0.0;                    // > 0: stop when the relative L2 change per step < tolerance
+    int checkEvery = 8;                        // tolerance check period in steps
+    int maxSteps = 0;                          // tolerance mode cap; 0 = 4 x the longest edge
+    float brownThreshold = 0.5f;               // wood fraction above which a node is brown (g = -1)
+    Storage storage = Storage::Fp32;
+};
+
+struct Preset {
+    std::string name;
+    std::string description;
+    std::array<ChannelParams, 3> channels;
+    bool zeroF0;
+};
+
+// leaf, dogrose, cloud, pmma (LB_MODEL.md "Parameter presets").
+const std::vector<Preset>& presets();
+const Preset* findPreset(const std::string& name);
+LbParams paramsFromPreset(const Preset& preset);
+
+// Throws Error naming the parameter and its bound when the solve would be unstable or meaningless.
+void validate(const LbParams& params);
+// Checks the density grid: dims >= 3, values finite in [0,1], sizes consistent. Throws Error.
+void validateDensity(const DensityGrid& density);
+
+// The step count a solve with these parameters runs in fixed-step mode (2 x longest edge by default).
+int defaultSteps(const glm::ivec3& dims);
+
+} // namespace sylva::lb

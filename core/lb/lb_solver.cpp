@@ -1,0 +1,397 @@
+// CPU LB solver: rows along z vectorized 8 nodes wide, rows in parallel with oneTBB, fp32 or fp16 storage.
+#include "core/lb/lb_solver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <tuple>
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#if defined(__F16C__) && defined(__AVX__)
+#include <immintrin.h>
+#define SYLVA_LB_F16C 1
+#endif
+
+#include "core/base/error.h"
+#include "core/base/half.h"
+#include "core/lb/lb_node.h"
+
+namespace sylva::lb {
+
+namespace {
+
+constexpr int kLanes = 8;
+typedef float Vec8 __attribute__((vector_size(32)));   // 8 floats; GCC vector extension
+typedef int Vec8i __attribute__((vector_size(32)));
+
+inline Vec8 loadVec(const float* p)
+{
+    Vec8 v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+}
+inline void storeVec(float* p, Vec8 v) { std::memcpy(p, &v, sizeof v); }
+
+// Storage conversion of n contiguous values.
+inline void loadRow(const float* src, float* dst, int n) { std::memcpy(dst, src, size_t(n) * sizeof(float)); }
+inline void storeRow(const float* src, float* dst, int n) { std::memcpy(dst, src, size_t(n) * sizeof(float)); }
+inline void loadRow(const uint16_t* src, float* dst, int n)
+{
+    int k = 0;
+#ifdef SYLVA_LB_F16C
+    for (; k + 8 <= n; k += 8)
+        _mm256_storeu_ps(dst + k, _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + k))));
+#endif
+    for (; k < n; ++k) dst[k] = halfToFloat(src[k]);
+}
+inline void storeRow(const float* src, uint16_t* dst, int n)
+{
+    int k = 0;
+#ifdef SYLVA_LB_F16C
+    for (; k + 8 <= n; k += 8)
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + k),
+                         _mm256_cvtps_ph(_mm256_loadu_ps(src + k), _MM_FROUND_TO_NEAREST_INT));
+#endif
+    for (; k < n; ++k) dst[k] = floatToHalf(src[k]);
+}
+template <typename S>
+S toStorage(float v);
+template <>
+float toStorage<float>(float v) { return v; }
+template <>
+uint16_t toStorage<uint16_t>(float v) { return floatToHalf(v); }
+
+// One distinct channel solve: optics (green and brown) and two copies of f.
+template <typename S>
+struct ChannelField {
+    CompactOmega green{}, brown{};
+    std::vector<S> a, b;
+    S* cur() { return flip ? b.data() : a.data(); }
+    S* next() { return flip ? a.data() : b.data(); }
+    bool flip = false;
+};
+
+struct Scratch {
+    std::vector<float> buf;   // 19 rows of Zp floats
+    std::vector<float> out;   // Zp floats: node totals of the source state
+};
+
+template <typename S>
+class Solver {
+public:
+    Solver(const DensityGrid& density, const LbParams& params, const std::vector<ChannelParams>& solves)
+        : m_params(params), m_dims(density.geometry.dims)
+    {
+        m_X = m_dims.x;
+        m_Y = m_dims.y;
+        m_Z = m_dims.z;
+        m_Zp = (m_Z + kLanes - 1) / kLanes * kLanes;
+        const size_t rows = size_t(m_X) * size_t(m_Y);
+        m_rho.assign(rows * size_t(m_Zp), 0.0f);
+        m_brown.assign(rows * size_t(m_Zp), 0);
+        m_rowActive.assign(rows, 0);
+        m_rowBrown.assign(rows, 0);
+        for (size_t r = 0; r < rows; ++r)
+            for (int k = 0; k < m_Z; ++k) {
+                const size_t n = r * size_t(m_Z) + size_t(k);
+                const float rho = density.density[n];
+                const bool brown = !density.woodFraction.empty() && density.woodFraction[n] > params.brownThreshold;
+                m_rho[r * size_t(m_Zp) + size_t(k)] = rho;
+                m_brown[r * size_t(m_Zp) + size_t(k)] = brown ? -1 : 0;
+                if (rho > 0.0f) {
+                    m_rowActive[r] = 1;
+                    if (brown) m_rowBrown[r] = 1;
+                }
+            }
+        // Boundary condition for unit intensity; the solve is linear in intensity (scaled at the end).
+        const std::vector<float> bc = boundaryDistribution(params.sun);
+        const size_t count = rows * size_t(kDirections) * size_t(m_Z);
+        for (const ChannelParams& cp : solves) {
+            auto field = std::make_unique<ChannelField<S>>();
+            field->green = compactOmega(cp);
+            field->brown = compactOmega({cp.sigmaA, cp.sigmaS, -1.0f});
+            field->a.assign(count, toStorage<S>(0.0f));
+            for (int i = 0; i < m_X; ++i)
+                for (int j = 0; j < m_Y; ++j)
+                    for (int m = 0; m < kDirections; ++m)
+                        for (int k = 0; k < m_Z; ++k)
+                            if (isBoundary(i, j, k))
+                                field->a[dindex(i, j, k, m)] = toStorage<S>(bc[size_t(m)]);
+            field->b = field->a;
+            m_fields.push_back(std::move(field));
+        }
+    }
+
+    size_t bytesPerStep() const { return m_fields.size() * size_t(m_X) * m_Y * m_Z * kDirections * sizeof(S) * 2; }
+
+    // One step for every channel. outMode: 0 none, 1 store totals of the source state, 2 compare with stored.
+    double step(int outMode)
+    {
+        const size_t rows = size_t(m_X) * size_t(m_Y);
+        if (outMode != 0 && m_totals.empty()) m_totals.assign(m_fields.size() * rows * size_t(m_Z), 0.0f);
+        if (outMode == 2) {
+            m_rowDiff.assign(rows, 0.0);
+            m_rowNorm.assign(rows, 0.0);
+        }
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, rows, 4), [&](const tbb::blocked_range<size_t>& range) {
+            Scratch& s = m_scratch.local();
+            if (s.buf.size() != size_t(kDirections) * size_t(m_Zp)) {
+                s.buf.assign(size_t(kDirections) * size_t(m_Zp), 0.0f);
+                s.out.assign(size_t(m_Zp), 0.0f);
+            }
+            for (size_t r = range.begin(); r != range.end(); ++r)
+                for (size_t c = 0; c < m_fields.size(); ++c) processRow(r, c, s, outMode);
+        });
+        for (auto& f : m_fields) f->flip = !f->flip;
+        if (outMode != 2) return 0.0;
+        double diff = 0.0, norm = 0.0;
+        for (size_t r = 0; r < rows; ++r) {
+            diff += m_rowDiff[r];
+            norm += m_rowNorm[r];
+        }
+        return norm > 0.0 ? std::sqrt(diff / norm) : 0.0;
+    }
+
+    // Raw access to the current state of channel solve c (storage order, fp32 values).
+    void setState(size_t c, const std::vector<float>& f)
+    {
+        ChannelField<S>& field = *m_fields[c];
+        for (size_t n = 0; n < f.size(); ++n) field.a[n] = toStorage<S>(f[n]);
+        field.b = field.a;
+        field.flip = false;
+    }
+    void getState(size_t c, std::vector<float>& f) const
+    {
+        const ChannelField<S>& field = *m_fields[c];
+        const S* cur = field.flip ? field.b.data() : field.a.data();
+        f.resize(field.a.size());
+        loadRow(cur, f.data(), int(f.size()));
+    }
+
+    // Node totals sum_m f_m of the current state, for channel solve c.
+    void totals(size_t c, std::vector<float>& out) const
+    {
+        const ChannelField<S>& f = *m_fields[c];
+        const S* cur = f.flip ? f.b.data() : f.a.data();
+        out.assign(size_t(m_X) * m_Y * m_Z, 0.0f);
+        tbb::parallel_for(0, m_X, [&](int i) {
+            std::vector<float> row(static_cast<size_t>(m_Z));
+            for (int j = 0; j < m_Y; ++j) {
+                float* o = &out[(size_t(i) * m_Y + size_t(j)) * size_t(m_Z)];
+                for (int m = 0; m < kDirections; ++m) {
+                    loadRow(cur + dindex(i, j, 0, m), row.data(), m_Z);
+                    for (int k = 0; k < m_Z; ++k) o[k] += row[size_t(k)];
+                }
+            }
+        });
+    }
+
+private:
+    size_t dindex(int i, int j, int k, int m) const
+    {
+        return ((size_t(i) * size_t(m_Y) + size_t(j)) * kDirections + size_t(m)) * size_t(m_Z) + size_t(k);
+    }
+    bool isBoundary(int i, int j, int k) const
+    {
+        return i == 0 || j == 0 || k == 0 || i == m_X - 1 || j == m_Y - 1 || k == m_Z - 1;
+    }
+
+    void processRow(size_t r, size_t c, Scratch& s, int outMode)
+    {
+        ChannelField<S>& field = *m_fields[c];
+        const int i = int(r / size_t(m_Y)), j = int(r % size_t(m_Y));
+        const S* src = field.cur();
+        S* dst = field.next();
+        float* buf = s.buf.data();
+        const size_t Zp = size_t(m_Zp);
+        // 1. Load the row's 19 directions (z contiguous), padding to a multiple of 8 with zeros.
+        for (int m = 0; m < kDirections; ++m) loadRow(src + dindex(i, j, 0, m), buf + size_t(m) * Zp, m_Z);
+        // 2. Node totals of the source state, for the tolerance check.
+        if (outMode != 0) {
+            float* tot = &m_totals[(c * size_t(m_X) * m_Y + r) * size_t(m_Z)];
+            double diff = 0.0, norm = 0.0;
+            for (int k = 0; k < m_Z; ++k) {
+                float sum = 0.0f;
+                for (int m = 0; m < kDirections; ++m) sum += buf[size_t(m) * Zp + size_t(k)];
+                if (outMode == 2) {
+                    const double d = double(sum) - double(tot[k]);
+                    diff += d * d;
+                    norm += double(sum) * double(sum);
+                }
+                tot[k] = sum;
+            }
+            if (outMode == 2) {
+                m_rowDiff[r] += diff;
+                m_rowNorm[r] += norm;
+            }
+        }
+        // 3. Collide, 8 nodes at a time; rows and vectors without medium stream unchanged.
+        if (m_rowActive[r]) {
+            const float* rho = &m_rho[r * Zp];
+            const int* brown = &m_brown[r * Zp];
+            const bool rowBrown = m_rowBrown[r] != 0;
+            for (size_t k = 0; k < Zp; k += kLanes) {
+                const Vec8 rv = loadVec(rho + k);
+                bool any = false;
+                for (int l = 0; l < kLanes; ++l) any |= rho[k + size_t(l)] > 0.0f;
+                if (!any) continue;
+                Vec8 f[kDirections];
+                for (int m = 0; m < kDirections; ++m) f[m] = loadVec(buf + size_t(m) * Zp + k);
+                bool anyBrown = false;
+                if (rowBrown)
+                    for (int l = 0; l < kLanes; ++l) anyBrown |= brown[k + size_t(l)] != 0;
+                if (!anyBrown) {
+                    collideNode(f, rv, field.green, m_params.zeroF0);
+                } else {
+                    Vec8 fb[kDirections];
+                    for (int m = 0; m < kDirections; ++m) fb[m] = f[m];
+                    collideNode(f, rv, field.green, m_params.zeroF0);
+                    collideNode(fb, rv, field.brown, m_params.zeroF0);
+                    Vec8i mask;
+                    std::memcpy(&mask, brown + k, sizeof mask);
+                    for (int m = 0; m < kDirections; ++m) f[m] = mask ? fb[m] : f[m];
+                }
+                for (int m = 0; m < kDirections; ++m) storeVec(buf + size_t(m) * Zp + k, f[m]);
+            }
+        }
+        if (m_params.zeroF0) std::fill(buf, buf + Zp, 0.0f);   // absorbed: f_0 leaves the visible band
+        // 4. Stream: post_m(r) goes to r + c_m when that node is interior.
+        for (int m = 0; m < kDirections; ++m) {
+            const int ti = i + kC[m][0], tj = j + kC[m][1], cz = kC[m][2];
+            if (ti < 1 || ti > m_X - 2 || tj < 1 || tj > m_Y - 2) continue;
+            const int k0 = std::max(0, 1 - cz), k1 = std::min(m_Z - 1, m_Z - 2 - cz);   // source k range
+            if (k1 < k0) continue;
+            storeRow(buf + size_t(m) * Zp + size_t(k0), dst + dindex(ti, tj, k0 + cz, m), k1 - k0 + 1);
+        }
+    }
+
+    const LbParams& m_params;
+    glm::ivec3 m_dims;
+    int m_X = 0, m_Y = 0, m_Z = 0, m_Zp = 0;
+    std::vector<float> m_rho;          // padded rows of density
+    std::vector<int> m_brown;          // padded rows, -1 where brown
+    std::vector<uint8_t> m_rowActive;  // any density in the row
+    std::vector<uint8_t> m_rowBrown;   // any brown node in the row
+    std::vector<std::unique_ptr<ChannelField<S>>> m_fields;
+    std::vector<float> m_totals;
+    std::vector<double> m_rowDiff, m_rowNorm;
+    tbb::enumerable_thread_specific<Scratch> m_scratch;
+};
+
+template <typename S>
+LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progress* progress, SolveStats& stats)
+{
+    // Channels with equal optics share one solve: the result is linear in the sun intensity.
+    std::vector<ChannelParams> solves;
+    int solveOf[3];
+    for (int c = 0; c < 3; ++c) {
+        const ChannelParams& p = params.channels[size_t(c)];
+        int found = -1;
+        for (size_t s = 0; s < solves.size(); ++s)
+            if (solves[s].sigmaA == p.sigmaA && solves[s].sigmaS == p.sigmaS && solves[s].g == p.g) found = int(s);
+        if (found < 0) {
+            found = int(solves.size());
+            solves.push_back(p);
+        }
+        solveOf[c] = found;
+    }
+    stats.channelSolves = int(solves.size());
+
+    Solver<S> solver(density, params, solves);
+    stats.bytesPerStep = double(solver.bytesPerStep());
+    const int longest = density.geometry.longestEdge();
+    const bool tolMode = params.tolerance > 0.0;
+    const int steps = tolMode ? (params.maxSteps > 0 ? params.maxSteps : 4 * longest)
+                              : (params.steps > 0 ? params.steps : defaultSteps(density.geometry.dims));
+    const int every = std::max(1, params.checkEvery);
+    int done = 0;
+    for (int t = 0; t < steps; ++t) {
+        int outMode = 0;
+        if (tolMode) {
+            if (t >= 1 && t % every == 0) outMode = 2;      // compare with the state one step earlier
+            else if ((t + 1) % every == 0) outMode = 1;     // remember this state's totals
+        }
+        const double change = solver.step(outMode);
+        done = t + 1;
+        if (outMode == 2) {
+            stats.changeHistory.emplace_back(t, change);
+            stats.lastChange = change;
+            if (change < params.tolerance) {
+                stats.converged = true;
+                break;
+            }
+        }
+        if (progress) {
+            const double frac = double(done) / double(steps);
+            progress->report(frac, "LB step " + std::to_string(done) + "/" + std::to_string(steps));
+        }
+    }
+    stats.steps = done;
+
+    LightingGrid out;
+    out.geometry = density.geometry;
+    out.rgb.assign(density.geometry.nodeCount() * 3, 0.0f);
+    std::vector<float> tot;
+    for (size_t s = 0; s < solves.size(); ++s) {
+        solver.totals(s, tot);
+        for (int c = 0; c < 3; ++c) {
+            if (solveOf[c] != int(s)) continue;
+            const float intensity = params.intensity[c];
+            for (size_t n = 0; n < tot.size(); ++n) out.rgb[n * 3 + size_t(c)] = tot[n] * intensity;
+        }
+    }
+    return out;
+}
+
+} // namespace
+
+void advance(const DensityGrid& density, const LbParams& params, std::vector<float>& f, int steps)
+{
+    validate(params);
+    validateDensity(density);
+    const size_t expected = density.geometry.nodeCount() * size_t(kDirections);
+    if (f.size() != expected)
+        throw Error("LB state holds " + std::to_string(f.size()) + " values, expected " + std::to_string(expected));
+    auto run = [&](auto tag) {
+        using S = decltype(tag);
+        Solver<S> solver(density, params, {params.channels[0]});
+        solver.setState(0, f);
+        for (int t = 0; t < steps; ++t) solver.step(0);
+        solver.getState(0, f);
+    };
+    if (params.storage == Storage::Fp16) run(uint16_t{});
+    else run(float{});
+}
+
+std::vector<float> boundaryDistribution(const glm::vec3& sun)
+{
+    const glm::dvec3 d = -glm::normalize(glm::dvec3(sun));
+    std::vector<float> bc(kDirections, 0.0f);
+    for (int m = 1; m < kDirections; ++m) {
+        const glm::dvec3 n = glm::normalize(glm::dvec3(kC[m][0], kC[m][1], kC[m][2]));
+        bc[size_t(m)] = float(std::max(0.0, glm::dot(n, d)));
+    }
+    return bc;
+}
+
+LightingGrid solveLighting(const DensityGrid& density, const LbParams& params, Progress* progress, SolveStats* stats)
+{
+    validate(params);
+    validateDensity(density);
+    SolveStats local;
+    SolveStats& st = stats ? *stats : local;
+    st = SolveStats{};
+    const auto t0 = std::chrono::steady_clock::now();
+    LightingGrid out = params.storage == Storage::Fp16 ? runSolve<uint16_t>(density, params, progress, st)
+                                                       : runSolve<float>(density, params, progress, st);
+    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+}
+
+} // namespace sylva::lb

@@ -1,0 +1,35 @@
+// The LB lighting solve on the CPU: density grid in, RGB lighting grid out (LB_MODEL.md is the contract).
+#pragma once
+
+#include <vector>
+
+#include "core/base/progress.h"
+#include "core/grid/grid.h"
+#include "core/lb/lb_params.h"
+
+namespace sylva::lb {
+
+struct SolveStats {
+    int steps = 0;                  // steps taken (per channel)
+    bool converged = false;         // tolerance mode: the change fell under the tolerance
+    double lastChange = 0.0;        // last measured relative L2 change per step
+    int channelSolves = 0;          // distinct channel solves (channels with equal optics share one)
+    double seconds = 0.0;
+    double bytesPerStep = 0.0;      // f bytes read + written per step, all solved channels
+    std::vector<std::pair<int, double>> changeHistory;   // (step, relative change) at each check
+};
+
+// Solves the lighting for all three channels. Throws Error on invalid parameters or density,
+// Cancelled when progress is cancelled.
+LightingGrid solveLighting(const DensityGrid& density, const LbParams& params, Progress* progress = nullptr,
+                           SolveStats* stats = nullptr);
+
+// Advances an explicit state of channel 0 (19 values per node in the storage order of LB_MODEL.md:
+// ((i*Y + j)*19 + m)*Z + k) by `steps` steps with the same code as solveLighting. Boundary nodes keep
+// their values. For tests and tools.
+void advance(const DensityGrid& density, const LbParams& params, std::vector<float>& f, int steps);
+
+// Boundary value f_m = max(0, n_m . d) for unit intensity, d = -normalize(sun) (LB_MODEL.md "Boundary condition").
+std::vector<float> boundaryDistribution(const glm::vec3& sun);
+
+} // namespace sylva::lb

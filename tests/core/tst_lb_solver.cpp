@@ -1,0 +1,367 @@
+// LB solver against the seed's naive kernel, conservation, diffusion, symmetry, tolerance mode, fp16, validation.
+#include <QTest>
+
+#include <cmath>
+#include <random>
+
+#include "core/base/error.h"
+#include "core/base/progress.h"
+#include "core/grid/grid.h"
+#include "core/lb/lattice.h"
+#include "core/lb/lb_params.h"
+#include "core/lb/lb_solver.h"
+#include "core/lb/omega.h"
+
+using namespace sylva;
+using namespace sylva::lb;
+
+namespace {
+
+DensityGrid randomDensity(glm::ivec3 dims, uint32_t seed, double emptyShare, double woodShare)
+{
+    DensityGrid g;
+    g.geometry.dims = dims;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    g.density.resize(g.geometry.nodeCount());
+    g.woodFraction.resize(g.geometry.nodeCount());
+    for (size_t n = 0; n < g.density.size(); ++n) {
+        g.density[n] = u(rng) < emptyShare ? 0.0f : u(rng);
+        g.woodFraction[n] = u(rng) < woodShare ? 1.0f : 0.0f;
+    }
+    return g;
+}
+
+// The seed's naive kernel (004 section 3.1) in double precision: dense Omega, every node pushes
+// f_m + rho * (Omega f)_m to r + c_m when that node is interior; plants zero f_0 after each step.
+std::vector<double> referenceSolve(const DensityGrid& d, const LbParams& p, int channel, int steps)
+{
+    const glm::ivec3 n = d.geometry.dims;
+    const ChannelParams cp = p.channels[size_t(channel)];
+    const DenseOmega green = buildOmega(cp), brown = buildOmega({cp.sigmaA, cp.sigmaS, -1.0f});
+    auto idx = [&](int i, int j, int k, int m) { return ((size_t(i) * n.y + j) * kDirections + m) * n.z + k; };
+    auto interior = [&](int i, int j, int k) { return i > 0 && j > 0 && k > 0 && i < n.x - 1 && j < n.y - 1 && k < n.z - 1; };
+    std::vector<double> from(d.geometry.nodeCount() * kDirections, 0.0);
+    const glm::dvec3 dir = -glm::normalize(glm::dvec3(p.sun));
+    for (int i = 0; i < n.x; ++i)
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k)
+                if (!interior(i, j, k))
+                    for (int m = 1; m < kDirections; ++m) {
+                        glm::dvec3 c(kC[m][0], kC[m][1], kC[m][2]);
+                        from[idx(i, j, k, m)] = std::max(0.0, glm::dot(glm::normalize(c), dir));
+                    }
+    std::vector<double> to = from;
+    for (int t = 0; t < steps; ++t) {
+        for (int i = 0; i < n.x; ++i)
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k) {
+                    const size_t node = d.geometry.index(i, j, k);
+                    const double rho = d.density[node];
+                    const bool isBrown = d.woodFraction[node] > p.brownThreshold;
+                    const DenseOmega& om = isBrown ? brown : green;
+                    for (int m = 0; m < kDirections; ++m) {
+                        const int oi = i + kC[m][0], oj = j + kC[m][1], ok = k + kC[m][2];
+                        if (!interior(oi, oj, ok)) continue;
+                        double flow = 0;
+                        for (int q = 0; q < kDirections; ++q) flow += om[size_t(m * kDirections + q)] * from[idx(i, j, k, q)];
+                        to[idx(oi, oj, ok, m)] = from[idx(i, j, k, m)] + flow * rho;
+                    }
+                }
+        if (p.zeroF0)
+            for (int i = 1; i < n.x - 1; ++i)
+                for (int j = 1; j < n.y - 1; ++j)
+                    for (int k = 1; k < n.z - 1; ++k) to[idx(i, j, k, 0)] = 0.0;
+        std::swap(from, to);
+    }
+    std::vector<double> total(d.geometry.nodeCount(), 0.0);
+    for (int i = 0; i < n.x; ++i)
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k)
+                for (int m = 0; m < kDirections; ++m) total[d.geometry.index(i, j, k)] += from[idx(i, j, k, m)];
+    return total;
+}
+
+double relL2(const LightingGrid& a, const LightingGrid& b)
+{
+    double diff = 0, norm = 0;
+    for (size_t n = 0; n < a.rgb.size(); ++n) {
+        diff += double(a.rgb[n] - b.rgb[n]) * double(a.rgb[n] - b.rgb[n]);
+        norm += double(b.rgb[n]) * double(b.rgb[n]);
+    }
+    return std::sqrt(diff / norm);
+}
+
+std::vector<float> pulseState(const DensityGrid& g, glm::ivec3 at, float sigmaA)
+{
+    const glm::ivec3 n = g.geometry.dims;
+    std::vector<float> f(g.geometry.nodeCount() * kDirections, 0.0f);
+    for (int m = 0; m < kDirections; ++m) {
+        // The local equilibrium of the appendix, v / (1 + sigma_a), scaled to total mass 1000.
+        const double v = m == 0 ? sigmaA : weight(m);
+        f[((size_t(at.x) * n.y + at.y) * kDirections + m) * n.z + at.z] = float(1000.0 * v / (1.0 + sigmaA));
+    }
+    return f;
+}
+
+} // namespace
+
+class TestLbSolver : public QObject {
+    Q_OBJECT
+private Q_SLOTS:
+    void matchesNaiveKernel_data()
+    {
+        QTest::addColumn<QString>("preset");
+        QTest::addColumn<int>("nx");
+        QTest::addColumn<int>("ny");
+        QTest::addColumn<int>("nz");
+        QTest::addColumn<double>("woodShare");
+        QTest::addColumn<float>("sunX");
+        QTest::addColumn<float>("sunY");
+        QTest::addColumn<float>("sunZ");
+        QTest::newRow("leaf 9x7x11") << "leaf" << 9 << 7 << 11 << 0.0 << 0.3f << 1.0f << 0.2f;
+        QTest::newRow("leaf brown 10x9x13") << "leaf" << 10 << 9 << 13 << 0.3 << -0.5f << 0.8f << 0.1f;
+        QTest::newRow("dogrose brown 8x12x17") << "dogrose" << 8 << 12 << 17 << 0.2 << 0.0f << 0.0f << 1.0f;
+        QTest::newRow("cloud 12x6x9") << "cloud" << 12 << 6 << 9 << 0.0 << 1.0f << 1.0f << 1.0f;
+        QTest::newRow("pmma 7x7x20") << "pmma" << 7 << 7 << 20 << 0.0 << -1.0f << 0.2f << -0.3f;
+        QTest::newRow("isotropic 3x3x3") << "iso" << 3 << 3 << 3 << 0.0 << 0.0f << 1.0f << 0.0f;
+        QTest::newRow("isotropic 5x4x3") << "iso" << 5 << 4 << 3 << 0.5 << 0.2f << 1.0f << 0.7f;
+    }
+    void matchesNaiveKernel()
+    {
+        QFETCH(QString, preset);
+        QFETCH(int, nx);
+        QFETCH(int, ny);
+        QFETCH(int, nz);
+        QFETCH(double, woodShare);
+        QFETCH(float, sunX);
+        QFETCH(float, sunY);
+        QFETCH(float, sunZ);
+        LbParams p;
+        if (preset == "iso") {
+            p.channels = {{{0.2f, 0.7f, 0.0f}, {0.05f, 0.95f, 0.0f}, {0.5f, 0.5f, 0.0f}}};
+            p.zeroF0 = false;
+        } else {
+            p = paramsFromPreset(*findPreset(preset.toStdString()));
+        }
+        p.sun = {sunX, sunY, sunZ};
+        p.steps = 2 * std::max(nx, std::max(ny, nz));
+        const DensityGrid d = randomDensity({nx, ny, nz}, uint32_t(nx * 131 + ny * 17 + nz), 0.3, woodShare);
+        const LightingGrid out = solveLighting(d, p);
+        for (int c = 0; c < 3; ++c) {
+            const std::vector<double> ref = referenceSolve(d, p, c, p.steps);
+            double maxRef = 0, maxErr = 0;
+            for (size_t n = 0; n < ref.size(); ++n) {
+                maxRef = std::max(maxRef, std::fabs(ref[n]));
+                maxErr = std::max(maxErr, std::fabs(ref[n] - double(out.rgb[n * 3 + size_t(c)])));
+            }
+            QVERIFY(maxRef > 0.1);
+            QVERIFY2(maxErr <= 2e-6 * maxRef, qPrintable(QString("channel %1: max error %2 of %3").arg(c).arg(maxErr).arg(maxRef)));
+        }
+    }
+
+    void massConservedWithoutAbsorptionLoss()
+    {
+        // A pulse far from the boundary: nothing reaches it, so the total is conserved when f_0 is kept
+        // (for any sigma_a: absorbed mass is re-emitted), and falls by the zeroed f_0 otherwise.
+        DensityGrid d = randomDensity({31, 31, 31}, 5, 0.2, 0.0);
+        for (float sa : {0.0f, 0.3f}) {
+            LbParams p;
+            p.channels[0] = {sa, 1.0f - sa, 0.4f};
+            p.zeroF0 = false;
+            std::vector<float> f = pulseState(d, {15, 15, 15}, sa);
+            double before = 0;
+            for (float v : f) before += v;
+            advance(d, p, f, 12);
+            double after = 0;
+            for (float v : f) {
+                QVERIFY(v >= 0.0f && std::isfinite(v));
+                after += v;
+            }
+            QVERIFY2(std::fabs(after - before) < 1e-4 * before, qPrintable(QString("%1 -> %2").arg(before).arg(after)));
+        }
+    }
+
+    void pulseSpreadsWithSeedDiffusionCoefficient()
+    {
+        // Seed equation (4) with lambda = tau = 1: D = ((2/sigma_t) - 1) / (4 (1 + sigma_a)); in 3D the second
+        // moment of the density grows as d<r^2>/dt = 6 D. Measured between steps 20 and 40 in a uniform medium; within 1%.
+        const int n = 91, c = 45;
+        DensityGrid d;
+        d.geometry.dims = {n, n, n};
+        d.density.assign(d.geometry.nodeCount(), 1.0f);
+        for (auto [sa, ss] : {std::pair{0.0f, 0.8f}, std::pair{0.1f, 0.8f}}) {
+            LbParams p;
+            p.channels[0] = {sa, ss, 0.0f};
+            p.zeroF0 = false;
+            auto moment = [&](const std::vector<float>& f) {
+                double m0 = 0, m2 = 0;
+                for (int i = 0; i < n; ++i)
+                    for (int j = 0; j < n; ++j)
+                        for (int mm = 0; mm < kDirections; ++mm)
+                            for (int k = 0; k < n; ++k) {
+                                const double v = f[((size_t(i) * n + j) * kDirections + mm) * n + k];
+                                m0 += v;
+                                m2 += v * double((i - c) * (i - c) + (j - c) * (j - c) + (k - c) * (k - c));
+                            }
+                return m2 / m0;
+            };
+            std::vector<float> f = pulseState(d, {c, c, c}, sa);
+            advance(d, p, f, 20);
+            const double r20 = moment(f);
+            advance(d, p, f, 20);
+            const double r40 = moment(f);
+            const double measured = (r40 - r20) / 20.0 / 6.0;
+            const double st = double(sa) + double(ss);
+            const double expected = (2.0 / st - 1.0) / (4.0 * (1.0 + double(sa)));
+            qInfo("sigma_a=%.2f sigma_s=%.2f: D measured %.4f, seed (4) %.4f", double(sa), double(ss), measured, expected);
+            QVERIFY2(std::fabs(measured - expected) < 0.01 * expected,
+                     qPrintable(QString("D measured %1, expected %2").arg(measured).arg(expected)));
+        }
+    }
+
+    void symmetricInputGivesSymmetricOutput()
+    {
+        // Density mirrored in x, sun in the y-z plane: the lighting is mirror-symmetric in x.
+        DensityGrid d = randomDensity({13, 11, 9}, 21, 0.3, 0.2);
+        const glm::ivec3 n = d.geometry.dims;
+        for (int i = 0; i < n.x / 2; ++i)
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k) {
+                    d.density[d.geometry.index(n.x - 1 - i, j, k)] = d.density[d.geometry.index(i, j, k)];
+                    d.woodFraction[d.geometry.index(n.x - 1 - i, j, k)] = d.woodFraction[d.geometry.index(i, j, k)];
+                }
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.sun = {0.0f, 1.0f, 0.4f};
+        const LightingGrid out = solveLighting(d, p);
+        float maxV = 0, maxDiff = 0;
+        for (int i = 0; i < n.x; ++i)
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k)
+                    for (int c = 0; c < 3; ++c) {
+                        maxV = std::max(maxV, out.at(i, j, k, c));
+                        maxDiff = std::max(maxDiff, std::fabs(out.at(i, j, k, c) - out.at(n.x - 1 - i, j, k, c)));
+                    }
+        QVERIFY2(maxDiff <= 1e-5f * maxV, qPrintable(QString("asymmetry %1 of %2").arg(maxDiff).arg(maxV)));
+    }
+
+    void passThroughWhenNothingInteracts()
+    {
+        // sigma_a = 0, g = 1 (any density) equals an empty grid: light streams straight through.
+        DensityGrid dense = randomDensity({10, 9, 8}, 2, 0.0, 0.0);
+        DensityGrid empty = dense;
+        std::fill(empty.density.begin(), empty.density.end(), 0.0f);
+        LbParams p;
+        p.channels = {{{0.0f, 1.0f, 1.0f}, {0.0f, 0.5f, 1.0f}, {0.0f, 0.0f, 0.0f}}};
+        p.zeroF0 = false;
+        p.sun = {0.3f, 1.0f, -0.2f};
+        const LightingGrid a = solveLighting(dense, p), b = solveLighting(empty, p);
+        QVERIFY(relL2(a, b) < 1e-6);
+    }
+
+    void toleranceModeReachesFixedStepAnswer()
+    {
+        DensityGrid d = randomDensity({24, 30, 24}, 9, 0.5, 0.1);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.sun = {0.2f, 1.0f, 0.3f};
+        const LightingGrid fixed = solveLighting(d, p);
+        p.tolerance = 1e-3;
+        p.checkEvery = 4;
+        SolveStats st;
+        const LightingGrid tol = solveLighting(d, p, nullptr, &st);
+        qInfo("tolerance 1e-3: %d steps (fixed %d), converged %d, rel L2 %.2e", st.steps, 2 * 30, int(st.converged), relL2(tol, fixed));
+        QVERIFY(st.converged);
+        QVERIFY(st.steps < 60);
+        QVERIFY(relL2(tol, fixed) < 0.01);
+    }
+
+    void fp16StorageCloseToFp32()
+    {
+        DensityGrid d = randomDensity({20, 24, 18}, 4, 0.4, 0.1);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.sun = {0.5f, 1.0f, 0.0f};
+        const LightingGrid a = solveLighting(d, p);
+        p.storage = Storage::Fp16;
+        const LightingGrid b = solveLighting(d, p);
+        const double err = relL2(b, a);
+        qInfo("fp16 storage: rel L2 error %.2e", err);
+        QVERIFY(err < 5e-3);
+    }
+
+    void equalChannelsShareOneSolve()
+    {
+        DensityGrid d = randomDensity({9, 9, 9}, 1, 0.3, 0.0);
+        LbParams p = paramsFromPreset(*findPreset("cloud"));
+        p.intensity = {1.0f, 0.5f, 2.0f};
+        SolveStats st;
+        const LightingGrid out = solveLighting(d, p, nullptr, &st);
+        QCOMPARE(st.channelSolves, 1);
+        const std::vector<double> ref = referenceSolve(d, p, 0, 18);
+        for (size_t n = 0; n < ref.size(); ++n)
+            for (int c = 0; c < 3; ++c)
+                QVERIFY(std::fabs(out.rgb[n * 3 + size_t(c)] - p.intensity[c] * ref[n]) <= 2e-6 * std::max(1.0, p.intensity[c] * ref[n]));
+    }
+
+    void invalidParametersAreRefused_data()
+    {
+        QTest::addColumn<float>("sa");
+        QTest::addColumn<float>("ss");
+        QTest::addColumn<float>("g");
+        QTest::addColumn<QString>("mentions");
+        QTest::newRow("sigma_t > 1") << 0.5f << 0.6f << 0.0f << "stability bound 1";
+        QTest::newRow("negative sigma_a") << -0.1f << 0.5f << 0.0f << "sigma_a";
+        QTest::newRow("negative sigma_s") << 0.1f << -0.5f << 0.0f << "sigma_s";
+        QTest::newRow("g > 1") << 0.1f << 0.5f << 1.5f << "g = ";
+        QTest::newRow("NaN g") << 0.1f << 0.5f << NAN << "g = ";
+        QTest::newRow("inf sigma_s") << 0.1f << INFINITY << 0.0f << "sigma_s";
+    }
+    void invalidParametersAreRefused()
+    {
+        QFETCH(float, sa);
+        QFETCH(float, ss);
+        QFETCH(float, g);
+        QFETCH(QString, mentions);
+        DensityGrid d = randomDensity({5, 5, 5}, 1, 0.0, 0.0);
+        LbParams p;
+        p.channels[1] = {sa, ss, g};
+        try {
+            solveLighting(d, p);
+            QFAIL("accepted invalid parameters");
+        } catch (const Error& e) {
+            QVERIFY2(QString(e.what()).contains(mentions), e.what());
+            QVERIFY2(QString(e.what()).contains("channel G"), e.what());
+        }
+    }
+
+    void invalidDensityIsRefused()
+    {
+        DensityGrid d = randomDensity({5, 5, 5}, 1, 0.0, 0.0);
+        LbParams p;
+        d.density[17] = 1.5f;
+        QVERIFY_THROWS_EXCEPTION(Error, solveLighting(d, p));
+        d.density[17] = NAN;
+        QVERIFY_THROWS_EXCEPTION(Error, solveLighting(d, p));
+        d.density[17] = 0.5f;
+        d.geometry.dims = {2, 5, 5};
+        QVERIFY_THROWS_EXCEPTION(Error, solveLighting(d, p));
+        d.geometry.dims = {5, 5, 5};
+        p.sun = {0, 0, 0};
+        QVERIFY_THROWS_EXCEPTION(Error, solveLighting(d, p));
+    }
+
+    void cancelStopsTheSolve()
+    {
+        DensityGrid d = randomDensity({16, 16, 16}, 1, 0.0, 0.0);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        int calls = 0;
+        Progress progress;
+        progress.setCallback([&](double, const std::string&) {
+            if (++calls == 3) progress.cancel();
+        });
+        QVERIFY_THROWS_EXCEPTION(Cancelled, solveLighting(d, p, &progress));
+        QCOMPARE(calls, 3);
+    }
+};
+
+QTEST_APPLESS_MAIN(TestLbSolver)
+#include "tst_lb_solver.moc"
