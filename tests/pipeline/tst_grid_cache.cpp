@@ -1,0 +1,394 @@
+// Tests of the grid cache: keys, round trips, detection of damaged or stale entries, concurrent writers.
+#include <algorithm>
+#include <cstring>
+#include <functional>
+
+#include <QCoreApplication>
+#include <QDir>
+#include <QFile>
+#include <QFileInfo>
+#include <QProcess>
+#include <QProcessEnvironment>
+#include <QTest>
+
+#include "core/base/error.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/io/npy.h"
+
+using namespace sylva;
+
+namespace {
+
+// Set in the environment of the child processes that concurrentWriters starts.
+constexpr char kChildDirVariable[] = "SYLVA_TST_CACHE_CHILD_DIR";
+constexpr char kChildValueVariable[] = "SYLVA_TST_CACHE_CHILD_VALUE";
+constexpr int kChildRounds = 25;
+constexpr int kChildGridEdge = 64;   // 64^3 x 3 floats: a 3 MiB entry
+
+QString outDir()
+{
+    return QStringLiteral(SYLVA_TEST_OUTPUT "/tst_grid_cache");
+}
+
+DensityGrid makeDensity(glm::ivec3 dims, float seed)
+{
+    DensityGrid g;
+    g.geometry.dims = dims;
+    g.geometry.origin = {0.5, -1.25, 3.0};
+    g.geometry.spacing = 0.0625;
+    const size_t n = g.geometry.nodeCount();
+    g.density.resize(n);
+    g.woodFraction.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        g.density[i] = float(i % 97) / 97.0f + seed;
+        g.woodFraction[i] = float(i % 13) / 13.0f;
+    }
+    return g;
+}
+
+LightingGrid makeLighting(glm::ivec3 dims, float value)
+{
+    LightingGrid g;
+    g.geometry.dims = dims;
+    g.geometry.origin = {-2.0, 0.0, 1.0};
+    g.geometry.spacing = 0.125;
+    g.rgb.assign(g.geometry.nodeCount() * 3, value);
+    return g;
+}
+
+CacheKey keyFor(const char* mesh, double sigma)
+{
+    CacheKey key;
+    key.add("cache format", int64_t(kCacheFormatVersion)).add("mesh", mesh).add("sigma_s", sigma).add("grid", int64_t(32));
+    return key;
+}
+
+QByteArray readAll(const std::string& path)
+{
+    QFile f(QString::fromStdString(path));
+    return f.open(QIODevice::ReadOnly) ? f.readAll() : QByteArray();
+}
+
+void writeAll(const std::string& path, const QByteArray& bytes)
+{
+    QFile f(QString::fromStdString(path));
+    QVERIFY(f.open(QIODevice::WriteOnly | QIODevice::Truncate));
+    QCOMPARE(f.write(bytes), bytes.size());
+}
+
+bool exists(const std::string& path)
+{
+    return QFile::exists(QString::fromStdString(path));
+}
+
+} // namespace
+
+class TstGridCache : public QObject {
+    Q_OBJECT
+
+private:
+    bool isChild() const { return qEnvironmentVariableIsSet(kChildDirVariable); }
+
+    std::string freshDir(const char* name)
+    {
+        const QString dir = outDir() + QLatin1Char('/') + QLatin1String(name);
+        QDir(dir).removeRecursively();
+        return dir.toStdString();
+    }
+
+    // Stores an entry, lets `damage` edit its bytes, then expects a reported, deleting miss.
+    void expectRejected(const char* name, const std::function<void(QByteArray&)>& damage, const QString& expected)
+    {
+        GridCache cache(freshDir(name));
+        const CacheKey key = keyFor("tree.obj", 0.5);
+        cache.storeDensity(key, makeDensity({6, 7, 8}, 0.0f));
+        const std::string path = cache.entryPath(key, 'd');
+        QByteArray bytes = readAll(path);
+        damage(bytes);
+        writeAll(path, bytes);
+        std::string why;
+        QVERIFY(!cache.loadDensity(key, &why));
+        const QString message = QString::fromStdString(why);
+        QVERIFY2(message.contains(expected), qPrintable(message));
+        QVERIFY2(message.contains(QString::fromStdString(path)), qPrintable(message));
+        QVERIFY2(message.contains(QStringLiteral("recomputing")), qPrintable(message));
+        QVERIFY(!exists(path));
+        // The next store heals the entry.
+        cache.storeDensity(key, makeDensity({6, 7, 8}, 0.0f));
+        QVERIFY(cache.loadDensity(key));
+    }
+
+private Q_SLOTS:
+    void initTestCase()
+    {
+        if (isChild()) return;
+        QDir(outDir()).removeRecursively();
+        QVERIFY(QDir().mkpath(outDir()));
+    }
+
+    void keyFields()
+    {
+        auto hexOf = [](auto build) {
+            CacheKey k;
+            build(k);
+            return k.hex();
+        };
+        const std::string abc1 = hexOf([](CacheKey& k) { k.add("ab", "c"); });
+        const std::string abc2 = hexOf([](CacheKey& k) { k.add("a", "bc"); });
+        QVERIFY(abc1 != abc2);
+        QVERIFY(hexOf([](CacheKey& k) { k.add("x", "ab").add("y", "c"); }) != hexOf([](CacheKey& k) { k.add("x", "a").add("y", "bc"); }));
+        QCOMPARE(abc1, hexOf([](CacheKey& k) { k.add("ab", "c"); }));
+        QCOMPARE(abc1.size(), size_t(64));
+        QVERIFY(abc1.find_first_not_of("0123456789abcdef") == std::string::npos);
+        QVERIFY(hexOf([](CacheKey& k) { k.add("n", 1.0); }) != hexOf([](CacheKey& k) { k.add("n", int64_t(1)); }));
+        QCOMPARE(hexOf([](CacheKey& k) { k.add("n", -0.0); }), hexOf([](CacheKey& k) { k.add("n", 0.0); }));
+        QVERIFY(hexOf([](CacheKey& k) { k.add("a", int64_t(1)).add("b", int64_t(2)); }) !=
+                hexOf([](CacheKey& k) { k.add("b", int64_t(2)).add("a", int64_t(1)); }));
+        const std::byte raw[3] = {std::byte{'a'}, std::byte{'b'}, std::byte{'c'}};
+        const std::string spanKey = hexOf([&](CacheKey& k) { k.add("mesh", std::span<const std::byte>(raw)); });
+        QVERIFY(spanKey != hexOf([](CacheKey& k) { k.add("mesh", "abc"); }));
+        QCOMPARE(spanKey, hexOf([&](CacheKey& k) { k.add("mesh", std::span<const std::byte>(raw, 3)); }));
+        QVERIFY(spanKey != hexOf([&](CacheKey& k) { k.add("mesh", std::span<const std::byte>(raw, 2)); }));
+        QCOMPARE(CacheKey().hex(), std::string("e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"));   // SHA-256("")
+    }
+
+    // XXH64 against the reference implementation's values.
+    void checksumVectors()
+    {
+        QCOMPARE(xxh64("", 0), 0xef46db3751d8e999ull);
+        QCOMPARE(xxh64("abc", 3), 0x44bc2cf5ad770999ull);
+        QByteArray pattern;
+        for (int r = 0; r < 4; ++r)
+            for (int i = 0; i < 256; ++i) pattern += char(i);
+        pattern += "xyz";
+        QCOMPARE(xxh64(pattern.constData(), size_t(pattern.size())), 0xe146cb31b65bc21aull);
+    }
+
+    void defaultDir()
+    {
+        const QByteArray saved = qgetenv("XDG_CACHE_HOME");
+        qputenv("XDG_CACHE_HOME", "/tmp/sylva-xdg");
+        QCOMPARE(GridCache().dir(), std::string("/tmp/sylva-xdg/sylva"));
+        qunsetenv("XDG_CACHE_HOME");
+        QCOMPARE(QString::fromStdString(GridCache().dir()), QDir::homePath() + QStringLiteral("/.cache/sylva"));
+        qputenv("XDG_CACHE_HOME", "relative/path");   // not absolute: ignored, as the XDG spec says
+        QCOMPARE(QString::fromStdString(GridCache().dir()), QDir::homePath() + QStringLiteral("/.cache/sylva"));
+        if (saved.isNull()) qunsetenv("XDG_CACHE_HOME");
+        else qputenv("XDG_CACHE_HOME", saved);
+        QCOMPARE(GridCache("/somewhere").dir(), std::string("/somewhere"));
+    }
+
+    void roundTrip()
+    {
+        const std::string dir = freshDir("roundtrip") + "/not/yet/there";
+        GridCache cache(dir);
+        const CacheKey key = keyFor("tree.obj", 0.5);
+        const DensityGrid d = makeDensity({5, 6, 7}, 0.25f);
+        cache.storeDensity(key, d);
+        QVERIFY(QDir(QString::fromStdString(dir)).exists());   // the entry folder was created
+        std::string why;
+        const auto loaded = cache.loadDensity(key, &why);
+        QVERIFY2(loaded, why.c_str());
+        QVERIFY(loaded->geometry == d.geometry);
+        QVERIFY(loaded->density == d.density);
+        QVERIFY(loaded->woodFraction == d.woodFraction);
+
+        const LightingGrid l = makeLighting({4, 5, 6}, 0.75f);
+        cache.storeLighting(key, l);
+        const auto light = cache.loadLighting(key, &why);
+        QVERIFY2(light, why.c_str());
+        QVERIFY(light->geometry == l.geometry);
+        QVERIFY(light->rgb == l.rgb);
+        // Density and lighting of one key are separate entries.
+        QVERIFY(cache.entryPath(key, 'd') != cache.entryPath(key, 'l'));
+        QVERIFY(cache.loadDensity(key));
+
+        // A grid without wood fraction comes back with zeros.
+        DensityGrid bare = d;
+        bare.woodFraction.clear();
+        cache.storeDensity(key, bare);
+        QVERIFY(cache.loadDensity(key)->woodFraction == std::vector<float>(d.density.size(), 0.0f));
+
+        // Entries are exactly header + payload, and no temporary files remain.
+        QCOMPARE(QFileInfo(QString::fromStdString(cache.entryPath(key, 'l'))).size(), qint64(136 + 4 * 5 * 6 * 3 * 4));
+        const QStringList files = QFileInfo(QString::fromStdString(cache.entryPath(key, 'd'))).dir().entryList(QDir::Files | QDir::Hidden);
+        QCOMPARE(files.size(), 2);
+
+        QVERIFY_THROWS_EXCEPTION(Error, cache.storeLighting(key, LightingGrid{}));
+        LightingGrid wrong = l;
+        wrong.rgb.pop_back();
+        QVERIFY_THROWS_EXCEPTION(Error, cache.storeLighting(key, wrong));
+    }
+
+    void missOnOtherKey()
+    {
+        GridCache cache(freshDir("miss"));
+        cache.storeLighting(keyFor("tree.obj", 0.5), makeLighting({3, 3, 3}, 1.0f));
+        std::string why;
+        QVERIFY(!cache.loadLighting(keyFor("tree.obj", 0.6), &why));
+        QVERIFY2(QString::fromStdString(why).contains(QStringLiteral("no cache entry")), why.c_str());
+        QVERIFY(!cache.loadLighting(keyFor("bush.obj", 0.5)));
+        QVERIFY(!cache.loadDensity(keyFor("tree.obj", 0.5)));
+        QVERIFY(cache.loadLighting(keyFor("tree.obj", 0.5)));
+    }
+
+    void truncatedEntry()
+    {
+        expectRejected("truncated", [](QByteArray& b) { b.truncate(b.size() / 2); }, QStringLiteral("is truncated"));
+        expectRejected("truncated-header", [](QByteArray& b) { b.truncate(100); }, QStringLiteral("is truncated"));
+        expectRejected("empty", [](QByteArray& b) { b.clear(); }, QStringLiteral("is truncated"));
+        expectRejected("trailing", [](QByteArray& b) { b.append("junk"); }, QStringLiteral("is corrupt"));
+    }
+
+    void flippedPayloadByte()
+    {
+        expectRejected("flip-payload", [](QByteArray& b) { b[b.size() - 1000] = char(b[b.size() - 1000] ^ 0x10); },
+                       QStringLiteral("is corrupt (checksum mismatch)"));
+        expectRejected("flip-origin", [](QByteArray& b) { b[40] = char(b[40] ^ 0x01); }, QStringLiteral("is corrupt (checksum mismatch)"));
+        expectRejected("flip-checksum", [](QByteArray& b) { b[104] = char(b[104] ^ 0x80); }, QStringLiteral("is corrupt (checksum mismatch)"));
+        expectRejected("flip-dims", [](QByteArray& b) { b[16] = char(b[16] + 1); }, QStringLiteral("is corrupt"));
+        expectRejected("bad magic", [](QByteArray& b) { b[0] = 'X'; }, QStringLiteral("not a Sylva grid cache file"));
+    }
+
+    void wrongVersion()
+    {
+        expectRejected("version", [](QByteArray& b) { b[8] = char(kCacheFormatVersion + 1); },
+                       QStringLiteral("of format version %1").arg(kCacheFormatVersion + 1));
+    }
+
+    void keyMismatch()
+    {
+        GridCache cache(freshDir("stale"));
+        const CacheKey a = keyFor("tree.obj", 0.5), b = keyFor("tree.obj", 0.7);
+        cache.storeDensity(a, makeDensity({4, 4, 4}, 0.0f));
+        QVERIFY(QFile::copy(QString::fromStdString(cache.entryPath(a, 'd')), QString::fromStdString(cache.entryPath(b, 'd'))));
+        std::string why;
+        QVERIFY(!cache.loadDensity(b, &why));
+        QVERIFY2(QString::fromStdString(why).contains(QStringLiteral("stale")), why.c_str());
+        QVERIFY(!exists(cache.entryPath(b, 'd')));
+        QVERIFY(cache.loadDensity(a));
+
+        // A density entry where a lighting entry belongs is rejected too.
+        QVERIFY(QFile::copy(QString::fromStdString(cache.entryPath(a, 'd')), QString::fromStdString(cache.entryPath(a, 'l'))));
+        QVERIFY(!cache.loadLighting(a, &why));
+        QVERIFY2(QString::fromStdString(why).contains(QStringLiteral("a density entry, not a lighting entry")), why.c_str());
+        QVERIFY(!exists(cache.entryPath(a, 'l')));
+    }
+
+    void describe()
+    {
+        GridCache cache(freshDir("describe"));
+        const CacheKey key = keyFor("tree.obj", 0.5);
+        cache.storeLighting(key, makeLighting({4, 5, 6}, 0.5f));
+        const std::string path = cache.entryPath(key, 'l');
+        QVERIFY(isCacheFile(path));
+        QString text = QString::fromStdString(describeCacheFile(path));
+        QVERIFY2(text.contains(QStringLiteral("lighting")), qPrintable(text));
+        QVERIFY2(text.contains(QStringLiteral("4 x 5 x 6, 3 channels")), qPrintable(text));
+        QVERIFY2(text.contains(QString::fromStdString(key.hex())), qPrintable(text));
+        QVERIFY2(text.contains(QStringLiteral("checksum:  ok")), qPrintable(text));
+
+        QByteArray bytes = readAll(path);
+        bytes[200] = char(bytes[200] ^ 1);
+        writeAll(path, bytes);
+        text = QString::fromStdString(describeCacheFile(path));
+        QVERIFY2(text.contains(QStringLiteral("MISMATCH")), qPrintable(text));
+        writeAll(path, bytes.left(300));
+        text = QString::fromStdString(describeCacheFile(path));
+        QVERIFY2(text.contains(QStringLiteral("truncated")), qPrintable(text));
+
+        const std::string npy = outDir().toStdString() + "/describe.npy";
+        writeNpy(npy, NpyArray{{3}, {1.0f, 2.0f, 3.0f}});
+        QVERIFY(!isCacheFile(npy));
+        QVERIFY(!isCacheFile(outDir().toStdString() + "/missing"));
+        QVERIFY_THROWS_EXCEPTION(Error, describeCacheFile(npy));
+        QVERIFY_THROWS_EXCEPTION(Error, describeCacheFile(outDir().toStdString() + "/missing"));
+    }
+
+    // Child processes store the same key many times while this process keeps loading it: every
+    // load is a clean miss or a whole entry from one writer, and one valid entry remains.
+    void concurrentWriters()
+    {
+        if (isChild()) QSKIP("runs in the parent process only");
+        const std::string dir = freshDir("concurrent");
+        const CacheKey key = keyFor("forest.obj", 1.5);
+        const glm::ivec3 dims(kChildGridEdge);
+        QList<QProcess*> children;
+        for (int c = 0; c < 3; ++c) {
+            auto* child = new QProcess(this);
+            QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+            env.insert(QLatin1String(kChildDirVariable), QString::fromStdString(dir));
+            env.insert(QLatin1String(kChildValueVariable), QString::number(c + 1));
+            child->setProcessEnvironment(env);
+            child->setProcessChannelMode(QProcess::MergedChannels);
+            child->start(QCoreApplication::applicationFilePath(), {QStringLiteral("concurrentWriterChild")});
+            QVERIFY2(child->waitForStarted(), qPrintable(child->errorString()));
+            children << child;
+        }
+        // Whatever happens below, no child outlives this test.
+        struct Reaper {
+            QList<QProcess*>& children;
+            ~Reaper()
+            {
+                for (QProcess* c : children) {
+                    if (c->state() != QProcess::NotRunning) {
+                        c->kill();
+                        c->waitForFinished(5000);
+                    }
+                }
+            }
+        } reaper{children};
+        GridCache cache(dir);
+        int hits = 0, loads = 0;
+        auto running = [&] {
+            for (QProcess* c : children)
+                if (c->state() != QProcess::NotRunning) return true;
+            return false;
+        };
+        while (running()) {
+            std::string why;
+            ++loads;
+            if (auto g = cache.loadLighting(key, &why)) {
+                ++hits;
+                QCOMPARE(g->geometry.dims, dims);
+                const float first = g->rgb.front();
+                QVERIFY(first == 1.0f || first == 2.0f || first == 3.0f);
+                QVERIFY(std::all_of(g->rgb.begin(), g->rgb.end(), [&](float v) { return v == first; }));
+            } else {
+                QVERIFY2(QString::fromStdString(why).startsWith(QStringLiteral("no cache entry")), why.c_str());
+            }
+            for (QProcess* c : children) c->waitForFinished(1);
+        }
+        for (QProcess* c : children) {
+            QVERIFY2(c->exitStatus() == QProcess::NormalExit && c->exitCode() == 0, c->readAll().constData());
+        }
+        qInfo("%d of %d loads during the writes were hits", hits, loads);
+        std::string why;
+        const auto final = cache.loadLighting(key, &why);
+        QVERIFY2(final, why.c_str());
+        QCOMPARE(final->geometry.dims, dims);
+        const QStringList files = QFileInfo(QString::fromStdString(cache.entryPath(key, 'l'))).dir().entryList(QDir::Files | QDir::Hidden);
+        QVERIFY2(files.size() == 1, qPrintable(files.join(QLatin1Char(' '))));   // no temporary files left behind
+    }
+
+    // The body of a concurrentWriters child (started with this slot's name); skipped otherwise.
+    void concurrentWriterChild()
+    {
+        if (!isChild()) QSKIP("runs only as a child process of concurrentWriters");
+        GridCache cache(qEnvironmentVariable(kChildDirVariable).toStdString());
+        const float value = qEnvironmentVariable(kChildValueVariable).toFloat();
+        const LightingGrid grid = makeLighting(glm::ivec3(kChildGridEdge), value);
+        const CacheKey key = keyFor("forest.obj", 1.5);
+        for (int round = 0; round < kChildRounds; ++round) {
+            cache.storeLighting(key, grid);
+            if (round % 5 == 0) {
+                std::string why;
+                const auto g = cache.loadLighting(key, &why);
+                QVERIFY2(g, why.c_str());
+            }
+        }
+    }
+};
+
+QTEST_GUILESS_MAIN(TstGridCache)
+#include "tst_grid_cache.moc"
