@@ -72,14 +72,11 @@ template <typename S>
 struct ChannelField {
     CompactOmega green{}, brown{};
     std::vector<S> a, b;
-    S* cur() { return flip ? b.data() : a.data(); }
-    S* next() { return flip ? a.data() : b.data(); }
     bool flip = false;
 };
 
 struct Scratch {
     std::vector<float> buf;   // 19 rows of Zp floats
-    std::vector<float> out;   // Zp floats: node totals of the source state
 };
 
 template <typename S>
@@ -130,32 +127,58 @@ public:
 
     size_t bytesPerStep() const { return m_fields.size() * size_t(m_X) * m_Y * m_Z * kDirections * sizeof(S) * 2; }
 
-    // One step for every channel. outMode: 0 none, 1 store totals of the source state, 2 compare with stored.
-    double step(int outMode)
+    // Advances every channel by `levels` steps as a wavefront over x-slabs (temporal blocking): level l
+    // processes source slab w - l, one slab behind level l-1, so the slabs a block touches stay in cache.
+    // Two full copies of f suffice: level l reads the copy level l-1 wrote, and the one-slab lag keeps every
+    // read ahead of the next overwrite. Each node update is the same arithmetic as a plain step, so the
+    // result is bit-identical for any block depth. With compareLevel >= 1, level compareLevel-1 stores the
+    // node totals and level compareLevel returns the relative L2 change between the two (else 0).
+    double advanceBlock(int levels, int compareLevel)
     {
         const size_t rows = size_t(m_X) * size_t(m_Y);
-        if (outMode != 0 && m_totals.empty()) m_totals.assign(m_fields.size() * rows * size_t(m_Z), 0.0f);
-        if (outMode == 2) {
+        if (compareLevel >= 1 && m_totals.empty()) m_totals.assign(m_fields.size() * rows * size_t(m_Z), 0.0f);
+        if (compareLevel >= 1) {
             m_rowDiff.assign(rows, 0.0);
             m_rowNorm.assign(rows, 0.0);
         }
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, rows, 4), [&](const tbb::blocked_range<size_t>& range) {
-            Scratch& s = m_scratch.local();
-            if (s.buf.size() != size_t(kDirections) * size_t(m_Zp)) {
-                s.buf.assign(size_t(kDirections) * size_t(m_Zp), 0.0f);
-                s.out.assign(size_t(m_Zp), 0.0f);
+        const size_t grain = size_t(std::max(1, m_Y / 16));
+        for (size_t c = 0; c < m_fields.size(); ++c) {
+            ChannelField<S>& field = *m_fields[c];
+            for (int w = 0; w < m_X + levels - 1; ++w) {
+                if (m_progress) m_progress->throwIfCancelled();
+                for (int l = 0; l < levels; ++l) {
+                    const int x = w - l;
+                    if (x < 0 || x >= m_X) continue;
+                    const bool odd = (l & 1) != 0;
+                    const S* src = (field.flip != odd) ? field.b.data() : field.a.data();
+                    S* dst = (field.flip != odd) ? field.a.data() : field.b.data();
+                    const int outMode = compareLevel < 1 ? 0 : (l == compareLevel - 1 ? 1 : (l == compareLevel ? 2 : 0));
+                    tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(m_Y), grain),
+                                      [&](const tbb::blocked_range<size_t>& range) {
+                                          Scratch& sc = m_scratch.local();
+                                          if (sc.buf.size() != size_t(kDirections) * size_t(m_Zp))
+                                              sc.buf.assign(size_t(kDirections) * size_t(m_Zp), 0.0f);
+                                          for (size_t j = range.begin(); j != range.end(); ++j)
+                                              processRow(size_t(x) * size_t(m_Y) + j, c, src, dst, sc, outMode);
+                                      });
+                }
             }
-            for (size_t r = range.begin(); r != range.end(); ++r)
-                for (size_t c = 0; c < m_fields.size(); ++c) processRow(r, c, s, outMode);
-        });
-        for (auto& f : m_fields) f->flip = !f->flip;
-        if (outMode != 2) return 0.0;
+            if (levels & 1) field.flip = !field.flip;
+        }
+        if (compareLevel < 1) return 0.0;
         double diff = 0.0, norm = 0.0;
         for (size_t r = 0; r < rows; ++r) {
             diff += m_rowDiff[r];
             norm += m_rowNorm[r];
         }
         return norm > 0.0 ? std::sqrt(diff / norm) : 0.0;
+    }
+
+    // Slab depth of the wavefront: as many levels as keep (levels + 3) slabs of both copies in ~12 MB.
+    int autoLevels() const
+    {
+        const double slab = double(m_Y) * m_Z * kDirections * sizeof(S);
+        return std::clamp(int(12.0e6 / (2.0 * slab)) - 3, 1, 16);
     }
 
     // Raw access to the current state of channel solve c (storage order, fp32 values).
@@ -202,12 +225,10 @@ private:
         return i == 0 || j == 0 || k == 0 || i == m_X - 1 || j == m_Y - 1 || k == m_Z - 1;
     }
 
-    void processRow(size_t r, size_t c, Scratch& s, int outMode)
+    void processRow(size_t r, size_t c, const S* src, S* dst, Scratch& s, int outMode)
     {
         ChannelField<S>& field = *m_fields[c];
         const int i = int(r / size_t(m_Y)), j = int(r % size_t(m_Y));
-        const S* src = field.cur();
-        S* dst = field.next();
         float* buf = s.buf.data();
         const size_t Zp = size_t(m_Zp);
         // 1. Load the row's 19 directions (z contiguous), padding to a multiple of 8 with zeros.
@@ -271,6 +292,10 @@ private:
         }
     }
 
+public:
+    Progress* m_progress = nullptr;   // checked for cancel once per wavefront slab
+
+private:
     const LbParams& m_params;
     glm::ivec3 m_dims;
     int m_X = 0, m_Y = 0, m_Z = 0, m_Zp = 0;
@@ -304,33 +329,32 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
     stats.channelSolves = int(solves.size());
 
     Solver<S> solver(density, params, solves);
+    solver.m_progress = progress;
     stats.bytesPerStep = double(solver.bytesPerStep());
     const int longest = density.geometry.longestEdge();
     const bool tolMode = params.tolerance > 0.0;
     const int steps = tolMode ? (params.maxSteps > 0 ? params.maxSteps : 4 * longest)
                               : (params.steps > 0 ? params.steps : defaultSteps(density.geometry.dims));
-    const int every = std::max(1, params.checkEvery);
+    // Fixed steps run in wavefront blocks of the cache-sized depth; tolerance mode in blocks of the check
+    // period whose last two levels measure the change per step.
+    const int block = tolMode ? std::max(2, params.checkEvery)
+                              : (params.blockSteps > 0 ? params.blockSteps : solver.autoLevels());
+    stats.blockSteps = block;
     int done = 0;
-    for (int t = 0; t < steps; ++t) {
-        int outMode = 0;
-        if (tolMode) {
-            if (t >= 1 && t % every == 0) outMode = 2;      // compare with the state one step earlier
-            else if ((t + 1) % every == 0) outMode = 1;     // remember this state's totals
-        }
-        const double change = solver.step(outMode);
-        done = t + 1;
-        if (outMode == 2) {
-            stats.changeHistory.emplace_back(t, change);
+    while (done < steps) {
+        const int levels = std::min(block, steps - done);
+        const int compare = tolMode && levels >= 2 ? levels - 1 : 0;
+        const double change = solver.advanceBlock(levels, compare);
+        done += levels;
+        if (compare > 0) {
+            stats.changeHistory.emplace_back(done, change);
             stats.lastChange = change;
             if (change < params.tolerance) {
                 stats.converged = true;
                 break;
             }
         }
-        if (progress) {
-            const double frac = double(done) / double(steps);
-            progress->report(frac, "LB step " + std::to_string(done) + "/" + std::to_string(steps));
-        }
+        if (progress) progress->report(double(done) / double(steps), "LB step " + std::to_string(done) + "/" + std::to_string(steps));
     }
     stats.steps = done;
 
@@ -362,7 +386,8 @@ void advance(const DensityGrid& density, const LbParams& params, std::vector<flo
         using S = decltype(tag);
         Solver<S> solver(density, params, {params.channels[0]});
         solver.setState(0, f);
-        for (int t = 0; t < steps; ++t) solver.step(0);
+        const int block = params.blockSteps > 0 ? params.blockSteps : solver.autoLevels();
+        for (int t = 0; t < steps; t += block) solver.advanceBlock(std::min(block, steps - t), 0);
         solver.getState(0, f);
     };
     if (params.storage == Storage::Fp16) run(uint16_t{});

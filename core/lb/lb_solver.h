@@ -15,6 +15,7 @@ struct SolveStats {
     double lastChange = 0.0;        // last measured relative L2 change per step
     int channelSolves = 0;          // distinct channel solves (channels with equal optics share one)
     double seconds = 0.0;
+    int blockSteps = 0;             // steps per wavefront block
     double bytesPerStep = 0.0;      // f bytes read + written per step, all solved channels
     std::vector<std::pair<int, double>> changeHistory;   // (step, relative change) at each check
 };

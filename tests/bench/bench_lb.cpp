@@ -1,0 +1,160 @@
+// LB solve benchmark: 128^3 RGB leaf lighting, fp32/fp16 x fixed/tolerance, against the memory-bandwidth floor measured in the same run.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "core/grid/grid.h"
+#include "core/lb/lb_params.h"
+#include "core/lb/lb_solver.h"
+
+using namespace sylva;
+using namespace sylva::lb;
+
+namespace {
+
+double now()
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// A tree-like density: an ellipsoidal crown of random leaf clusters over a wooden trunk, empty margin.
+DensityGrid treeLikeGrid(int n, uint32_t seed)
+{
+    DensityGrid g;
+    g.geometry.dims = {n, n, n};
+    g.density.assign(g.geometry.nodeCount(), 0.0f);
+    g.woodFraction.assign(g.geometry.nodeCount(), 0.0f);
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const float c = 0.5f * float(n - 1);
+    for (int i = 1; i < n - 1; ++i)
+        for (int j = 1; j < n - 1; ++j)
+            for (int k = 1; k < n - 1; ++k) {
+                const float x = (float(i) - c) / (0.45f * float(n)), y = (float(j) - 0.62f * float(n)) / (0.36f * float(n)),
+                            z = (float(k) - c) / (0.45f * float(n));
+                const size_t node = g.geometry.index(i, j, k);
+                if (x * x + y * y + z * z < 1.0f && u(rng) < 0.55f) g.density[node] = u(rng) * 0.7f;
+                const float r = std::hypot(float(i) - c, float(k) - c);
+                if (r < 0.03f * float(n) && j < int(0.7f * float(n))) {
+                    g.density[node] = 1.0f;
+                    g.woodFraction[node] = 1.0f;
+                }
+            }
+    return g;
+}
+
+// Memory floor: time to stream `bytes` through memory once (read half, write half), best of several.
+double copySeconds(size_t bytes)
+{
+    const size_t n = bytes / 2 / sizeof(float);
+    std::vector<float> a(n, 1.0f), b(n, 0.0f);
+    double best = 1e30;
+    for (int rep = 0; rep < 5; ++rep) {
+        const double t0 = now();
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1 << 16), [&](const tbb::blocked_range<size_t>& r) {
+            std::memcpy(&b[r.begin()], &a[r.begin()], (r.end() - r.begin()) * sizeof(float));
+        });
+        best = std::min(best, now() - t0);
+    }
+    return best;
+}
+
+double relL2(const LightingGrid& a, const LightingGrid& b)
+{
+    double diff = 0, norm = 0;
+    for (size_t n = 0; n < a.rgb.size(); ++n) {
+        diff += double(a.rgb[n] - b.rgb[n]) * double(a.rgb[n] - b.rgb[n]);
+        norm += double(b.rgb[n]) * double(b.rgb[n]);
+    }
+    return std::sqrt(diff / norm);
+}
+
+struct Row {
+    std::string name;
+    double seconds;
+    int steps;
+    double error;
+    double bytesPerStep;
+};
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    int n = 128, reps = 1;
+    double tol = 2e-4;
+    bool dense = false;
+    for (int a = 1; a < argc; ++a) {
+        std::string s = argv[a];
+        if (s == "--grid" && a + 1 < argc) n = std::atoi(argv[++a]);
+        else if (s == "--reps" && a + 1 < argc) reps = std::atoi(argv[++a]);
+        else if (s == "--tol" && a + 1 < argc) tol = std::atof(argv[++a]);
+        else if (s == "--dense") dense = true;
+        else {
+            std::printf("usage: bench_lb [--grid N] [--reps R] [--tol T] [--dense]\n");
+            return s == "--help" ? 0 : 2;
+        }
+    }
+    DensityGrid grid = treeLikeGrid(n, 42);
+    if (dense) std::fill(grid.density.begin(), grid.density.end(), 1.0f);
+    size_t occupied = 0;
+    for (float r : grid.density) occupied += r > 0.0f;
+    std::printf("LB benchmark: %d^3 grid, %s, %.1f%% of nodes with medium, leaf preset (3 distinct channels), sun (0.3,1,0.2)\n",
+                n, dense ? "dense medium" : "tree-like crown", 100.0 * double(occupied) / double(grid.density.size()));
+
+    LbParams base = paramsFromPreset(*findPreset("leaf"));
+    base.sun = {0.3f, 1.0f, 0.2f};
+
+    auto run = [&](const char* name, LbParams p, const LightingGrid* ref, LightingGrid* keep) {
+        std::vector<double> times;
+        SolveStats st;
+        LightingGrid out;
+        for (int r = 0; r < reps; ++r) {
+            out = solveLighting(grid, p, nullptr, &st);
+            times.push_back(st.seconds);
+        }
+        std::sort(times.begin(), times.end());
+        Row row{name, times[times.size() / 2], st.steps, ref ? relL2(out, *ref) : 0.0, st.bytesPerStep};
+        std::printf("  %-22s %8.3f s  %4d steps  %6.2f ms/step  rel L2 vs fp32 default %.2e  %.0f MB/step\n", name,
+                    row.seconds, row.steps, 1e3 * row.seconds / row.steps, row.error, row.bytesPerStep / 1e6);
+        std::fflush(stdout);
+        if (keep) *keep = std::move(out);
+        return row;
+    };
+
+    LightingGrid reference;
+    Row fp32 = run("fp32 default steps", base, nullptr, &reference);
+    LbParams p16 = base;
+    p16.storage = Storage::Fp16;
+    Row fp16 = run("fp16 default steps", p16, &reference, nullptr);
+    LbParams t32 = base;
+    t32.tolerance = tol;
+    Row tol32 = run("fp32 tolerance", t32, &reference, nullptr);
+    LbParams t16 = p16;
+    t16.tolerance = tol;
+    Row tol16 = run("fp16 tolerance", t16, &reference, nullptr);
+
+    const double floorStep32 = copySeconds(size_t(fp32.bytesPerStep));
+    const double floorStep16 = copySeconds(size_t(fp16.bytesPerStep));
+    std::printf("memory floor (parallel memcpy of the same bytes): fp32 %.2f ms/step (%.1f GB/s), fp16 %.2f ms/step\n",
+                1e3 * floorStep32, fp32.bytesPerStep / floorStep32 / 1e9, 1e3 * floorStep16);
+    std::printf("  fp32 default: %.2fx the floor for its steps; fp16 tolerance: %.2fx the fp32 default-step floor\n",
+                fp32.seconds / (floorStep32 * fp32.steps), tol16.seconds / (floorStep32 * fp32.steps));
+
+    std::printf("lb_grid=%d\n", n);
+    std::printf("lb_fp32_default_s=%.4f\nlb_fp32_default_steps=%d\n", fp32.seconds, fp32.steps);
+    std::printf("lb_fp16_default_s=%.4f\nlb_fp16_default_err=%.3e\n", fp16.seconds, fp16.error);
+    std::printf("lb_fp32_tol_s=%.4f\nlb_fp32_tol_steps=%d\nlb_fp32_tol_err=%.3e\n", tol32.seconds, tol32.steps, tol32.error);
+    std::printf("lb_fp16_tol_s=%.4f\nlb_fp16_tol_steps=%d\nlb_fp16_tol_err=%.3e\n", tol16.seconds, tol16.steps, tol16.error);
+    std::printf("lb_bytes_per_step_fp32=%.0f\nlb_bytes_per_step_fp16=%.0f\n", fp32.bytesPerStep, fp16.bytesPerStep);
+    std::printf("lb_floor_fp32_default_s=%.4f\nlb_floor_gbps=%.2f\n", floorStep32 * fp32.steps, fp32.bytesPerStep / floorStep32 / 1e9);
+    std::printf("lb_speedup_fp16_tol_vs_fp32_default=%.2f\n", fp32.seconds / tol16.seconds);
+    return 0;
+}
