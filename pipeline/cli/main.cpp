@@ -1,8 +1,492 @@
-// sylva: the command line entry point.
+// sylva: the command line (grow, voxelize, light, info). Exit codes: 0 ok, 1 bad input or failure, 2 bad usage.
 #include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
 
-int main()
+#include <tbb/global_control.h>
+
+#include "core/base/error.h"
+#include "core/base/version.h"
+#include "core/lb/lb_params.h"
+#include "core/lb/lb_solver.h"
+#include "core/voxel/voxelize.h"
+#include "pipeline/backend_info.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/cli/cli_util.h"
+#include "pipeline/grow/obj_writer.h"
+#include "pipeline/grow/tree_grower.h"
+#include "pipeline/import/mesh_import.h"
+#include "pipeline/io/grid_picture.h"
+#include "pipeline/io/npy.h"
+#include "pipeline/lighting_job.h"
+
+namespace fs = std::filesystem;
+using namespace sylva;
+using namespace sylva::cli;
+
+namespace {
+
+// One option of a subcommand: --name VALUE, or a flag when value is empty.
+struct OptionSpec {
+    std::string name;
+    std::string value;   // placeholder shown in help; empty for flags
+    std::string help;
+};
+
+struct Command {
+    std::string name;
+    std::string synopsis;
+    std::string summary;
+    std::vector<OptionSpec> options;
+    int minPositional = 0, maxPositional = 0;
+};
+
+// Parsed arguments of one subcommand.
+class Args {
+public:
+    Args(const Command& cmd, const std::vector<std::string>& argv) : m_cmd(cmd)
+    {
+        for (size_t a = 0; a < argv.size(); ++a) {
+            std::string s = argv[a];
+            if (s == "-h" || s == "--help") {
+                m_help = true;
+                continue;
+            }
+            if (s.size() > 1 && s[0] == '-' && !(s.size() > 1 && (std::isdigit((unsigned char)s[1]) || s[1] == '.'))) {
+                std::string name = s, value;
+                const size_t eq = s.find('=');
+                const bool inlineValue = eq != std::string::npos;
+                if (inlineValue) {
+                    name = s.substr(0, eq);
+                    value = s.substr(eq + 1);
+                }
+                if (name == "-o") name = "--output";
+                const OptionSpec* spec = find(name);
+                if (!spec) throw UsageError("unknown option " + name + " for 'sylva " + cmd.name + "' (see sylva " + cmd.name + " --help)");
+                if (spec->value.empty()) {
+                    if (inlineValue) throw UsageError("option " + name + " takes no value");
+                    m_values[name] = "1";
+                } else {
+                    if (!inlineValue) {
+                        if (a + 1 >= argv.size()) throw UsageError("option " + name + " needs a value (" + spec->value + ")");
+                        value = argv[++a];
+                    }
+                    m_values[name] = value;
+                }
+            } else {
+                m_positional.push_back(s);
+            }
+        }
+        if (m_help) return;
+        if (int(m_positional.size()) < cmd.minPositional) throw UsageError("'sylva " + cmd.name + "' needs " + cmd.synopsis);
+        if (int(m_positional.size()) > cmd.maxPositional)
+            throw UsageError("unexpected argument '" + m_positional[size_t(cmd.maxPositional)] + "' for 'sylva " + cmd.name + "'");
+    }
+    bool help() const { return m_help; }
+    bool has(const std::string& name) const { return m_values.count(name) != 0; }
+    std::string get(const std::string& name, const std::string& fallback = {}) const
+    {
+        auto it = m_values.find(name);
+        return it == m_values.end() ? fallback : it->second;
+    }
+    std::string require(const std::string& name) const
+    {
+        if (!has(name)) throw UsageError("'sylva " + m_cmd.name + "' needs " + name + " (see sylva " + m_cmd.name + " --help)");
+        return get(name);
+    }
+    const std::vector<std::string>& positional() const { return m_positional; }
+
+private:
+    const OptionSpec* find(const std::string& name) const
+    {
+        for (const auto& o : m_cmd.options)
+            if (o.name == name) return &o;
+        return nullptr;
+    }
+    const Command& m_cmd;
+    std::map<std::string, std::string> m_values;
+    std::vector<std::string> m_positional;
+    bool m_help = false;
+};
+
+const OptionSpec kQuiet{"--quiet", "", "no progress output"};
+const OptionSpec kThreads{"--threads", "N", "worker threads (default: all cores)"};
+const OptionSpec kOutput{"--output", "FILE", "output file (also -o)"};
+const OptionSpec kCache{"--cache", "DIR", "grid cache folder (default $XDG_CACHE_HOME/sylva or ~/.cache/sylva)"};
+const OptionSpec kNoCache{"--no-cache", "", "neither read nor write the grid cache"};
+const OptionSpec kLeafMaterials{"--leaf-materials", "A,B", "names of the leaf materials (override the automatic leaf/wood split)"};
+const OptionSpec kGrid{"--grid", "N|X,Y,Z", "grid nodes on the longest axis, or per axis (3..512; default 128)"};
+const OptionSpec kSubcells{"--subcells", "N", "sub-cells per cell edge for the density (default 3)"};
+const OptionSpec kPicture{"--picture", "PNG", "also write a PNG montage of slices"};
+const OptionSpec kSlices{"--slices", "N", "slices in the picture (default 8)"};
+const OptionSpec kAxis{"--axis", "x|y|z", "slicing axis of the picture (default z)"};
+
+std::vector<Command> commands()
 {
-    std::puts("sylva");
-    return 0;
+    std::vector<Command> list;
+    list.push_back({"grow", "[-o TREE.obj]", "grow a procedural tree; writes OBJ + MTL + leaf and bark textures",
+                    {{"--species", "NAME", "broadleaf (default), birch, conifer or shrub"},
+                     {"--seed", "N", "random seed (default 1); the same seed gives the same tree"},
+                     {"--triangles", "N", "target triangle count, 1000..1000000 (default 200000)"},
+                     {"--height", "M", "tree height in metres (default: by species)"},
+                     kOutput, kThreads, kQuiet},
+                    0, 0});
+    list.push_back({"voxelize", "MESH -o DENSITY.npy", "voxelize a mesh into a density grid (+ wood fraction)",
+                    {kGrid, kSubcells, kLeafMaterials, kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
+                    1, 1});
+    list.push_back({"light", "(--density DENSITY.npy | --mesh MESH) --sun X,Y,Z -o LIGHT.npy",
+                    "solve the lattice-Boltzmann lighting of a density grid",
+                    {{"--density", "FILE", "density grid (.npy from sylva voxelize)"},
+                     {"--mesh", "FILE", "mesh to voxelize first (with --grid)"},
+                     kGrid, kSubcells, kLeafMaterials,
+                     {"--preset", "NAME", "leaf (default), dogrose, cloud or pmma"},
+                     {"--sigma-a", "R,G,B", "absorption per lattice step (one number: all channels)"},
+                     {"--sigma-s", "R,G,B", "scattering per lattice step; sigma_a + sigma_s <= 1"},
+                     {"--g", "R,G,B", "Henyey-Greenstein asymmetry in [-1, 1]"},
+                     {"--keep-f0", "", "keep absorbed light (clouds, plastics)"},
+                     {"--zero-f0", "", "zero f_0 after each step (plants)"},
+                     {"--sun", "X,Y,Z", "direction toward the sun (any length)"},
+                     {"--intensity", "R,G,B", "sun intensity per channel (default 1)"},
+                     {"--steps", "N", "fixed step count (default 2 x the longest grid edge)"},
+                     {"--tol", "T", "stop when the relative change per step falls under T"},
+                     {"--fp16", "", "store the distributions in half precision (half the memory)"},
+                     {"--backend", "auto|cpu|cuda", "compute backend (default auto)"},
+                     kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
+                    0, 0});
+    list.push_back({"info", "FILE", "print what a mesh, grid (.npy) or cache file holds", {}, 1, 1});
+    return list;
+}
+
+void printMainHelp()
+{
+    std::printf("sylva %s: forests with lattice-Boltzmann lighting\n\nusage: sylva COMMAND [options]\n\ncommands:\n",
+                versionString());
+    for (const auto& c : commands()) std::printf("  %-10s %s\n", c.name.c_str(), c.summary.c_str());
+    std::printf("\n  sylva COMMAND --help   options of a command\n  sylva --version        version and compute backends\n");
+}
+
+void printHelp(const Command& c)
+{
+    std::printf("usage: sylva %s %s\n\n%s\n", c.name.c_str(), c.synopsis.c_str(), c.summary.c_str());
+    if (!c.options.empty()) std::printf("\noptions:\n");
+    for (const auto& o : c.options) {
+        std::string left = o.name + (o.value.empty() ? "" : " " + o.value);
+        std::printf("  %-24s %s\n", left.c_str(), o.help.c_str());
+    }
+    std::printf("  %-24s %s\n", "-h, --help", "this help");
+}
+
+std::unique_ptr<tbb::global_control> threadLimit(const Args& args)
+{
+    if (!args.has("--threads")) return nullptr;
+    const long long n = parseInteger("--threads", args.get("--threads"), 1, 1024);
+    return std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, size_t(n));
+}
+
+std::unique_ptr<GridCache> openCache(const Args& args)
+{
+    if (args.has("--no-cache")) return nullptr;
+    return std::make_unique<GridCache>(args.get("--cache"));
+}
+
+void requireReadable(const std::string& path, const char* what)
+{
+    std::error_code ec;
+    if (!fs::exists(path, ec)) throw Error(path + ": no such " + std::string(what));
+    if (fs::is_directory(path, ec)) throw Error(path + ": is a folder, not a " + std::string(what));
+}
+
+VoxelizeSettings voxelSettings(const Args& args)
+{
+    VoxelizeSettings v;
+    if (args.has("--grid")) {
+        const std::vector<std::string> parts = splitList(args.get("--grid"));
+        if (parts.size() == 1) {
+            v.longestAxisNodes = int(parseInteger("--grid", parts[0], 3, 512));
+        } else if (parts.size() == 3) {
+            v.dims = {int(parseInteger("--grid", parts[0], 3, 512)), int(parseInteger("--grid", parts[1], 3, 512)),
+                      int(parseInteger("--grid", parts[2], 3, 512))};
+        } else {
+            throw UsageError("option --grid: expected N or X,Y,Z, got '" + args.get("--grid") + "'");
+        }
+    }
+    if (args.has("--subcells")) v.subcells = int(parseInteger("--subcells", args.get("--subcells"), 1, 16));
+    return v;
+}
+
+ImportOptions importOptions(const Args& args)
+{
+    ImportOptions o;
+    if (args.has("--leaf-materials"))
+        for (const auto& name : splitList(args.get("--leaf-materials")))
+            if (!name.empty()) o.leafMaterials.push_back(name);
+    return o;
+}
+
+void writePicture(const Args& args, const DensityGrid* density, const LightingGrid* light)
+{
+    if (!args.has("--picture")) return;
+    int axis = 2;
+    if (args.has("--axis")) {
+        const std::string a = args.get("--axis");
+        if (a == "x") axis = 0;
+        else if (a == "y") axis = 1;
+        else if (a == "z") axis = 2;
+        else throw UsageError("option --axis: expected x, y or z, got '" + a + "'");
+    }
+    const int slices = args.has("--slices") ? int(parseInteger("--slices", args.get("--slices"), 1, 64)) : 8;
+    writeGridMontage(args.get("--picture"), density, light, axis, slices);
+    std::printf("picture: %s\n", args.get("--picture").c_str());
+}
+
+std::string dimsText(const GridGeometry& g)
+{
+    return std::to_string(g.dims.x) + "x" + std::to_string(g.dims.y) + "x" + std::to_string(g.dims.z);
+}
+
+void printDensitySummary(const DensityGrid& d)
+{
+    double sum = 0;
+    size_t occupied = 0, brown = 0;
+    for (size_t n = 0; n < d.density.size(); ++n) {
+        sum += d.density[n];
+        occupied += d.density[n] > 0.0f;
+        brown += !d.woodFraction.empty() && d.woodFraction[n] > 0.5f && d.density[n] > 0.0f;
+    }
+    std::printf("density grid %s, spacing %.4g m, origin (%.4g, %.4g, %.4g): %.1f%% of nodes occupied, mean density %.4f, "
+                "%zu brown nodes\n",
+                dimsText(d.geometry).c_str(), d.geometry.spacing, d.geometry.origin.x, d.geometry.origin.y, d.geometry.origin.z,
+                100.0 * double(occupied) / double(d.density.size()), sum / double(d.density.size()), brown);
+}
+
+int cmdGrow(const Args& args)
+{
+    auto threads = threadLimit(args);
+    GrowOptions opt;
+    opt.targetTriangles = 200000;
+    if (args.has("--species") && !parseSpecies(args.get("--species"), &opt.species)) {
+        std::string names;
+        for (const auto& n : speciesNames()) names += (names.empty() ? "" : ", ") + n;
+        throw UsageError("option --species: unknown species '" + args.get("--species") + "' (known: " + names + ")");
+    }
+    if (args.has("--seed")) opt.seed = uint64_t(parseInteger("--seed", args.get("--seed"), 0, (1LL << 62)));
+    if (args.has("--triangles"))
+        opt.targetTriangles = size_t(parseInteger("--triangles", args.get("--triangles"), kMinGrowTriangles, kMaxGrowTriangles));
+    if (args.has("--height")) {
+        opt.height = float(parseNumber("--height", args.get("--height")));
+        if (!(opt.height > 0.0f)) throw UsageError("option --height: must be > 0 metres");
+    }
+    const std::string out = args.get("--output", speciesName(opt.species) + ".obj");
+    ProgressPrinter bar("grow", args.has("--quiet"));
+    GrownTree tree = growTree(opt, &bar.progress());
+    writeObj(out, tree);
+    size_t leaf = 0;
+    for (size_t t = 0; t < tree.mesh.triangleCount(); ++t) leaf += tree.mesh.isLeafTriangle(t);
+    bar.finish();
+    const Bounds3 b = meshBounds(tree.mesh);
+    std::printf("%s: %s tree, seed %llu, %zu triangles (%zu leaf, %zu wood), %.2f m tall, %.2f m wide\n", out.c_str(),
+                speciesName(opt.species).c_str(), (unsigned long long)opt.seed, tree.mesh.triangleCount(), leaf,
+                tree.mesh.triangleCount() - leaf, b.extent().y, std::max(b.extent().x, b.extent().z));
+    return kOk;
+}
+
+int cmdVoxelize(const Args& args)
+{
+    auto threads = threadLimit(args);
+    const std::string mesh = args.positional()[0];
+    const std::string out = args.require("--output");
+    DensityJob job{mesh, importOptions(args), voxelSettings(args)};   // usage errors before file errors
+    requireReadable(mesh, "mesh file");
+    auto cache = openCache(args);
+    ProgressPrinter bar("voxelize", args.has("--quiet"));
+    JobLog log;
+    const DensityGrid grid = densityForMesh(job, cache.get(), &bar.progress(), &log);
+    writeDensityGrid(out, grid);
+    bar.finish(log.stages.empty() ? "" : log.stages.back());
+    for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    printDensitySummary(grid);
+    std::printf("wrote %s (+ %s, %s)\n", out.c_str(), woodFractionPath(out).c_str(), gridSidecarPath(out).c_str());
+    writePicture(args, &grid, nullptr);
+    return kOk;
+}
+
+lb::LbParams lightParams(const Args& args)
+{
+    const std::string presetName = args.get("--preset", "leaf");
+    const lb::Preset* preset = lb::findPreset(presetName);
+    if (!preset) {
+        std::string names;
+        for (const auto& p : lb::presets()) names += (names.empty() ? "" : ", ") + p.name;
+        throw UsageError("option --preset: unknown preset '" + presetName + "' (known: " + names + ")");
+    }
+    lb::LbParams p = lb::paramsFromPreset(*preset);
+    if (args.has("--sigma-a")) {
+        const glm::vec3 v = parseTriple("--sigma-a", args.get("--sigma-a"));
+        for (int c = 0; c < 3; ++c) p.channels[size_t(c)].sigmaA = v[c];
+    }
+    if (args.has("--sigma-s")) {
+        const glm::vec3 v = parseTriple("--sigma-s", args.get("--sigma-s"));
+        for (int c = 0; c < 3; ++c) p.channels[size_t(c)].sigmaS = v[c];
+    }
+    if (args.has("--g")) {
+        const glm::vec3 v = parseTriple("--g", args.get("--g"));
+        for (int c = 0; c < 3; ++c) p.channels[size_t(c)].g = v[c];
+    }
+    if (args.has("--keep-f0") && args.has("--zero-f0")) throw UsageError("--keep-f0 and --zero-f0 exclude each other");
+    if (args.has("--keep-f0")) p.zeroF0 = false;
+    if (args.has("--zero-f0")) p.zeroF0 = true;
+    p.sun = parseTriple("--sun", args.require("--sun"));
+    if (args.get("--sun").find(',') == std::string::npos) throw UsageError("option --sun: expected X,Y,Z");
+    if (args.has("--intensity")) p.intensity = parseTriple("--intensity", args.get("--intensity"));
+    if (args.has("--steps") && args.has("--tol")) throw UsageError("--steps and --tol exclude each other");
+    if (args.has("--steps")) p.steps = int(parseInteger("--steps", args.get("--steps"), 1, 1000000));
+    if (args.has("--tol")) {
+        p.tolerance = parseNumber("--tol", args.get("--tol"));
+        if (!(p.tolerance > 0.0)) throw UsageError("option --tol: must be > 0");
+    }
+    if (args.has("--fp16")) p.storage = lb::Storage::Fp16;
+    lb::validate(p);   // bad parameter values are bad input (exit 1) with a message naming the bound
+    return p;
+}
+
+int cmdLight(const Args& args)
+{
+    auto threads = threadLimit(args);
+    if (args.has("--density") == args.has("--mesh")) throw UsageError("'sylva light' needs exactly one of --density FILE or --mesh FILE");
+    const std::string out = args.require("--output");
+    const std::string backend = args.get("--backend", "auto");
+    if (backend != "auto" && backend != "cpu" && backend != "cuda")
+        throw UsageError("option --backend: expected auto, cpu or cuda, got '" + backend + "'");
+    if (backend == "cuda") std::fprintf(stderr, "note: the CUDA LB solver is not in this build yet; solving on the CPU\n");
+    const lb::LbParams params = lightParams(args);
+    auto cache = openCache(args);
+    JobLog log;
+    DensityGrid density;
+    const VoxelizeSettings voxel = voxelSettings(args);
+    if (args.has("--density")) {
+        requireReadable(args.get("--density"), "density grid");
+        density = readDensityGrid(args.get("--density"));
+    } else {
+        requireReadable(args.get("--mesh"), "mesh file");
+        ProgressPrinter vbar("voxelize", args.has("--quiet"));
+        density = densityForMesh({args.get("--mesh"), importOptions(args), voxel}, cache.get(), &vbar.progress(), &log);
+        vbar.finish(log.stages.back());
+    }
+    printDensitySummary(density);
+    ProgressPrinter bar("light", args.has("--quiet"));
+    const LightingGrid light = lightingFor(density, params, cache.get(), &bar.progress(), &log);
+    bar.finish(log.stages.back());
+    for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    std::ostringstream extra;
+    extra << "{\"sun\":[" << params.sun.x << "," << params.sun.y << "," << params.sun.z << "],\"preset\":\""
+          << args.get("--preset", "leaf") << "\",\"zero_f0\":" << (params.zeroF0 ? "true" : "false") << "}";
+    writeLightingGrid(out, light, extra.str());
+    double maxV[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
+    for (size_t n = 0; n < light.rgb.size() / 3; ++n)
+        for (int c = 0; c < 3; ++c) {
+            maxV[c] = std::max(maxV[c], double(light.rgb[n * 3 + size_t(c)]));
+            mean[c] += light.rgb[n * 3 + size_t(c)];
+        }
+    const double nodes = double(light.rgb.size() / 3);
+    std::printf("lighting grid %s: mean RGB (%.4f, %.4f, %.4f), max RGB (%.4f, %.4f, %.4f)\nwrote %s\n",
+                dimsText(light.geometry).c_str(), mean[0] / nodes, mean[1] / nodes, mean[2] / nodes, maxV[0], maxV[1], maxV[2],
+                out.c_str());
+    writePicture(args, &density, &light);
+    return kOk;
+}
+
+std::string lowerExtension(const std::string& path)
+{
+    std::string ext = fs::path(path).extension().string();
+    for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
+    return ext;
+}
+
+int cmdInfo(const Args& args)
+{
+    const std::string path = args.positional()[0];
+    requireReadable(path, "file");
+    if (isCacheFile(path)) {
+        std::printf("%s", describeCacheFile(path).c_str());
+        return kOk;
+    }
+    if (lowerExtension(path) == ".npy") {
+        const NpyArray a = readNpy(path);
+        std::string shape;
+        for (size_t s : a.shape) shape += (shape.empty() ? "" : ", ") + std::to_string(s);
+        double lo = 1e300, hi = -1e300, sum = 0;
+        for (float v : a.data) {
+            lo = std::min(lo, double(v));
+            hi = std::max(hi, double(v));
+            sum += v;
+        }
+        std::printf("%s: NumPy float32 array, shape (%s), %zu values, min %.6g, max %.6g, mean %.6g\n", path.c_str(),
+                    shape.c_str(), a.data.size(), lo, hi, a.data.empty() ? 0.0 : sum / double(a.data.size()));
+        const std::string sidecar = gridSidecarPath(path);
+        if (fs::exists(sidecar)) {
+            std::FILE* f = std::fopen(sidecar.c_str(), "rb");
+            if (f) {
+                char buf[4096];
+                const size_t n = std::fread(buf, 1, sizeof buf - 1, f);
+                std::fclose(f);
+                buf[n] = 0;
+                std::printf("placement (%s): %s\n", sidecar.c_str(), buf);
+            }
+        }
+        return kOk;
+    }
+    ImportReport report;
+    const TriangleMesh mesh = importMesh(path, {}, &report);
+    std::printf("%s: mesh\n%s", path.c_str(), describeMesh(mesh).c_str());
+    for (const auto& w : report.warnings) std::printf("warning: %s\n", w.c_str());
+    return kOk;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    std::vector<std::string> argsv(argv + 1, argv + argc);
+    if (argsv.empty() || argsv[0] == "-h" || argsv[0] == "--help" || argsv[0] == "help") {
+        printMainHelp();
+        return argsv.empty() ? kUsage : kOk;
+    }
+    if (argsv[0] == "--version") {
+        std::printf("sylva %s\nbackends: %s\n", versionString(), backendSummary().c_str());
+        return kOk;
+    }
+    const std::vector<Command> cmds = commands();
+    const Command* cmd = nullptr;
+    for (const auto& c : cmds)
+        if (c.name == argsv[0]) cmd = &c;
+    if (!cmd) {
+        std::fprintf(stderr, "sylva: unknown command '%s' (see sylva --help)\n", argsv[0].c_str());
+        return kUsage;
+    }
+    try {
+        Args args(*cmd, std::vector<std::string>(argsv.begin() + 1, argsv.end()));
+        if (args.help()) {
+            printHelp(*cmd);
+            return kOk;
+        }
+        if (cmd->name == "grow") return cmdGrow(args);
+        if (cmd->name == "voxelize") return cmdVoxelize(args);
+        if (cmd->name == "light") return cmdLight(args);
+        if (cmd->name == "info") return cmdInfo(args);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "sylva %s: %s\n", cmd->name.c_str(), e.what());
+        return kUsage;
+    } catch (const Cancelled&) {
+        std::fprintf(stderr, "sylva %s: cancelled\n", cmd->name.c_str());
+        return kFailure;
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "sylva %s: error: %s\n", cmd->name.c_str(), e.what());
+        return kFailure;
+    }
+    return kFailure;
 }

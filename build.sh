@@ -1,0 +1,61 @@
+#!/usr/bin/env bash
+# Sylva on a fresh Debian 12 machine: install what is missing, build, then run the main job or the tests.
+#   ./build.sh run    install + build + grow the default tree, light it, write out/default_tree_light.png
+#   ./build.sh test   install + build + run every test (ctest)
+#   ./build.sh build  install + build only
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+MODE="${1:-run}"
+BUILD_DIR="$ROOT/build/release"
+JOBS="${SYLVA_JOBS:-$(nproc)}"
+
+PACKAGES=(cmake ninja-build ccache g++ pkg-config
+  qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev
+  libassimp-dev libopenmesh-dev libopenimageio-dev openimageio-tools libopencv-core-dev
+  libglm-dev libtbb-dev)
+
+install_missing() {
+  local missing=()
+  for p in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+  done
+  if ((${#missing[@]})); then
+    echo "==> installing: ${missing[*]}"
+    local sudo=()
+    if [[ $(id -u) -ne 0 ]]; then sudo=(sudo); fi
+    "${sudo[@]}" apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+  else
+    echo "==> all packages present"
+  fi
+}
+
+build() {
+  # nvcc lives outside PATH in a default CUDA install; the build enables CUDA when it finds it.
+  if ! command -v nvcc >/dev/null 2>&1 && [[ -x /usr/local/cuda/bin/nvcc ]]; then
+    export PATH="/usr/local/cuda/bin:$PATH"
+  fi
+  echo "==> configuring ($BUILD_DIR)"
+  (cd "$ROOT" && cmake --preset release >/dev/null)
+  echo "==> building with $JOBS jobs"
+  cmake --build "$BUILD_DIR" -j "$JOBS"
+}
+
+run_main_job() {
+  local out="$ROOT/out" sylva="$BUILD_DIR/pipeline/sylva"
+  mkdir -p "$out"
+  echo "==> growing the default tree (broadleaf, seed 1, 200k triangles)"
+  "$sylva" grow --species broadleaf --seed 1 --triangles 200000 -o "$out/default_tree/default_tree.obj"
+  echo "==> voxelizing and lighting it (128 nodes on the longest axis, leaf preset)"
+  "$sylva" light --mesh "$out/default_tree/default_tree.obj" --grid 128 --preset leaf --sun 0.4,0.85,0.3 \
+    -o "$out/default_tree_light.npy" --picture "$out/default_tree_light.png"
+  echo "==> done: $out/default_tree_light.png (slices: density left, lighting right)"
+}
+
+case "$MODE" in
+  run) install_missing; build; run_main_job ;;
+  test) install_missing; build; cd "$BUILD_DIR" && ctest --output-on-failure -j "$JOBS" ;;
+  build) install_missing; build ;;
+  *) echo "usage: $0 [run|test|build]" >&2; exit 2 ;;
+esac

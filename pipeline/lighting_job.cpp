@@ -1,0 +1,134 @@
+// Lighting pipeline for one species, with cache keys that cover everything that determines the result.
+#include "pipeline/lighting_job.h"
+
+#include <span>
+
+#include "core/lb/lb_solver.h"
+#include "core/mesh/triangle_mesh.h"
+#include "pipeline/cache/grid_cache.h"
+
+namespace sylva {
+
+namespace {
+
+template <typename T>
+std::span<const std::byte> bytesOf(const std::vector<T>& v)
+{
+    return std::as_bytes(std::span<const T>(v.data(), v.size()));
+}
+
+CacheKey meshKey(const TriangleMesh& mesh, const VoxelizeSettings& voxel)
+{
+    CacheKey key;
+    key.add("cache format", int64_t(kCacheFormatVersion));
+    key.add("stage", "density");
+    key.add("positions", bytesOf(mesh.positions));
+    key.add("triangles", bytesOf(mesh.triangles));
+    key.add("triangle materials", bytesOf(mesh.triangleMaterial));
+    for (const Material& m : mesh.materials) key.add("material leaf", int64_t(m.isLeaf ? 1 : 0));
+    key.add("dims x", voxel.dims.x).add("dims y", voxel.dims.y).add("dims z", voxel.dims.z);
+    key.add("longest axis nodes", voxel.longestAxisNodes);
+    key.add("subcells", voxel.subcells);
+    return key;
+}
+
+CacheKey lightKey(const DensityGrid& density, const lb::LbParams& p)
+{
+    CacheKey key;
+    key.add("cache format", int64_t(kCacheFormatVersion));
+    key.add("stage", "lighting");
+    key.add("density", densityHash(density));
+    for (int c = 0; c < 3; ++c) {
+        const lb::ChannelParams& ch = p.channels[size_t(c)];
+        key.add("sigma_a", double(ch.sigmaA)).add("sigma_s", double(ch.sigmaS)).add("g", double(ch.g));
+        key.add("intensity", double(p.intensity[c]));
+    }
+    const glm::vec3 sun = glm::normalize(p.sun);
+    key.add("sun x", double(sun.x)).add("sun y", double(sun.y)).add("sun z", double(sun.z));
+    key.add("zero f0", int64_t(p.zeroF0));
+    key.add("brown threshold", double(p.brownThreshold));
+    key.add("storage", int64_t(p.storage == lb::Storage::Fp16 ? 16 : 32));
+    if (p.tolerance > 0.0) {
+        key.add("tolerance", p.tolerance).add("check every", p.checkEvery).add("max steps", p.maxSteps);
+    } else {
+        key.add("steps", p.steps > 0 ? p.steps : lb::defaultSteps(density.geometry.dims));
+    }
+    return key;
+}
+
+} // namespace
+
+std::string densityHash(const DensityGrid& density)
+{
+    CacheKey key;
+    const GridGeometry& g = density.geometry;
+    key.add("dims x", g.dims.x).add("dims y", g.dims.y).add("dims z", g.dims.z);
+    key.add("origin x", g.origin.x).add("origin y", g.origin.y).add("origin z", g.origin.z).add("spacing", g.spacing);
+    key.add("density", bytesOf(density.density));
+    key.add("wood", bytesOf(density.woodFraction));
+    return key.hex();
+}
+
+DensityGrid densityForMesh(const DensityJob& job, GridCache* cache, Progress* progress, JobLog* log)
+{
+    SubProgress importProgress(progress, 0.0, 0.1);
+    importProgress.report(0.0, "importing " + job.meshPath);
+    ImportReport report;
+    const TriangleMesh mesh = importMesh(job.meshPath, job.import, &report);
+    if (log) {
+        log->stages.push_back("import");
+        for (const auto& w : report.warnings) log->warnings.push_back(job.meshPath + ": " + w);
+    }
+    const CacheKey key = meshKey(mesh, job.voxel);
+    if (cache) {
+        std::string why;
+        if (auto hit = cache->loadDensity(key, &why)) {
+            if (log) log->stages.push_back("voxelize (cache hit)");
+            if (progress) progress->report(1.0, "density grid from the cache");
+            return *hit;
+        }
+        if (log && why.find("no cache entry") == std::string::npos) log->warnings.push_back(why);
+    }
+    Progress sub([&](double f, const std::string& msg) {
+        if (progress) progress->report(0.1 + 0.9 * f, msg);
+    });
+    if (progress && progress->isCancelled()) sub.cancel();
+    DensityGrid grid = voxelize(mesh, job.voxel, progress ? &sub : nullptr);
+    if (log) log->stages.push_back("voxelize");
+    if (cache) {
+        try {
+            cache->storeDensity(key, grid);
+        } catch (const std::exception& e) {
+            if (log) log->warnings.push_back(std::string("cannot write the cache: ") + e.what());
+        }
+    }
+    return grid;
+}
+
+LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache, Progress* progress,
+                         JobLog* log)
+{
+    lb::validate(params);
+    const CacheKey key = lightKey(density, params);
+    if (cache) {
+        std::string why;
+        if (auto hit = cache->loadLighting(key, &why)) {
+            if (log) log->stages.push_back("light (cache hit)");
+            if (progress) progress->report(1.0, "lighting grid from the cache");
+            return *hit;
+        }
+        if (log && why.find("no cache entry") == std::string::npos) log->warnings.push_back(why);
+    }
+    LightingGrid grid = lb::solveLighting(density, params, progress);
+    if (log) log->stages.push_back("light");
+    if (cache) {
+        try {
+            cache->storeLighting(key, grid);
+        } catch (const std::exception& e) {
+            if (log) log->warnings.push_back(std::string("cannot write the cache: ") + e.what());
+        }
+    }
+    return grid;
+}
+
+} // namespace sylva

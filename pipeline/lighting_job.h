@@ -1,0 +1,42 @@
+// The lighting pipeline for one species: mesh -> density grid -> LB lighting grid, with the grid cache.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/base/progress.h"
+#include "core/grid/grid.h"
+#include "core/lb/lb_params.h"
+#include "core/voxel/voxelize.h"
+#include "pipeline/import/mesh_import.h"
+
+namespace sylva {
+
+class GridCache;
+
+// What ran, in order: "import", "voxelize", "voxelize (cache hit)", "light", "light (cache hit)", and
+// cache warnings. Tests and the studio read it.
+struct JobLog {
+    std::vector<std::string> stages;
+    std::vector<std::string> warnings;
+};
+
+struct DensityJob {
+    std::string meshPath;
+    ImportOptions import;
+    VoxelizeSettings voxel;
+};
+
+// Imports and voxelizes a mesh, or loads the grid from the cache (key: imported geometry and materials,
+// voxelizer settings, cache format). cache may be null (no caching).
+DensityGrid densityForMesh(const DensityJob& job, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr);
+
+// Hash of a density grid's content and placement, for lighting cache keys.
+std::string densityHash(const DensityGrid& density);
+
+// Solves (or loads from the cache) the lighting of a density grid. The key covers the density content,
+// every LB parameter that changes the answer, the sun, steps/tolerance, storage and the format version.
+LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache,
+                         Progress* progress = nullptr, JobLog* log = nullptr);
+
+} // namespace sylva

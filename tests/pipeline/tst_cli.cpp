@@ -1,0 +1,179 @@
+// The sylva command line: exit codes and messages for bad usage and bad input, and the whole path on a real tree.
+#include <QDir>
+#include <QProcess>
+#include <QTest>
+
+#include <cmath>
+
+#include "core/grid/grid.h"
+#include "pipeline/io/npy.h"
+
+using namespace sylva;
+
+namespace {
+
+struct Run {
+    int code = -1;
+    QString out, err;
+};
+
+Run runSylva(const QStringList& args, const QString& cacheDir = {})
+{
+    QProcess p;
+    QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+    if (!cacheDir.isEmpty()) env.insert("XDG_CACHE_HOME", cacheDir);
+    p.setProcessEnvironment(env);
+    p.start(SYLVA_CLI_PATH, args);
+    p.waitForFinished(600000);
+    return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
+            QString::fromUtf8(p.readAllStandardError())};
+}
+
+QString outDir()
+{
+    const QString dir = QString(SYLVA_TEST_OUTPUT) + "/cli";
+    QDir().mkpath(dir);
+    return dir;
+}
+
+} // namespace
+
+class TestCli : public QObject {
+    Q_OBJECT
+private Q_SLOTS:
+    void usageErrorsExitTwo_data()
+    {
+        QTest::addColumn<QStringList>("args");
+        QTest::addColumn<QString>("mentions");
+        QTest::newRow("no command") << QStringList{} << "usage";
+        QTest::newRow("unknown command") << QStringList{"paint"} << "unknown command 'paint'";
+        QTest::newRow("unknown option") << QStringList{"grow", "--colour", "red"} << "unknown option --colour";
+        QTest::newRow("missing value") << QStringList{"grow", "--seed"} << "needs a value";
+        QTest::newRow("bad number") << QStringList{"grow", "--triangles", "lots"} << "not a whole number";
+        QTest::newRow("out of range") << QStringList{"grow", "--triangles", "10"} << "outside [1000, 1000000]";
+        QTest::newRow("unknown species") << QStringList{"grow", "--species", "palm"} << "unknown species 'palm'";
+        QTest::newRow("light without sun") << QStringList{"light", "--density", "x.npy", "-o", "y.npy"} << "needs --sun";
+        QTest::newRow("light without input") << QStringList{"light", "--sun", "0,1,0", "-o", "y.npy"} << "exactly one of";
+        QTest::newRow("bad triple") << QStringList{"light", "--density", "x.npy", "--sun", "0,1", "-o", "y.npy"} << "three comma-separated";
+        QTest::newRow("bad preset") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "--preset", "glass", "-o", "y"} << "unknown preset 'glass'";
+        QTest::newRow("voxelize without output") << QStringList{"voxelize", "mesh.obj"} << "needs --output";
+        QTest::newRow("bad grid") << QStringList{"voxelize", "mesh.obj", "--grid", "2", "-o", "d.npy"} << "outside [3, 512]";
+        QTest::newRow("steps and tol") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "--steps", "5", "--tol", "1e-3", "-o", "y"} << "exclude each other";
+    }
+    void usageErrorsExitTwo()
+    {
+        QFETCH(QStringList, args);
+        QFETCH(QString, mentions);
+        const Run r = runSylva(args);
+        QCOMPARE(r.code, 2);
+        QVERIFY2((r.err + r.out).contains(mentions), qPrintable(r.err + r.out));
+    }
+
+    void helpExitsZero()
+    {
+        for (const QString cmd : {"grow", "voxelize", "light", "info"}) {
+            const Run r = runSylva({cmd, "--help"});
+            QCOMPARE(r.code, 0);
+            QVERIFY(r.out.contains("usage: sylva " + cmd));
+        }
+        QCOMPARE(runSylva({"--help"}).code, 0);
+        const Run v = runSylva({"--version"});
+        QCOMPARE(v.code, 0);
+        QVERIFY(v.out.contains("backends: cpu"));
+    }
+
+    void badInputExitsOneNamingTheFile()
+    {
+        const QString dir = outDir();
+        const QString garbage = dir + "/garbage.obj";
+        QFile f(garbage);
+        QVERIFY(f.open(QIODevice::WriteOnly));
+        f.write("this is not a mesh \x01\x02\x03");
+        f.close();
+        const QString missing = dir + "/does_not_exist.obj";
+        Run r = runSylva({"voxelize", missing, "-o", dir + "/d.npy"});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains(missing), qPrintable(r.err));
+        r = runSylva({"voxelize", garbage, "-o", dir + "/d.npy", "--no-cache"});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains(garbage), qPrintable(r.err));
+        r = runSylva({"light", "--density", missing, "--sun", "0,1,0", "-o", dir + "/l.npy"});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains(missing), qPrintable(r.err));
+        r = runSylva({"light", "--density", garbage, "--sun", "0,1,0", "-o", dir + "/l.npy"});
+        QCOMPARE(r.code, 1);
+        r = runSylva({"info", missing});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains(missing), qPrintable(r.err));
+        // Parameter values outside the stable region are bad input, refused with the bound named.
+        r = runSylva({"light", "--density", garbage, "--sun", "0,1,0", "--sigma-a", "0.5", "--sigma-s", "0.8", "-o", dir + "/l.npy"});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains("stability bound"), qPrintable(r.err));
+        r = runSylva({"light", "--density", garbage, "--sun", "0,0,0", "-o", dir + "/l.npy"});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains("sun"), qPrintable(r.err));
+    }
+
+    void growVoxelizeLightInfo()
+    {
+        const QString dir = outDir() + "/chain";
+        const QString cache = outDir() + "/chain-cache";
+        QDir(dir).removeRecursively();
+        QDir(cache).removeRecursively();
+        Run r = runSylva({"grow", "--species", "birch", "--triangles", "5000", "--seed", "3", "-o", dir + "/birch.obj"});
+        QCOMPARE(r.code, 0);
+        QVERIFY(QFile::exists(dir + "/birch.obj") && QFile::exists(dir + "/birch.mtl"));
+        r = runSylva({"voxelize", dir + "/birch.obj", "--grid", "24", "-o", dir + "/d.npy", "--picture", dir + "/d.png"}, cache);
+        QCOMPARE(r.code, 0);
+        QVERIFY(QFile::exists(dir + "/d.npy") && QFile::exists(dir + "/d.npy.json") && QFile::exists(dir + "/d.png"));
+        r = runSylva({"light", "--density", dir + "/d.npy", "--sun", "0.3,1,0.2", "-o", dir + "/l.npy", "--picture", dir + "/l.png"}, cache);
+        QCOMPARE(r.code, 0);
+        QVERIFY2(r.err.contains("light: done"), qPrintable(r.err));
+        const LightingGrid light = readLightingGrid((dir + "/l.npy").toStdString());
+        QCOMPARE(light.geometry.dims.y, 24);
+        // The same job again is a cache hit.
+        r = runSylva({"light", "--density", dir + "/d.npy", "--sun", "0.3,1,0.2", "-o", dir + "/l2.npy"}, cache);
+        QCOMPARE(r.code, 0);
+        QVERIFY2(r.err.contains("cache hit"), qPrintable(r.err));
+        r = runSylva({"info", dir + "/l.npy"});
+        QCOMPARE(r.code, 0);
+        QVERIFY2(r.out.contains("shape (") && r.out.contains(", 3)"), qPrintable(r.out));
+        r = runSylva({"info", dir + "/birch.obj"});
+        QCOMPARE(r.code, 0);
+        QVERIFY2(r.out.contains("leaf"), qPrintable(r.out));
+    }
+
+    void realTreeLightingLooksRight()
+    {
+        const QString tree = QString(SYLVA_SHARED_DATA) + "/trees/quaternius/OBJ_textured/Tree_1.obj";
+        if (!QFile::exists(tree)) QSKIP("../shared/data is absent");
+        const QString dir = outDir() + "/real";
+        QDir().mkpath(dir);
+        // Sun from +x and above: the +x side of the crown must be brighter than the -x side.
+        const Run r = runSylva({"light", "--mesh", tree, "--grid", "48", "--sun", "1,0.5,0", "--no-cache", "-o", dir + "/tree1.npy",
+                             "--picture", dir + "/tree1.png"});
+        QCOMPARE(r.code, 0);
+        const LightingGrid light = readLightingGrid((dir + "/tree1.npy").toStdString());
+        const glm::ivec3 n = light.geometry.dims;
+        double lit = 0, shaded = 0, sumG = 0, sumR = 0, sumB = 0;
+        size_t litCount = 0, shadedCount = 0;
+        for (int i = 1; i < n.x - 1; ++i)
+            for (int j = 1; j < n.y - 1; ++j)
+                for (int k = 1; k < n.z - 1; ++k) {
+                    const double g = light.at(i, j, k, 1);
+                    if (i > n.x * 2 / 3) lit += g, ++litCount;
+                    if (i < n.x / 3) shaded += g, ++shadedCount;
+                    sumR += light.at(i, j, k, 0);
+                    sumG += g;
+                    sumB += light.at(i, j, k, 2);
+                }
+        lit /= double(litCount);
+        shaded /= double(shadedCount);
+        qInfo("mean green: lit third %.3f, shaded third %.3f; interior sums R %.1f G %.1f B %.1f", lit, shaded, sumR, sumG, sumB);
+        QVERIFY(lit > shaded * 1.05);
+        QVERIFY(sumG > sumR && sumG > sumB);
+    }
+};
+
+QTEST_GUILESS_MAIN(TestCli)
+#include "tst_cli.moc"

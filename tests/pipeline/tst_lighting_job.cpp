@@ -1,0 +1,105 @@
+// The lighting pipeline with the cache: which stages run, and damaged cache entries are recomputed, never used.
+#include <QDir>
+#include <QFile>
+#include <QTest>
+
+#include "core/lb/lb_solver.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/grow/obj_writer.h"
+#include "pipeline/grow/tree_grower.h"
+#include "pipeline/lighting_job.h"
+
+using namespace sylva;
+
+class TestLightingJob : public QObject {
+    Q_OBJECT
+
+    QString m_dir;
+    std::string m_mesh;
+
+private Q_SLOTS:
+    void initTestCase()
+    {
+        m_dir = QString(SYLVA_TEST_OUTPUT) + "/lighting_job";
+        QDir(m_dir).removeRecursively();
+        QDir().mkpath(m_dir);
+        GrowOptions g;
+        g.species = TreeSpecies::Shrub;
+        g.targetTriangles = 4000;
+        m_mesh = (m_dir + "/shrub.obj").toStdString();
+        writeObj(m_mesh, growTree(g));
+    }
+
+    void stagesFollowWhatChanged()
+    {
+        GridCache cache((m_dir + "/cache-stages").toStdString());
+        DensityJob job{m_mesh, {}, {}};
+        job.voxel.longestAxisNodes = 20;
+        lb::LbParams p = lb::paramsFromPreset(*lb::findPreset("leaf"));
+        p.sun = {0.2f, 1.0f, 0.1f};
+
+        JobLog first;
+        const DensityGrid d1 = densityForMesh(job, &cache, nullptr, &first);
+        const LightingGrid l1 = lightingFor(d1, p, &cache, nullptr, &first);
+        QCOMPARE(first.stages, (std::vector<std::string>{"import", "voxelize", "light"}));
+
+        JobLog again;
+        const DensityGrid d2 = densityForMesh(job, &cache, nullptr, &again);
+        const LightingGrid l2 = lightingFor(d2, p, &cache, nullptr, &again);
+        QCOMPARE(again.stages, (std::vector<std::string>{"import", "voxelize (cache hit)", "light (cache hit)"}));
+        QVERIFY(d2.density == d1.density && l2.rgb == l1.rgb);
+
+        // A sun move relights but does not revoxelize; a grid change does both.
+        JobLog sunMoved;
+        p.sun = {1.0f, 1.0f, 0.0f};
+        lightingFor(densityForMesh(job, &cache, nullptr, &sunMoved), p, &cache, nullptr, &sunMoved);
+        QCOMPARE(sunMoved.stages, (std::vector<std::string>{"import", "voxelize (cache hit)", "light"}));
+        JobLog regrid;
+        job.voxel.longestAxisNodes = 22;
+        lightingFor(densityForMesh(job, &cache, nullptr, &regrid), p, &cache, nullptr, &regrid);
+        QCOMPARE(regrid.stages, (std::vector<std::string>{"import", "voxelize", "light"}));
+        // Block depth does not change the answer, so it is not part of the key.
+        JobLog blocked;
+        p.blockSteps = 3;
+        lightingFor(densityForMesh(job, &cache, nullptr, &blocked), p, &cache, nullptr, &blocked);
+        QCOMPARE(blocked.stages.back(), std::string("light (cache hit)"));
+    }
+
+    void damagedEntryIsRecomputed()
+    {
+        const std::string dir = (m_dir + "/cache-damaged").toStdString();
+        GridCache cache(dir);
+        DensityJob job{m_mesh, {}, {}};
+        job.voxel.longestAxisNodes = 16;
+        lb::LbParams p = lb::paramsFromPreset(*lb::findPreset("leaf"));
+        const DensityGrid d = densityForMesh(job, &cache, nullptr, nullptr);
+        const LightingGrid good = lightingFor(d, p, &cache, nullptr, nullptr);
+        // Flip one payload byte of the lighting entry.
+        QDir entries(QString::fromStdString(dir) + "/grids");
+        const QStringList files = entries.entryList({"*.l.sgrid"}, QDir::Files);
+        QCOMPARE(files.size(), 1);
+        QFile f(entries.filePath(files[0]));
+        QVERIFY(f.open(QIODevice::ReadWrite));
+        f.seek(f.size() - 5);
+        char c;
+        f.getChar(&c);
+        f.seek(f.size() - 5);
+        f.putChar(char(c ^ 0x40));
+        f.close();
+        JobLog log;
+        const LightingGrid again = lightingFor(d, p, &cache, nullptr, &log);
+        QCOMPARE(log.stages, (std::vector<std::string>{"light"}));
+        QVERIFY(!log.warnings.empty());
+        QVERIFY2(QString::fromStdString(log.warnings[0]).contains("corrupt"), log.warnings[0].c_str());
+        QVERIFY(again.rgb == good.rgb);
+        // Truncated entry: also detected and recomputed.
+        QVERIFY(QFile::resize(entries.filePath(files[0]), 200));
+        JobLog log2;
+        const LightingGrid third = lightingFor(d, p, &cache, nullptr, &log2);
+        QCOMPARE(log2.stages, (std::vector<std::string>{"light"}));
+        QVERIFY(third.rgb == good.rgb);
+    }
+};
+
+QTEST_GUILESS_MAIN(TestLightingJob)
+#include "tst_lighting_job.moc"
