@@ -48,6 +48,7 @@ CacheKey lightKey(const DensityGrid& density, const lb::LbParams& p)
     key.add("zero f0", int64_t(p.zeroF0));
     key.add("brown threshold", double(p.brownThreshold));
     key.add("storage", int64_t(p.storage == lb::Storage::Fp16 ? 16 : 32));
+    key.add("warm start", int64_t(p.warmStart));
     if (p.tolerance > 0.0) {
         key.add("tolerance", p.tolerance).add("check every", p.checkEvery).add("max steps", p.maxSteps);
     } else {

@@ -26,6 +26,8 @@ struct LbParams {
     double tolerance = 0.0;                    // > 0: stop when the relative L2 change per step < tolerance
     int checkEvery = 8;                        // tolerance check period in steps
     int maxSteps = 0;                          // tolerance mode cap; 0 = 4 x the longest edge
+    bool warmStart = false;                    // start the interior from the unobstructed field instead of 0
+                                               // (same steady state, reached in fewer steps; not the seed's start)
     int blockSteps = 0;                        // steps per cache-blocked wavefront; 0 = sized to the cache
     float brownThreshold = 0.5f;               // wood fraction above which a node is brown (g = -1)
     Storage storage = Storage::Fp32;

@@ -118,7 +118,7 @@ public:
                 for (int j = 0; j < m_Y; ++j)
                     for (int m = 0; m < kDirections; ++m)
                         for (int k = 0; k < m_Z; ++k)
-                            if (isBoundary(i, j, k))
+                            if (params.warmStart || isBoundary(i, j, k))
                                 field->a[dindex(i, j, k, m)] = toStorage<S>(bc[size_t(m)]);
             field->b = field->a;
             m_fields.push_back(std::move(field));

@@ -140,6 +140,9 @@ int main(int argc, char** argv)
     LbParams t16 = p16;
     t16.tolerance = tol;
     Row tol16 = run("fp16 tolerance", t16, &reference, nullptr);
+    LbParams w16 = t16;
+    w16.warmStart = true;
+    Row warm16 = run("fp16 tolerance warm", w16, &reference, nullptr);
 
     const double floorStep32 = copySeconds(size_t(fp32.bytesPerStep));
     const double floorStep16 = copySeconds(size_t(fp16.bytesPerStep));
@@ -155,6 +158,9 @@ int main(int argc, char** argv)
     std::printf("lb_fp16_tol_s=%.4f\nlb_fp16_tol_steps=%d\nlb_fp16_tol_err=%.3e\n", tol16.seconds, tol16.steps, tol16.error);
     std::printf("lb_bytes_per_step_fp32=%.0f\nlb_bytes_per_step_fp16=%.0f\n", fp32.bytesPerStep, fp16.bytesPerStep);
     std::printf("lb_floor_fp32_default_s=%.4f\nlb_floor_gbps=%.2f\n", floorStep32 * fp32.steps, fp32.bytesPerStep / floorStep32 / 1e9);
+    std::printf("lb_fp16_tol_warm_s=%.4f\nlb_fp16_tol_warm_steps=%d\nlb_fp16_tol_warm_err=%.3e\n", warm16.seconds, warm16.steps,
+                warm16.error);
     std::printf("lb_speedup_fp16_tol_vs_fp32_default=%.2f\n", fp32.seconds / tol16.seconds);
+    std::printf("lb_speedup_fp16_tol_warm_vs_fp32_default=%.2f\n", fp32.seconds / warm16.seconds);
     return 0;
 }
