@@ -319,8 +319,9 @@ DensityGrid voxelize(const TriangleMesh& mesh, const VoxelizeSettings& settings,
                             float a = (sat.cmin[0] - base) / normal.z - 0.5f;
                             float b = (sat.cmax[0] - base) / normal.z - 0.5f;
                             if (a > b) std::swap(a, b);
-                            w0 = int(std::max(std::ceil(a) - 1.0f, 0.0f));
-                            w1 = int(std::min(std::floor(b) + 1.0f, float(n.z - 1)));
+                            // Clamped as floats first: a nearly vertical plane gives huge or infinite bounds.
+                            w0 = int(std::clamp(std::ceil(a) - 1.0f, 0.0f, float(n.z)));
+                            w1 = int(std::clamp(std::floor(b) + 1.0f, -1.0f, float(n.z - 1)));
                         }
                         for (int w = w0; w <= w1; ++w) {
                             const glm::vec3 centre(float(u) + 0.5f, float(v) + 0.5f, float(w) + 0.5f);

@@ -34,6 +34,9 @@ GridGeometry gridForMesh(const Bounds3& bounds, const VoxelizeSettings& settings
 // A sub-cell is marked when a triangle meets it (exact overlap test, closed sub-cells: a triangle on
 // a face shared by two sub-cells marks both, one touching an edge or corner marks all sharing it),
 // except that margin sub-cells are never marked (the mesh bounds touch them only on their faces).
+// The test runs in float sub-cell units (computed in double, rounded once): a contact closer than
+// about 1e-4 sub-cell may go either way, but a coordinate within double rounding of a sub-cell plane
+// (an axis-aligned face at the mesh bounds, for one) lands exactly on it and counts as touching.
 // density = marked / subcells^3 in [0,1]. woodFraction = (sub-cells touched by a wood triangle) /
 // (marked sub-cells), 0 where nothing is marked; triangles whose material is not a leaf (and all
 // triangles of a mesh without materials) count as wood. Zero-area triangles mark what they touch.

@@ -304,6 +304,7 @@ private Q_SLOTS:
     void densityInUnitRange();
     void matchesNaiveVoxelizer_data();
     void matchesNaiveVoxelizer();
+    void largeTrianglesNearAxisPlanes();
     void deterministicAcrossThreads();
     void progressAndCancel();
     void badInput();
@@ -704,6 +705,29 @@ void TestVoxelize::matchesNaiveVoxelizer()
     QVERIFY(fast.density == naive.density);
     QVERIFY(fast.woodFraction == naive.woodFraction);
     QVERIFY(*std::max_element(fast.density.begin(), fast.density.end()) > 0.0f);
+}
+
+void TestVoxelize::largeTrianglesNearAxisPlanes()
+{
+    // Large triangles whose normals have a zero or tiny z component (the per-column plane interval
+    // degenerates), or lie in axis planes, against the straightforward voxelizer. Coordinates are
+    // generic so that no exact touching (where rounding may decide either way) occurs.
+    MeshBuilder b;
+    b.tri({0.113f, 0.271f, 0.05f}, {4.871f, 4.323f, 0.42f}, {0.113f, 0.271f, 4.93f});          // normal.z = 0
+    b.tri({0.337f, 4.913f, 0.021f}, {4.957f, 0.291f, 0.021f}, {0.33701f, 4.913f, 4.97f}, true); // tiny normal.z
+    b.tri({0.05f, 0.2f, 2.4731f}, {4.97f, 0.23f, 2.4731f}, {0.1f, 4.9f, 2.4731f});            // horizontal
+    b.tri({4.6813f, 0.07f, 0.09f}, {4.6813f, 4.93f, 0.11f}, {4.6813f, 0.12f, 4.91f}, true);   // x = const
+    b.tri({0.021f, 0.033f, 4.987f}, {4.991f, 3.117f, 4.013f}, {2.019f, 4.977f, 0.017f});      // oblique
+    for (int sc : {1, 2, 3}) {
+        VoxelizeSettings s;
+        s.longestAxisNodes = 40;
+        s.subcells = sc;
+        const DensityGrid fast = voxelize(b.mesh, s);
+        const DensityGrid naive = naiveVoxelize(b.mesh, s);
+        QVERIFY(fast.density == naive.density);
+        QVERIFY(fast.woodFraction == naive.woodFraction);
+        QVERIFY(marginEmpty(fast));
+    }
 }
 
 void TestVoxelize::deterministicAcrossThreads()
