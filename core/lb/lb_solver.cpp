@@ -115,11 +115,19 @@ public:
             field->brown = compactOmega({cp.sigmaA, cp.sigmaS, -1.0f});
             field->a.assign(count, toStorage<S>(0.0f));
             for (int i = 0; i < m_X; ++i)
-                for (int j = 0; j < m_Y; ++j)
-                    for (int m = 0; m < kDirections; ++m)
-                        for (int k = 0; k < m_Z; ++k)
-                            if (params.warmStart || isBoundary(i, j, k))
-                                field->a[dindex(i, j, k, m)] = toStorage<S>(bc[size_t(m)]);
+                for (int j = 0; j < m_Y; ++j) {
+                    const bool wholeRow = params.warmStart || i == 0 || j == 0 || i == m_X - 1 || j == m_Y - 1;
+                    for (int m = 0; m < kDirections; ++m) {
+                        S* row = &field->a[dindex(i, j, 0, m)];
+                        const S v = toStorage<S>(bc[size_t(m)]);
+                        if (wholeRow) {
+                            std::fill(row, row + m_Z, v);
+                        } else {
+                            row[0] = v;
+                            row[m_Z - 1] = v;
+                        }
+                    }
+                }
             field->b = field->a;
             m_fields.push_back(std::move(field));
         }
@@ -219,10 +227,6 @@ private:
     size_t dindex(int i, int j, int k, int m) const
     {
         return ((size_t(i) * size_t(m_Y) + size_t(j)) * kDirections + size_t(m)) * size_t(m_Z) + size_t(k);
-    }
-    bool isBoundary(int i, int j, int k) const
-    {
-        return i == 0 || j == 0 || k == 0 || i == m_X - 1 || j == m_Y - 1 || k == m_Z - 1;
     }
 
     void processRow(size_t r, size_t c, const S* src, S* dst, Scratch& s, int outMode)
