@@ -13,6 +13,8 @@
 #include "core/grid/grid.h"
 #include "core/lb/lb_params.h"
 #include "core/lb/lb_solver.h"
+#include "core/voxel/voxelize.h"
+#include "pipeline/grow/tree_grower.h"
 
 using namespace sylva;
 using namespace sylva::lb;
@@ -90,24 +92,34 @@ int main(int argc, char** argv)
 {
     int n = 128, reps = 1;
     double tol = 2e-4;
-    bool dense = false;
+    bool dense = false, grown = false;
     for (int a = 1; a < argc; ++a) {
         std::string s = argv[a];
         if (s == "--grid" && a + 1 < argc) n = std::atoi(argv[++a]);
         else if (s == "--reps" && a + 1 < argc) reps = std::atoi(argv[++a]);
         else if (s == "--tol" && a + 1 < argc) tol = std::atof(argv[++a]);
         else if (s == "--dense") dense = true;
+        else if (s == "--grown") grown = true;
         else {
-            std::printf("usage: bench_lb [--grid N] [--reps R] [--tol T] [--dense]\n");
+            std::printf("usage: bench_lb [--grid N] [--reps R] [--tol T] [--dense | --grown]\n");
             return s == "--help" ? 0 : 2;
         }
     }
     DensityGrid grid = treeLikeGrid(n, 42);
     if (dense) std::fill(grid.density.begin(), grid.density.end(), 1.0f);
+    if (grown) {   // the main job's default tree: broadleaf, seed 1, 200k triangles, voxelized at N
+        GrowOptions g;
+        g.targetTriangles = 200000;
+        VoxelizeSettings v;
+        v.longestAxisNodes = n;
+        grid = voxelize(growTree(g).mesh, v);
+    }
     size_t occupied = 0;
     for (float r : grid.density) occupied += r > 0.0f;
-    std::printf("LB benchmark: %d^3 grid, %s, %.1f%% of nodes with medium, leaf preset (3 distinct channels), sun (0.3,1,0.2)\n",
-                n, dense ? "dense medium" : "tree-like crown", 100.0 * double(occupied) / double(grid.density.size()));
+    const glm::ivec3 dd = grid.geometry.dims;
+    std::printf("LB benchmark: %dx%dx%d grid, %s, %.1f%% of nodes with medium, leaf preset (3 distinct channels), sun (0.3,1,0.2)\n",
+                dd.x, dd.y, dd.z, grown ? "grown default tree" : (dense ? "dense medium" : "tree-like crown"),
+                100.0 * double(occupied) / double(grid.density.size()));
 
     LbParams base = paramsFromPreset(*findPreset("leaf"));
     base.sun = {0.3f, 1.0f, 0.2f};
