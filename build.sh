@@ -25,7 +25,7 @@ install_missing() {
     local sudo=()
     if [[ $(id -u) -ne 0 ]]; then sudo=(sudo); fi
     "${sudo[@]}" apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+    DEBIAN_FRONTEND=noninteractive "${sudo[@]}" apt-get install -y -qq "${missing[@]}"
   else
     echo "==> all packages present"
   fi
