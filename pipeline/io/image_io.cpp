@@ -31,7 +31,11 @@ std::string lowerExtension(const std::string& path)
 ImageRgba readImage(const std::string& path)
 {
     if (!fs::exists(path)) throw Error(path + ": no such image file");
-    auto in = OIIO::ImageInput::open(path);
+    // Keep colour and alpha as stored (unassociated), as textures are authored; OIIO would otherwise
+    // premultiply, turning the colour of cut-out texels black.
+    OIIO::ImageSpec config;
+    config.attribute("oiio:UnassociatedAlpha", 1);
+    auto in = OIIO::ImageInput::open(path, &config);
     if (!in) throw Error(path + ": cannot read image (" + OIIO::geterror() + ")");
     const OIIO::ImageSpec& spec = in->spec();
     const int w = spec.width, h = spec.height, nc = spec.nchannels;
@@ -82,7 +86,10 @@ void writeImage(const std::string& path, const ImageRgba& image, int channels)
     auto out = OIIO::ImageOutput::create(tmp.string());
     if (!out) throw Error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
     OIIO::ImageSpec spec(image.width, image.height, channels, isFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
-    if (channels == 4) spec.alpha_channel = 3;
+    if (channels == 4) {
+        spec.alpha_channel = 3;
+        spec.attribute("oiio:UnassociatedAlpha", 1);   // the pixels are straight (unassociated) RGBA
+    }
     std::vector<float> data(size_t(image.width) * size_t(image.height) * size_t(channels));
     for (size_t p = 0; p < size_t(image.width) * size_t(image.height); ++p)
         for (int c = 0; c < channels; ++c) {

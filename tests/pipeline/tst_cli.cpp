@@ -150,10 +150,23 @@ private Q_SLOTS:
         const QString dir = outDir() + "/real";
         QDir().mkpath(dir);
         // Sun from +x and above: the +x side of the crown must be brighter than the -x side.
-        const Run r = runSylva({"light", "--mesh", tree, "--grid", "48", "--sun", "1,0.5,0", "--no-cache", "-o", dir + "/tree1.npy",
-                             "--picture", dir + "/tree1.png"});
+        Run r = runSylva({"voxelize", tree, "--grid", "48", "--no-cache", "-o", dir + "/tree1_density.npy"});
+        QCOMPARE(r.code, 0);
+        r = runSylva({"light", "--density", dir + "/tree1_density.npy", "--sun", "1,0.5,0", "--no-cache", "-o", dir + "/tree1.npy",
+                      "--picture", dir + "/tree1.png"});
         QCOMPARE(r.code, 0);
         const LightingGrid light = readLightingGrid((dir + "/tree1.npy").toStdString());
+        const DensityGrid density = readDensityGrid((dir + "/tree1_density.npy").toStdString());
+        // Inside the crown (nodes with medium) light is dimmer than in open space (a boundary node).
+        double inside = 0;
+        size_t insideCount = 0;
+        for (size_t node = 0; node < density.density.size(); ++node)
+            if (density.density[node] > 0.3f) inside += light.rgb[node * 3 + 1], ++insideCount;
+        QVERIFY(insideCount > 100);
+        inside /= double(insideCount);
+        const double open = light.at(0, 0, 0, 1);
+        qInfo("mean green inside the crown %.3f, in open space %.3f", inside, open);
+        QVERIFY(inside < 0.9 * open);
         const glm::ivec3 n = light.geometry.dims;
         double lit = 0, shaded = 0, sumG = 0, sumR = 0, sumB = 0;
         size_t litCount = 0, shadedCount = 0;
