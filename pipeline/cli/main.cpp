@@ -240,7 +240,7 @@ void writePicture(const Args& args, const DensityGrid* density, const LightingGr
         else throw UsageError("option --axis: expected x, y or z, got '" + a + "'");
     }
     const int slices = args.has("--slices") ? int(parseInteger("--slices", args.get("--slices"), 1, 64)) : 8;
-    writeGridMontage(args.get("--picture"), density, light, axis, slices);
+    writeGridMontage(args.get("--picture"), density, light, axis, slices, 256);
     std::printf("picture: %s\n", args.get("--picture").c_str());
 }
 

@@ -61,7 +61,7 @@ float robustMax(const LightingGrid& grid)
 
 } // namespace
 
-ImageRgba gridMontage(const DensityGrid* density, const LightingGrid* lighting, int axis, int slices)
+ImageRgba gridMontage(const DensityGrid* density, const LightingGrid* lighting, int axis, int slices, int tilePixels)
 {
     if (!density && !lighting) throw Error("grid picture: neither a density nor a lighting grid was given");
     if (axis < 0 || axis > 2) throw Error("grid picture: axis must be 0 (x), 1 (y) or 2 (z), not " + std::to_string(axis));
@@ -79,7 +79,7 @@ ImageRgba gridMontage(const DensityGrid* density, const LightingGrid* lighting, 
     const int vAxis = axis == 1 ? 2 : 1;
     const bool flipV = axis != 1;
     const int uN = dims[uAxis], vN = dims[vAxis], depthN = dims[axis];
-    const int scale = std::max(1, 64 / std::max(uN, vN));
+    const int scale = std::max(1, std::max(1, tilePixels) / std::max(uN, vN));
     const int tileW = uN * scale, tileH = vN * scale;
     const int count = std::clamp(slices, 1, depthN);
     const int cols = int(std::ceil(std::sqrt(double(count))));
@@ -133,11 +133,12 @@ ImageRgba gridMontage(const DensityGrid* density, const LightingGrid* lighting, 
     return image;
 }
 
-void writeGridMontage(const std::string& pngPath, const DensityGrid* density, const LightingGrid* lighting, int axis, int slices)
+void writeGridMontage(const std::string& pngPath, const DensityGrid* density, const LightingGrid* lighting, int axis, int slices,
+                      int tilePixels)
 {
     ImageRgba image;
     try {
-        image = gridMontage(density, lighting, axis, slices);
+        image = gridMontage(density, lighting, axis, slices, tilePixels);
     } catch (const Error& e) {
         throw Error(pngPath + ": " + e.what());
     }
