@@ -69,7 +69,7 @@ void validate(const LbParams& params)
     if (params.steps < 0) throw Error("invalid step count " + std::to_string(params.steps) + ": must be >= 1");
     if (!std::isfinite(params.tolerance) || params.tolerance < 0.0)
         throw Error("invalid tolerance: must be a finite number > 0");
-    if (params.checkEvery < 1) throw Error("invalid tolerance check period: must be >= 1 step");
+    if (params.checkEvery < 0) throw Error("invalid tolerance check period: must be >= 1 step (or 0 for automatic)");
     if (params.maxSteps < 0) throw Error("invalid maximum step count: must be >= 1");
     if (params.blockSteps < 0) throw Error("invalid block depth: must be >= 1 (or 0 for automatic)");
     if (!(params.brownThreshold >= 0.0f && params.brownThreshold <= 1.0f))

@@ -398,8 +398,8 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
                               : (params.steps > 0 ? params.steps : defaultSteps(density.geometry.dims));
     // Fixed steps run in wavefront blocks of the cache-sized depth; tolerance mode in blocks of the check
     // period whose last two levels measure the change per step.
-    const int block = tolMode ? std::max(2, params.checkEvery)
-                              : (params.blockSteps > 0 ? params.blockSteps : solver.autoLevels());
+    const int depth = params.blockSteps > 0 ? params.blockSteps : solver.autoLevels();
+    const int block = tolMode ? std::max(2, params.checkEvery > 0 ? params.checkEvery : depth) : depth;
     stats.blockSteps = block;
     int done = 0;
     while (done < steps) {

@@ -156,6 +156,16 @@ int main(int argc, char** argv)
     w16.warmStart = true;
     Row warm16 = run("fp16 tolerance warm", w16, &reference, nullptr);
 
+    // Tolerance sweep, fp16 + warm start: the accuracy each tolerance buys and what it costs.
+    std::vector<Row> sweep;
+    for (double t : {1e-4, 3e-4, 1e-3, 3e-3}) {
+        LbParams q = w16;
+        q.tolerance = t;
+        char name[64];
+        std::snprintf(name, sizeof name, "fp16 warm tol %.0e", t);
+        sweep.push_back(run(name, q, &reference, nullptr));
+    }
+
     const double floorStep32 = copySeconds(size_t(fp32.bytesPerStep));
     const double floorStep16 = copySeconds(size_t(fp16.bytesPerStep));
     std::printf("memory floor (parallel memcpy of the same bytes): fp32 %.2f ms/step (%.1f GB/s), fp16 %.2f ms/step\n",
@@ -172,6 +182,9 @@ int main(int argc, char** argv)
     std::printf("lb_floor_fp32_default_s=%.4f\nlb_floor_gbps=%.2f\n", floorStep32 * fp32.steps, fp32.bytesPerStep / floorStep32 / 1e9);
     std::printf("lb_fp16_tol_warm_s=%.4f\nlb_fp16_tol_warm_steps=%d\nlb_fp16_tol_warm_err=%.3e\n", warm16.seconds, warm16.steps,
                 warm16.error);
+    for (const Row& r : sweep)
+        std::printf("lb_sweep_%s_s=%.4f lb_sweep_steps=%d lb_sweep_err=%.3e\n", r.name.substr(r.name.rfind(' ') + 1).c_str(), r.seconds,
+                    r.steps, r.error);
     std::printf("lb_speedup_fp16_tol_vs_fp32_default=%.2f\n", fp32.seconds / tol16.seconds);
     std::printf("lb_speedup_fp16_tol_warm_vs_fp32_default=%.2f\n", fp32.seconds / warm16.seconds);
     return 0;
