@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/grid/grid.h"
+#include "core/grid/grid_compare.h"
 #include "core/lb/lb_params.h"
 #include "core/lb/lb_solver.h"
 #include "core/voxel/voxelize.h"
@@ -68,16 +69,6 @@ double copySeconds(size_t bytes)
     return best;
 }
 
-double relL2(const LightingGrid& a, const LightingGrid& b)
-{
-    double diff = 0, norm = 0;
-    for (size_t n = 0; n < a.rgb.size(); ++n) {
-        diff += double(a.rgb[n] - b.rgb[n]) * double(a.rgb[n] - b.rgb[n]);
-        norm += double(b.rgb[n]) * double(b.rgb[n]);
-    }
-    return std::sqrt(diff / norm);
-}
-
 struct Row {
     std::string name;
     double seconds;
@@ -133,7 +124,7 @@ int main(int argc, char** argv)
             times.push_back(st.seconds);
         }
         std::sort(times.begin(), times.end());
-        Row row{name, times[times.size() / 2], st.steps, ref ? relL2(out, *ref) : 0.0, st.bytesPerStep};
+        Row row{name, times[times.size() / 2], st.steps, ref ? relativeL2(out, *ref) : 0.0, st.bytesPerStep};
         std::printf("  %-22s %8.3f s  %4d steps  %6.2f ms/step  rel L2 vs fp32 default %.2e  %.0f MB/step\n", name,
                     row.seconds, row.steps, 1e3 * row.seconds / row.steps, row.error, row.bytesPerStep / 1e6);
         std::fflush(stdout);

@@ -8,6 +8,7 @@
 #include "core/base/error.h"
 #include "core/base/progress.h"
 #include "core/grid/grid.h"
+#include "core/grid/grid_compare.h"
 #include "core/lb/lattice.h"
 #include "core/lb/lb_params.h"
 #include "core/lb/lb_solver.h"
@@ -81,16 +82,6 @@ std::vector<double> referenceSolve(const DensityGrid& d, const LbParams& p, int 
             for (int k = 0; k < n.z; ++k)
                 for (int m = 0; m < kDirections; ++m) total[d.geometry.index(i, j, k)] += from[idx(i, j, k, m)];
     return total;
-}
-
-double relL2(const LightingGrid& a, const LightingGrid& b)
-{
-    double diff = 0, norm = 0;
-    for (size_t n = 0; n < a.rgb.size(); ++n) {
-        diff += double(a.rgb[n] - b.rgb[n]) * double(a.rgb[n] - b.rgb[n]);
-        norm += double(b.rgb[n]) * double(b.rgb[n]);
-    }
-    return std::sqrt(diff / norm);
 }
 
 std::vector<float> pulseState(const DensityGrid& g, glm::ivec3 at, float sigmaA)
@@ -257,7 +248,7 @@ private Q_SLOTS:
         p.zeroF0 = false;
         p.sun = {0.3f, 1.0f, -0.2f};
         const LightingGrid a = solveLighting(dense, p), b = solveLighting(empty, p);
-        QVERIFY(relL2(a, b) < 1e-6);
+        QVERIFY(relativeL2(a, b) < 1e-6);
     }
 
     void toleranceModeReachesFixedStepAnswer()
@@ -270,10 +261,10 @@ private Q_SLOTS:
         p.checkEvery = 4;
         SolveStats st;
         const LightingGrid tol = solveLighting(d, p, nullptr, &st);
-        qInfo("tolerance 1e-3: %d steps (fixed %d), converged %d, rel L2 %.2e", st.steps, 2 * 30, int(st.converged), relL2(tol, fixed));
+        qInfo("tolerance 1e-3: %d steps (fixed %d), converged %d, rel L2 %.2e", st.steps, 2 * 30, int(st.converged), relativeL2(tol, fixed));
         QVERIFY(st.converged);
         QVERIFY(st.steps < 60);
-        QVERIFY(relL2(tol, fixed) < 0.01);
+        QVERIFY(relativeL2(tol, fixed) < 0.01);
     }
 
     void fp16StorageCloseToFp32()
@@ -284,7 +275,7 @@ private Q_SLOTS:
         const LightingGrid a = solveLighting(d, p);
         p.storage = Storage::Fp16;
         const LightingGrid b = solveLighting(d, p);
-        const double err = relL2(b, a);
+        const double err = relativeL2(b, a);
         qInfo("fp16 storage: rel L2 error %.2e", err);
         QVERIFY(err < 5e-3);
     }
