@@ -24,7 +24,7 @@ struct LbParams {
     glm::vec3 intensity{1.0f};                 // sun intensity per channel
     int steps = 0;                             // 0 = default: 2 x the longest edge
     double tolerance = 0.0;                    // > 0: stop when the relative L2 change per step < tolerance
-    int checkEvery = 0;                        // tolerance check period in steps; 0 = the wavefront block depth
+    int checkEvery = 0;                        // tolerance check period in steps; 0 = about every 16 steps
     int maxSteps = 0;                          // tolerance mode cap; 0 = 4 x the longest edge
     bool warmStart = false;                    // start the interior from the unobstructed field instead of 0
                                                // (same steady state, reached in fewer steps; not the seed's start)

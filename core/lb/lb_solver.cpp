@@ -398,13 +398,18 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
                               : (params.steps > 0 ? params.steps : defaultSteps(density.geometry.dims));
     // Fixed steps run in wavefront blocks of the cache-sized depth; tolerance mode in blocks of the check
     // period whose last two levels measure the change per step.
+    // The check (node totals on two consecutive levels) costs about a step, so by default it runs on
+    // the last block of every ~16 steps rather than on every block.
     const int depth = params.blockSteps > 0 ? params.blockSteps : solver.autoLevels();
-    const int block = tolMode ? std::max(2, params.checkEvery > 0 ? params.checkEvery : depth) : depth;
+    const int block = tolMode && params.checkEvery > 0 ? std::max(2, params.checkEvery) : std::max(tolMode ? 2 : 1, depth);
+    const int checkBlocks = tolMode && params.checkEvery <= 0 ? std::max(1, (16 + block - 1) / block) : 1;
     stats.blockSteps = block;
-    int done = 0;
+    int done = 0, blocksRun = 0;
     while (done < steps) {
         const int levels = std::min(block, steps - done);
-        const int compare = tolMode && levels >= 2 ? levels - 1 : 0;
+        ++blocksRun;
+        const bool checkNow = tolMode && (blocksRun % checkBlocks == 0 || done + levels >= steps);
+        const int compare = checkNow && levels >= 2 ? levels - 1 : 0;
         const double change = solver.advanceBlock(levels, compare);
         done += levels;
         if (compare > 0) {
