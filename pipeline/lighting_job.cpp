@@ -22,6 +22,7 @@ CacheKey meshKey(const TriangleMesh& mesh, const VoxelizeSettings& voxel)
     CacheKey key;
     key.add("cache format", int64_t(kCacheFormatVersion));
     key.add("stage", "density");
+    key.add("voxelizer version", kVoxelizerVersion);
     key.add("positions", bytesOf(mesh.positions));
     key.add("triangles", bytesOf(mesh.triangles));
     key.add("triangle materials", bytesOf(mesh.triangleMaterial));
@@ -37,20 +38,23 @@ CacheKey lightKey(const DensityGrid& density, const lb::LbParams& p)
     CacheKey key;
     key.add("cache format", int64_t(kCacheFormatVersion));
     key.add("stage", "lighting");
+    key.add("lb algorithm version", lb::kAlgorithmVersion);
     key.add("density", densityHash(density));
     for (int c = 0; c < 3; ++c) {
         const lb::ChannelParams& ch = p.channels[size_t(c)];
         key.add("sigma_a", double(ch.sigmaA)).add("sigma_s", double(ch.sigmaS)).add("g", double(ch.g));
         key.add("intensity", double(p.intensity[c]));
     }
-    const glm::vec3 sun = glm::normalize(p.sun);
-    key.add("sun x", double(sun.x)).add("sun y", double(sun.y)).add("sun z", double(sun.z));
+    const glm::dvec3 sun = glm::normalize(glm::dvec3(p.sun));   // in double: a float length can overflow
+    key.add("sun x", sun.x).add("sun y", sun.y).add("sun z", sun.z);
     key.add("zero f0", int64_t(p.zeroF0));
     key.add("brown threshold", double(p.brownThreshold));
     key.add("storage", int64_t(p.storage == lb::Storage::Fp16 ? 16 : 32));
     key.add("warm start", int64_t(p.warmStart));
     if (p.tolerance > 0.0) {
+        // Where the tolerance check falls depends on the block depth, so it is part of the key here.
         key.add("tolerance", p.tolerance).add("check every", p.checkEvery).add("max steps", p.maxSteps);
+        key.add("block steps", p.blockSteps);
     } else {
         key.add("steps", p.steps > 0 ? p.steps : lb::defaultSteps(density.geometry.dims));
     }
@@ -78,7 +82,8 @@ DensityGrid densityForMesh(const DensityJob& job, GridCache* cache, Progress* pr
     const TriangleMesh mesh = importMesh(job.meshPath, job.import, &report);
     if (log) {
         log->stages.push_back("import");
-        for (const auto& w : report.warnings) log->warnings.push_back(job.meshPath + ": " + w);
+        for (const auto& w : report.warnings)
+            log->warnings.push_back(w.find(job.meshPath) == std::string::npos ? job.meshPath + ": " + w : w);
     }
     const CacheKey key = meshKey(mesh, job.voxel);
     if (cache) {

@@ -93,6 +93,14 @@ void validateDensity(const DensityGrid& density)
                     std::to_string(density.geometry.nodeCount()) + " nodes");
     if (!density.woodFraction.empty() && density.woodFraction.size() != density.density.size())
         throw Error("wood fraction grid size differs from the density grid");
+    for (size_t n = 0; n < density.woodFraction.size(); ++n) {
+        const float w = density.woodFraction[n];
+        if (!(w >= 0.0f && w <= 1.0f)) {
+            std::ostringstream msg;
+            msg << "wood fraction " << w << " at node " << n << " is outside [0, 1]";
+            throw Error(msg.str());
+        }
+    }
     for (size_t n = 0; n < density.density.size(); ++n) {
         const float r = density.density[n];
         if (!(r >= 0.0f && r <= 1.0f)) {

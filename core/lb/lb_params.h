@@ -17,6 +17,9 @@ namespace sylva::lb {
 
 enum class Storage { Fp32, Fp16 };
 
+// Bump whenever a change alters the numbers a solve returns (cache keys include it).
+inline constexpr int kAlgorithmVersion = 2;
+
 struct LbParams {
     std::array<ChannelParams, 3> channels{};   // R, G, B
     bool zeroF0 = true;                        // plants: true; clouds and plastics keep f_0
@@ -28,6 +31,7 @@ struct LbParams {
     int maxSteps = 0;                          // tolerance mode cap; 0 = 4 x the longest edge
     bool warmStart = false;                    // start the interior from the unobstructed field instead of 0
                                                // (same steady state, reached in fewer steps; not the seed's start)
+    int solvesPerPass = 0;                     // channel solves advanced together; 0 = all that fit in memory
     int blockSteps = 0;                        // steps per cache-blocked wavefront; 0 = sized to the cache
     float brownThreshold = 0.5f;               // wood fraction above which a node is brown (g = -1)
     Storage storage = Storage::Fp32;

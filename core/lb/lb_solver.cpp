@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -370,6 +371,19 @@ private:
     tbb::enumerable_thread_specific<Scratch> m_scratch;
 };
 
+// MemAvailable from /proc/meminfo in bytes, 0 when unknown.
+double availableMemoryBytes()
+{
+    std::FILE* f = std::fopen("/proc/meminfo", "r");
+    if (!f) return 0.0;
+    char line[256];
+    double kb = 0.0;
+    while (std::fgets(line, sizeof line, f))
+        if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
+    std::fclose(f);
+    return kb * 1024.0;
+}
+
 template <typename S>
 LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progress* progress, SolveStats& stats)
 {
@@ -389,53 +403,83 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
     }
     stats.channelSolves = int(solves.size());
 
-    Solver<S> solver(density, params, solves);
-    solver.m_progress = progress;
-    stats.bytesPerStep = double(solver.bytesPerStep());
+    // Memory: two copies of 19 values per node for each channel solve. Solve all channels in one pass
+    // when they fit in what the machine has available, else one channel at a time, else refuse.
+    const double nodes = double(density.geometry.nodeCount());
+    const double perSolve = 2.0 * nodes * kDirections * sizeof(S);
+    const double other = nodes * (4.0 * 3 + 8.0);   // output grid, padded density and brown mask
+    const double available = availableMemoryBytes();
+    size_t group = solves.size();
+    if (available > 0 && perSolve * double(group) + other > 0.8 * available) group = 1;
+    if (params.solvesPerPass > 0) group = std::min(group, size_t(params.solvesPerPass));
+    if (available > 0 && perSolve + other > 0.8 * available) {
+        const glm::ivec3 d = density.geometry.dims;
+        char msg[256];
+        std::snprintf(msg, sizeof msg,
+                      "the %dx%dx%d grid needs %.1f GB for one channel's LB distributions (%s) but %.1f GB of memory is "
+                      "available; use a smaller grid%s",
+                      d.x, d.y, d.z, (perSolve + other) / 1e9, sizeof(S) == 2 ? "fp16" : "fp32", available / 1e9,
+                      sizeof(S) == 2 ? "" : " or fp16 storage");
+        throw Error(msg);
+    }
+    stats.bytesPerStep = perSolve * double(solves.size());
+
     const int longest = density.geometry.longestEdge();
     const bool tolMode = params.tolerance > 0.0;
     const int steps = tolMode ? (params.maxSteps > 0 ? params.maxSteps : 4 * longest)
                               : (params.steps > 0 ? params.steps : defaultSteps(density.geometry.dims));
-    // Fixed steps run in wavefront blocks of the cache-sized depth; tolerance mode in blocks of the check
-    // period whose last two levels measure the change per step.
-    // The check (node totals on two consecutive levels) costs about a step, so by default it runs on
-    // the last block of every ~16 steps rather than on every block.
-    const int depth = params.blockSteps > 0 ? params.blockSteps : solver.autoLevels();
-    const int block = tolMode && params.checkEvery > 0 ? std::max(2, params.checkEvery) : std::max(tolMode ? 2 : 1, depth);
-    const int checkBlocks = tolMode && params.checkEvery <= 0 ? std::max(1, (16 + block - 1) / block) : 1;
-    stats.blockSteps = block;
-    int done = 0, blocksRun = 0;
-    while (done < steps) {
-        const int levels = std::min(block, steps - done);
-        ++blocksRun;
-        const bool checkNow = tolMode && (blocksRun % checkBlocks == 0 || done + levels >= steps);
-        const int compare = checkNow && levels >= 2 ? levels - 1 : 0;
-        const double change = solver.advanceBlock(levels, compare);
-        done += levels;
-        if (compare > 0) {
-            stats.changeHistory.emplace_back(done, change);
-            stats.lastChange = change;
-            if (change < params.tolerance) {
-                stats.converged = true;
-                break;
-            }
-        }
-        if (progress) progress->report(double(done) / double(steps), "LB step " + std::to_string(done) + "/" + std::to_string(steps));
-    }
-    stats.steps = done;
-
     LightingGrid out;
     out.geometry = density.geometry;
     out.rgb.assign(density.geometry.nodeCount() * 3, 0.0f);
     std::vector<float> tot;
-    for (size_t s = 0; s < solves.size(); ++s) {
-        solver.totals(s, tot);
-        for (int c = 0; c < 3; ++c) {
-            if (solveOf[c] != int(s)) continue;
-            const float intensity = params.intensity[c];
-            for (size_t n = 0; n < tot.size(); ++n) out.rgb[n * 3 + size_t(c)] = tot[n] * intensity;
+    const size_t groups = (solves.size() + group - 1) / group;
+    bool allConverged = true;
+    for (size_t g0 = 0; g0 < solves.size(); g0 += group) {
+        const std::vector<ChannelParams> these(solves.begin() + long(g0), solves.begin() + long(std::min(solves.size(), g0 + group)));
+        Solver<S> solver(density, params, these);
+        solver.m_progress = progress;
+        // Fixed steps run in wavefront blocks of the cache-sized depth. In tolerance mode the last two
+        // levels of a block measure the change per step; that check costs about a step, so by default
+        // it runs on the last block of every ~16 steps rather than on every block.
+        const int depth = params.blockSteps > 0 ? params.blockSteps : solver.autoLevels();
+        const int block = tolMode && params.checkEvery > 0 ? std::max(2, params.checkEvery) : std::max(tolMode ? 2 : 1, depth);
+        const int checkBlocks = tolMode && params.checkEvery <= 0 ? std::max(1, (16 + block - 1) / block) : 1;
+        stats.blockSteps = block;
+        const double groupIndex = double(g0 / group);
+        int done = 0, blocksRun = 0;
+        bool groupConverged = false;
+        while (done < steps) {
+            const int levels = std::min(block, steps - done);
+            ++blocksRun;
+            const bool checkNow = tolMode && (blocksRun % checkBlocks == 0 || done + levels >= steps);
+            const int compare = checkNow && levels >= 2 ? levels - 1 : 0;
+            const double change = solver.advanceBlock(levels, compare);
+            done += levels;
+            if (compare > 0) {
+                stats.changeHistory.emplace_back(done, change);
+                stats.lastChange = change;
+                if (change < params.tolerance) {
+                    groupConverged = true;
+                    break;
+                }
+            }
+            if (progress)
+                progress->report((groupIndex + double(done) / double(steps)) / double(groups),
+                                 "LB step " + std::to_string(done) + "/" + std::to_string(steps) +
+                                     (groups > 1 ? " (channel group " + std::to_string(g0 / group + 1) + "/" + std::to_string(groups) + ")" : ""));
+        }
+        stats.steps = std::max(stats.steps, done);
+        allConverged = allConverged && groupConverged;
+        for (size_t s = 0; s < these.size(); ++s) {
+            solver.totals(s, tot);
+            for (int c = 0; c < 3; ++c) {
+                if (solveOf[c] != int(g0 + s)) continue;
+                const float intensity = params.intensity[c];
+                for (size_t n = 0; n < tot.size(); ++n) out.rgb[n * 3 + size_t(c)] = tot[n] * intensity;
+            }
         }
     }
+    stats.converged = tolMode && allConverged;
     return out;
 }
 

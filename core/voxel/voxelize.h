@@ -12,6 +12,8 @@ class Progress;
 
 inline constexpr int kVoxelMinNodes = 3;      // nodes per axis: one interior node between two margin nodes
 inline constexpr int kVoxelMaxNodes = 512;
+// Bump whenever a change alters the grids voxelize returns (cache keys include it).
+inline constexpr int kVoxelizerVersion = 1;
 inline constexpr int kVoxelMaxSubcells = 16;  // sub-cells per cell edge; 16^3 = 4096 density levels
 
 // How to size the grid and refine its cells. 20 bytes.

@@ -23,6 +23,7 @@
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/grid_picture.h"
 #include "pipeline/io/npy.h"
+#include "pipeline/io/output_path.h"
 #include "pipeline/lighting_job.h"
 
 namespace fs = std::filesystem;
@@ -76,6 +77,7 @@ public:
                         if (a + 1 >= argv.size()) throw UsageError("option " + name + " needs a value (" + spec->value + ")");
                         value = argv[++a];
                     }
+                    if (value.empty()) throw UsageError("option " + name + ": empty value");
                     m_values[name] = value;
                 }
             } else {
@@ -228,21 +230,44 @@ ImportOptions importOptions(const Args& args)
     return o;
 }
 
-void writePicture(const Args& args, const DensityGrid* density, const LightingGrid* light)
-{
-    if (!args.has("--picture")) return;
+struct PictureOptions {
+    std::string path;   // empty: no picture
     int axis = 2;
+    int slices = 8;
+};
+
+// Parsed and checked before any work, so a bad picture option does not cost a solve.
+PictureOptions pictureOptions(const Args& args)
+{
+    PictureOptions o;
+    if (!args.has("--picture")) {
+        if (args.has("--axis") || args.has("--slices")) throw UsageError("--axis and --slices go with --picture");
+        return o;
+    }
+    o.path = args.get("--picture");
+    std::string ext = fs::path(o.path).extension().string();
+    for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
+    if (ext != ".png" && ext != ".tif" && ext != ".tiff" && ext != ".exr" && ext != ".jpg")
+        throw UsageError("option --picture: '" + o.path + "' needs an image extension (.png, .tif, .exr, .jpg)");
     if (args.has("--axis")) {
         const std::string a = args.get("--axis");
-        if (a == "x") axis = 0;
-        else if (a == "y") axis = 1;
-        else if (a == "z") axis = 2;
+        if (a == "x") o.axis = 0;
+        else if (a == "y") o.axis = 1;
+        else if (a == "z") o.axis = 2;
         else throw UsageError("option --axis: expected x, y or z, got '" + a + "'");
     }
-    const int slices = args.has("--slices") ? int(parseInteger("--slices", args.get("--slices"), 1, 64)) : 8;
-    writeGridMontage(args.get("--picture"), density, light, axis, slices, 256);
-    std::printf("picture: %s\n", args.get("--picture").c_str());
+    if (args.has("--slices")) o.slices = int(parseInteger("--slices", args.get("--slices"), 1, 64));
+    requireReplaceableFile(o.path);
+    return o;
 }
+
+void writePicture(const PictureOptions& o, const DensityGrid* density, const LightingGrid* light)
+{
+    if (o.path.empty()) return;
+    writeGridMontage(o.path, density, light, o.axis, o.slices, 256);
+    std::printf("picture: %s\n", o.path.c_str());
+}
+
 
 std::string dimsText(const GridGeometry& g)
 {
@@ -282,6 +307,7 @@ int cmdGrow(const Args& args)
         if (!(opt.height > 0.0f)) throw UsageError("option --height: must be > 0 metres");
     }
     const std::string out = args.get("--output", speciesName(opt.species) + ".obj");
+    requireReplaceableFile(out);
     ProgressPrinter bar("grow", args.has("--quiet"));
     GrownTree tree = growTree(opt, &bar.progress());
     writeObj(out, tree);
@@ -301,7 +327,9 @@ int cmdVoxelize(const Args& args)
     const std::string mesh = args.positional()[0];
     const std::string out = args.require("--output");
     DensityJob job{mesh, importOptions(args), voxelSettings(args)};   // usage errors before file errors
+    const PictureOptions picture = pictureOptions(args);
     requireReadable(mesh, "mesh file");
+    requireReplaceableFile(out);
     auto cache = openCache(args);
     ProgressPrinter bar("voxelize", args.has("--quiet"));
     JobLog log;
@@ -311,7 +339,7 @@ int cmdVoxelize(const Args& args)
     for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     printDensitySummary(grid);
     std::printf("wrote %s (+ %s, %s)\n", out.c_str(), woodFractionPath(out).c_str(), gridSidecarPath(out).c_str());
-    writePicture(args, &grid, nullptr);
+    writePicture(picture, &grid, nullptr);
     return kOk;
 }
 
@@ -368,9 +396,20 @@ int cmdLight(const Args& args)
     JobLog log;
     DensityGrid density;
     const VoxelizeSettings voxel = voxelSettings(args);
+    if (args.has("--density"))
+        for (const char* meshOnly : {"--grid", "--subcells", "--leaf-materials"})
+            if (args.has(meshOnly)) throw UsageError(std::string(meshOnly) + " applies to --mesh, not to --density");
+    const PictureOptions picture = pictureOptions(args);
+    requireReplaceableFile(out);
     if (args.has("--density")) {
-        requireReadable(args.get("--density"), "density grid");
-        density = readDensityGrid(args.get("--density"));
+        const std::string path = args.get("--density");
+        requireReadable(path, "density grid");
+        density = readDensityGrid(path);
+        try {
+            lb::validateDensity(density);
+        } catch (const Error& e) {
+            throw Error(path + ": " + e.what());
+        }
     } else {
         requireReadable(args.get("--mesh"), "mesh file");
         ProgressPrinter vbar("voxelize", args.has("--quiet"));
@@ -396,7 +435,7 @@ int cmdLight(const Args& args)
     std::printf("lighting grid %s: mean RGB (%.4f, %.4f, %.4f), max RGB (%.4f, %.4f, %.4f)\nwrote %s\n",
                 dimsText(light.geometry).c_str(), mean[0] / nodes, mean[1] / nodes, mean[2] / nodes, maxV[0], maxV[1], maxV[2],
                 out.c_str());
-    writePicture(args, &density, &light);
+    writePicture(picture, &density, &light);
     return kOk;
 }
 
@@ -440,8 +479,18 @@ int cmdInfo(const Args& args)
         }
         return kOk;
     }
+    const std::string ext = lowerExtension(path);
+    for (const char* notMesh : {".json", ".png", ".jpg", ".jpeg", ".tif", ".tiff", ".exr", ".txt", ".mtl"})
+        if (ext == notMesh)
+            throw Error(path + ": not a mesh, .npy grid or cache entry (sylva info reads those; a .npy.json sidecar is "
+                               "shown with its .npy)");
     ImportReport report;
-    const TriangleMesh mesh = importMesh(path, {}, &report);
+    TriangleMesh mesh;
+    try {
+        mesh = importMesh(path, {}, &report);
+    } catch (const Error& e) {
+        throw Error(std::string(e.what()) + " (sylva info reads meshes, .npy grids and cache entries)");
+    }
     std::printf("%s: mesh\n%s", path.c_str(), describeMesh(mesh).c_str());
     for (const auto& w : report.warnings) std::printf("warning: %s\n", w.c_str());
     return kOk;
@@ -481,6 +530,9 @@ int main(int argc, char** argv)
     } catch (const UsageError& e) {
         std::fprintf(stderr, "sylva %s: %s\n", cmd->name.c_str(), e.what());
         return kUsage;
+    } catch (const std::bad_alloc&) {
+        std::fprintf(stderr, "sylva %s: error: out of memory (try a smaller --grid or --fp16)\n", cmd->name.c_str());
+        return kFailure;
     } catch (const Cancelled&) {
         std::fprintf(stderr, "sylva %s: cancelled\n", cmd->name.c_str());
         return kFailure;

@@ -17,6 +17,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/base/error.h"
+#include "pipeline/io/output_path.h"
 #include "pipeline/io/image_io.h"
 
 namespace sylva {
@@ -30,6 +31,7 @@ class AtomicFile {
 public:
     explicit AtomicFile(const std::string& path) : m_path(path)
     {
+        requireReplaceableFile(path);
         static std::atomic<unsigned> counter{0};
         const fs::path target(path);
         const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();

@@ -12,6 +12,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/base/error.h"
+#include "pipeline/io/output_path.h"
 
 namespace sylva {
 
@@ -72,6 +73,7 @@ bool imageHasAlpha(const std::string& path)
 
 void writeImage(const std::string& path, const ImageRgba& image, int channels)
 {
+    requireReplaceableFile(path);
     if (image.empty()) throw Error(path + ": refusing to write an empty image");
     if (channels != 3 && channels != 4) throw Error(path + ": images are written with 3 or 4 channels");
     const std::string ext = lowerExtension(path);

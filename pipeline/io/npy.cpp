@@ -23,6 +23,7 @@
 #include <QSaveFile>
 
 #include "core/base/error.h"
+#include "pipeline/io/output_path.h"
 
 namespace sylva {
 
@@ -254,6 +255,7 @@ class AtomicFile {
 public:
     explicit AtomicFile(const std::string& path) : m_path(path), m_file(QString::fromStdString(path))
     {
+        requireReplaceableFile(path);
         const QFileInfo info(QString::fromStdString(path));
         QDir().mkpath(info.absolutePath());
         if (!m_file.open(QIODevice::WriteOnly))

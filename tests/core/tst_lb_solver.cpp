@@ -311,6 +311,18 @@ private Q_SLOTS:
         }
     }
 
+    void channelsOneAtATimeEqualAllAtOnce()
+    {
+        // The memory fallback (one channel solve per pass) computes the same numbers.
+        DensityGrid d = randomDensity({11, 9, 10}, 12, 0.3, 0.2);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.sun = {0.1f, 1.0f, 0.6f};
+        const LightingGrid all = solveLighting(d, p);
+        p.solvesPerPass = 1;
+        const LightingGrid one = solveLighting(d, p);
+        QVERIFY(std::memcmp(all.rgb.data(), one.rgb.data(), all.rgb.size() * sizeof(float)) == 0);
+    }
+
     void invalidParametersAreRefused_data()
     {
         QTest::addColumn<float>("sa");

@@ -1,5 +1,6 @@
 // The sylva command line: exit codes and messages for bad usage and bad input, and the whole path on a real tree.
 #include <QDir>
+#include <QFileInfo>
 #include <QProcess>
 #include <QTest>
 
@@ -58,6 +59,10 @@ private Q_SLOTS:
         QTest::newRow("bad preset") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "--preset", "glass", "-o", "y"} << "unknown preset 'glass'";
         QTest::newRow("voxelize without output") << QStringList{"voxelize", "mesh.obj"} << "needs --output";
         QTest::newRow("bad grid") << QStringList{"voxelize", "mesh.obj", "--grid", "2", "-o", "d.npy"} << "outside [3, 512]";
+        QTest::newRow("empty output") << QStringList{"voxelize", "mesh.obj", "-o", ""} << "empty value";
+        QTest::newRow("grid with density") << QStringList{"light", "--density", "x.npy", "--grid", "8", "--sun", "0,1,0", "-o", "y.npy"} << "applies to --mesh";
+        QTest::newRow("bad axis") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "-o", "y.npy", "--picture", "p.png", "--axis", "w"} << "expected x, y or z";
+        QTest::newRow("picture without extension") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "-o", "y.npy", "--picture", "pic"} << "image extension";
         QTest::newRow("steps and tol") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "--steps", "5", "--tol", "1e-3", "-o", "y"} << "exclude each other";
     }
     void usageErrorsExitTwo()
@@ -112,6 +117,20 @@ private Q_SLOTS:
         r = runSylva({"light", "--density", garbage, "--sun", "0,0,0", "-o", dir + "/l.npy"});
         QCOMPARE(r.code, 1);
         QVERIFY2(r.err.contains("sun"), qPrintable(r.err));
+        // A device or other non-regular file is never replaced by an output (as root, rename would do it).
+        r = runSylva({"grow", "--triangles", "1000", "-o", "/dev/null"});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains("/dev/null") && r.err.contains("not a regular file"), qPrintable(r.err));
+        QVERIFY(QFileInfo("/dev/null").exists() && !QFileInfo("/dev/null").isFile());
+        // Out-of-range density values are reported with the file's name.
+        NpyArray bad;
+        bad.shape = {4, 4, 4};
+        bad.data.assign(64, -0.5f);
+        const std::string badPath = (dir + "/negative.npy").toStdString();
+        writeNpy(badPath, bad);
+        r = runSylva({"light", "--density", QString::fromStdString(badPath), "--sun", "0,1,0", "--no-cache", "-o", dir + "/l.npy"});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains(QString::fromStdString(badPath)) && r.err.contains("outside [0, 1]"), qPrintable(r.err));
     }
 
     void growVoxelizeLightInfo()

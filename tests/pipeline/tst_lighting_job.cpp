@@ -58,7 +58,15 @@ private Q_SLOTS:
         job.voxel.longestAxisNodes = 22;
         lightingFor(densityForMesh(job, &cache, nullptr, &regrid), p, &cache, nullptr, &regrid);
         QCOMPARE(regrid.stages, (std::vector<std::string>{"import", "voxelize", "light"}));
-        // Block depth does not change the answer, so it is not part of the key.
+        // Sun vectors whose float length overflows still get distinct keys.
+        JobLog huge1, huge2;
+        p.sun = {1e20f, 0.0f, 0.0f};
+        lightingFor(densityForMesh(job, &cache, nullptr, &huge1), p, &cache, nullptr, &huge1);
+        p.sun = {0.0f, 1e20f, 0.0f};
+        lightingFor(densityForMesh(job, &cache, nullptr, &huge2), p, &cache, nullptr, &huge2);
+        QCOMPARE(huge2.stages.back(), std::string("light"));
+        p.sun = {1.0f, 1.0f, 0.0f};
+        // Block depth does not change a fixed-step answer, so it is not part of that key.
         JobLog blocked;
         p.blockSteps = 3;
         lightingFor(densityForMesh(job, &cache, nullptr, &blocked), p, &cache, nullptr, &blocked);
