@@ -508,6 +508,8 @@ void writeDensityGrid(const std::string& path, const DensityGrid& grid)
     if (g.dims.x <= 0 || g.dims.y <= 0 || g.dims.z <= 0) throw Error(path + ": refusing to write a grid with empty dims");
     checkSize(path, "density", grid.density.size(), n, g);
     if (!grid.woodFraction.empty()) checkSize(path, "wood fraction", grid.woodFraction.size(), n, g);
+    // All three targets are checked before any is written, so a bad one does not leave a mixed set.
+    for (const std::string& target : {path, woodFractionPath(path), gridSidecarPath(path)}) requireReplaceableFile(target);
     const std::vector<size_t> shape{size_t(g.dims.x), size_t(g.dims.y), size_t(g.dims.z)};
     writeNpy(path, NpyArray{shape, grid.density});
     // Always written (zeros when the grid has none) so a stale wood file never outlives its density.
@@ -541,6 +543,7 @@ void writeLightingGrid(const std::string& path, const LightingGrid& grid, const 
     const GridGeometry& g = grid.geometry;
     if (g.dims.x <= 0 || g.dims.y <= 0 || g.dims.z <= 0) throw Error(path + ": refusing to write a grid with empty dims");
     checkSize(path, "RGB", grid.rgb.size(), g.nodeCount() * 3, g);
+    for (const std::string& target : {path, gridSidecarPath(path)}) requireReplaceableFile(target);
     std::optional<QJsonObject> parameters;
     if (!extraJson.empty()) {
         QJsonParseError parseError;
