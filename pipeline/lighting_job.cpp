@@ -115,7 +115,7 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
                          JobLog* log)
 {
     lb::validate(params);
-    const CacheKey key = lightKey(density, params);
+    const CacheKey key = cache ? lightKey(density, params) : CacheKey{};   // hashing the grid costs time
     if (cache) {
         std::string why;
         if (auto hit = cache->loadLighting(key, &why)) {

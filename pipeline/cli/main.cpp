@@ -157,6 +157,7 @@ std::vector<Command> commands()
                      {"--steps", "N", "fixed step count (default 2 x the longest grid edge)"},
                      {"--tol", "T", "stop when the relative change per step falls under T"},
                      {"--fp16", "", "store the distributions in half precision (half the memory)"},
+                     {"--warm-start", "", "start from the unobstructed light field: same steady state, fewer steps"},
                      {"--backend", "auto|cpu|cuda", "compute backend (default auto)"},
                      kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
                     0, 0});
@@ -378,6 +379,7 @@ lb::LbParams lightParams(const Args& args)
         if (!(p.tolerance > 0.0)) throw UsageError("option --tol: must be > 0");
     }
     if (args.has("--fp16")) p.storage = lb::Storage::Fp16;
+    if (args.has("--warm-start")) p.warmStart = true;
     lb::validate(p);   // bad parameter values are bad input (exit 1) with a message naming the bound
     return p;
 }
@@ -441,6 +443,7 @@ int cmdLight(const Args& args)
           << (params.storage == lb::Storage::Fp16 ? "fp16" : "fp32") << "\"";
     if (params.tolerance > 0.0) extra << ",\"tolerance\":" << params.tolerance;
     else extra << ",\"steps\":" << (params.steps > 0 ? params.steps : lb::defaultSteps(density.geometry.dims));
+    extra << ",\"warm_start\":" << (params.warmStart ? "true" : "false");
     extra << "}";
     writeLightingGrid(out, light, extra.str());
     double maxV[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
