@@ -5,6 +5,7 @@
 #include <QTest>
 
 #include <cmath>
+#include <sys/stat.h>
 
 #include "core/grid/grid.h"
 #include "pipeline/io/npy.h"
@@ -117,11 +118,19 @@ private Q_SLOTS:
         r = runSylva({"light", "--density", garbage, "--sun", "0,0,0", "-o", dir + "/l.npy"});
         QCOMPARE(r.code, 1);
         QVERIFY2(r.err.contains("sun"), qPrintable(r.err));
-        // A device or other non-regular file is never replaced by an output (as root, rename would do it).
-        r = runSylva({"grow", "--triangles", "1000", "-o", "/dev/null"});
+        // A device, pipe or other non-regular file is never replaced by an output (as root, renaming over
+        // /dev/null replaced it). A FIFO of our own stands in for the device, so a regression cannot harm
+        // the machine.
+        const QString fifo = dir + "/fifo.obj";
+        QFile::remove(fifo);
+        QCOMPARE(::mkfifo(fifo.toLocal8Bit().constData(), 0600), 0);
+        r = runSylva({"grow", "--triangles", "1000", "-o", fifo});
         QCOMPARE(r.code, 1);
-        QVERIFY2(r.err.contains("/dev/null") && r.err.contains("not a regular file"), qPrintable(r.err));
-        QVERIFY(QFileInfo("/dev/null").exists() && !QFileInfo("/dev/null").isFile());
+        QVERIFY2(r.err.contains(fifo) && r.err.contains("not a regular file"), qPrintable(r.err));
+        QVERIFY(QFileInfo(fifo).exists() && !QFileInfo(fifo).isFile());
+        r = runSylva({"light", "--density", garbage, "--sun", "0,1,0", "-o", fifo});
+        QCOMPARE(r.code, 1);
+        QVERIFY(!QFileInfo(fifo).isFile());
         // Out-of-range density values are reported with the file's name.
         NpyArray bad;
         bad.shape = {4, 4, 4};
