@@ -1,7 +1,6 @@
 // Wavefront OBJ + MTL writer: lines formatted with std::to_chars into per-chunk buffers in parallel, written in order.
 #include "pipeline/grow/obj_writer.h"
 
-#include <atomic>
 #include <cctype>
 #include <cerrno>
 #include <charconv>
@@ -11,7 +10,6 @@
 #include <filesystem>
 #include <memory>
 #include <set>
-#include <unistd.h>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -29,32 +27,22 @@ namespace {
 // A file written under a temporary name in the target's folder, renamed into place by commit().
 class AtomicFile {
 public:
-    explicit AtomicFile(const std::string& path) : m_path(path)
+    explicit AtomicFile(const std::string& path) : m_out(path)
     {
-        requireReplaceableFile(path);
-        static std::atomic<unsigned> counter{0};
-        const fs::path target(path);
-        const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-        m_tmp = dir / (".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1)) + "." +
-                       target.filename().string());
-        m_file = std::fopen(m_tmp.c_str(), "wb");
-        if (!m_file) throw Error(m_path + ": cannot write (" + std::strerror(errno) + ")");
+        m_file = std::fopen(m_out.tempPath().c_str(), "wb");
+        if (!m_file) throw Error(path + ": cannot write (" + std::strerror(errno) + ")");
     }
     AtomicFile(const AtomicFile&) = delete;
     AtomicFile& operator=(const AtomicFile&) = delete;
     ~AtomicFile()
     {
         if (m_file) std::fclose(m_file);
-        if (!m_committed) {
-            std::error_code ec;
-            fs::remove(m_tmp, ec);
-        }
     }
 
     void write(const char* data, size_t size)
     {
         if (size && std::fwrite(data, 1, size, m_file) != size)
-            throw Error(m_path + ": cannot write (" + std::strerror(errno) + ")");
+            throw Error(m_out.target() + ": cannot write (" + std::strerror(errno) + ")");
     }
     void write(const std::string& text) { write(text.data(), text.size()); }
 
@@ -62,29 +50,14 @@ public:
     {
         const int closed = std::fclose(m_file);
         m_file = nullptr;
-        if (closed != 0) throw Error(m_path + ": cannot write (" + std::strerror(errno) + ")");
-        std::error_code ec;
-        fs::rename(m_tmp, m_path, ec);
-        if (ec) throw Error(m_path + ": cannot move the written file into place (" + ec.message() + ")");
-        m_committed = true;
+        if (closed != 0) throw Error(m_out.target() + ": cannot write (" + std::strerror(errno) + ")");
+        m_out.commit();
     }
 
 private:
-    std::string m_path;
-    fs::path m_tmp;
+    ReplacingFile m_out;
     FILE* m_file = nullptr;
-    bool m_committed = false;
 };
-
-void ensureFolder(const std::string& path)
-{
-    const fs::path parent = fs::path(path).parent_path();
-    if (parent.empty()) return;
-    std::error_code ec;
-    fs::create_directories(parent, ec);
-    if (!fs::is_directory(parent))
-        throw Error(path + ": cannot create the folder " + parent.string() + (ec ? " (" + ec.message() + ")" : ""));
-}
 
 char* putFloat(char* p, float v) { return std::to_chars(p, p + 24, v).ptr; }
 char* putIndex(char* p, uint32_t i) { return std::to_chars(p, p + 16, uint64_t(i) + 1).ptr; }
@@ -202,7 +175,6 @@ void writeObjWithMaterials(const std::string& objPath, const TriangleMesh& mesh,
 {
     if (objPath.empty()) throw Error("OBJ output: empty file name");
     checkMesh(objPath, mesh, materials);
-    ensureFolder(objPath);
     const fs::path obj(objPath);
     const fs::path objDir = obj.parent_path().empty() ? fs::path(".") : obj.parent_path();
     const std::string stem = obj.stem().string();
@@ -303,7 +275,6 @@ void writeObj(const std::string& objPath, const TriangleMesh& mesh)
 void writeObj(const std::string& objPath, const GrownTree& tree)
 {
     if (objPath.empty()) throw Error("OBJ output: empty file name");
-    ensureFolder(objPath);
     const fs::path obj(objPath);
     const fs::path dir = obj.parent_path().empty() ? fs::path(".") : obj.parent_path();
     const std::string stem = obj.stem().string();

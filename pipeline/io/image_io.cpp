@@ -5,7 +5,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -73,19 +72,13 @@ bool imageHasAlpha(const std::string& path)
 
 void writeImage(const std::string& path, const ImageRgba& image, int channels)
 {
-    requireReplaceableFile(path);
     if (image.empty()) throw Error(path + ": refusing to write an empty image");
     if (channels != 3 && channels != 4) throw Error(path + ": images are written with 3 or 4 channels");
     const std::string ext = lowerExtension(path);
     const bool isFloat = ext == ".exr" || ext == ".hdr";
-    fs::path target(path);
-    fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    // Keep the extension on the temporary name so OIIO picks the same format.
-    fs::path tmp = dir / (".tmp." + std::to_string(::getpid()) + "." + target.filename().string());
-
-    auto out = OIIO::ImageOutput::create(tmp.string());
+    // The temporary name keeps the extension, so OIIO picks the same format.
+    ReplacingFile file(path);
+    auto out = OIIO::ImageOutput::create(file.tempPath());
     if (!out) throw Error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
     OIIO::ImageSpec spec(image.width, image.height, channels, isFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
     if (channels == 4) {
@@ -98,16 +91,9 @@ void writeImage(const std::string& path, const ImageRgba& image, int channels)
             float v = image.pixels[p * 4 + size_t(c)];
             data[p * size_t(channels) + size_t(c)] = isFloat ? v : std::clamp(v, 0.0f, 1.0f);
         }
-    if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data.data()) || !out->close()) {
-        std::string why = out->geterror();
-        fs::remove(tmp, ec);
-        throw Error(path + ": cannot write image (" + why + ")");
-    }
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        fs::remove(tmp, ec);
-        throw Error(path + ": cannot move the written image into place (" + ec.message() + ")");
-    }
+    if (!out->open(file.tempPath(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data.data()) || !out->close())
+        throw Error(path + ": cannot write image (" + out->geterror() + ")");
+    file.commit();
 }
 
 } // namespace sylva

@@ -26,3 +26,42 @@ void requireReplaceableFile(const std::string& path)
 }
 
 } // namespace sylva
+
+#include <atomic>
+#include <unistd.h>
+
+namespace sylva {
+
+ReplacingFile::ReplacingFile(std::string target) : m_target(std::move(target))
+{
+    namespace fs = std::filesystem;
+    requireReplaceableFile(m_target);
+    static std::atomic<unsigned> counter{0};
+    const fs::path path(m_target);
+    const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (!fs::is_directory(dir))
+        throw Error(m_target + ": cannot create the folder " + dir.string() + (ec ? " (" + ec.message() + ")" : ""));
+    m_temp = (dir / (".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1)) + "." +
+                     path.filename().string()))
+                 .string();
+}
+
+ReplacingFile::~ReplacingFile()
+{
+    if (!m_committed) {
+        std::error_code ec;
+        std::filesystem::remove(m_temp, ec);
+    }
+}
+
+void ReplacingFile::commit()
+{
+    std::error_code ec;
+    std::filesystem::rename(m_temp, m_target, ec);
+    if (ec) throw Error(m_target + ": cannot move the written file into place (" + ec.message() + ")");
+    m_committed = true;
+}
+
+} // namespace sylva
