@@ -59,6 +59,17 @@ private:
     FILE* m_file = nullptr;
 };
 
+// Creates the OBJ's folder first, so a bad folder is reported against the OBJ, not a texture.
+void ensureFolder(const std::string& path)
+{
+    const fs::path parent = fs::path(path).parent_path();
+    if (parent.empty()) return;
+    std::error_code ec;
+    fs::create_directories(parent, ec);
+    if (!fs::is_directory(parent))
+        throw Error(path + ": cannot create the folder " + parent.string() + (ec ? " (" + ec.message() + ")" : ""));
+}
+
 char* putFloat(char* p, float v) { return std::to_chars(p, p + 24, v).ptr; }
 char* putIndex(char* p, uint32_t i) { return std::to_chars(p, p + 16, uint64_t(i) + 1).ptr; }
 
@@ -175,6 +186,7 @@ void writeObjWithMaterials(const std::string& objPath, const TriangleMesh& mesh,
 {
     if (objPath.empty()) throw Error("OBJ output: empty file name");
     checkMesh(objPath, mesh, materials);
+    ensureFolder(objPath);
     const fs::path obj(objPath);
     const fs::path objDir = obj.parent_path().empty() ? fs::path(".") : obj.parent_path();
     const std::string stem = obj.stem().string();
@@ -275,6 +287,7 @@ void writeObj(const std::string& objPath, const TriangleMesh& mesh)
 void writeObj(const std::string& objPath, const GrownTree& tree)
 {
     if (objPath.empty()) throw Error("OBJ output: empty file name");
+    ensureFolder(objPath);
     const fs::path obj(objPath);
     const fs::path dir = obj.parent_path().empty() ? fs::path(".") : obj.parent_path();
     const std::string stem = obj.stem().string();
