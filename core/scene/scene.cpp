@@ -1,0 +1,45 @@
+// Names of render modes and acceleration structures; sun direction from angles.
+#include "core/scene/scene.h"
+
+#include <cmath>
+
+namespace sylva {
+
+const char* renderModeName(RenderMode mode)
+{
+    switch (mode) {
+    case RenderMode::Full: return "full";
+    case RenderMode::Local: return "local";
+    case RenderMode::Ambient: return "ambient";
+    case RenderMode::Lb: return "lb";
+    }
+    return "full";
+}
+
+bool parseRenderMode(const std::string& name, RenderMode* out)
+{
+    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
+        if (name == renderModeName(m)) {
+            *out = m;
+            return true;
+        }
+    return false;
+}
+
+const char* accelName(AccelKind kind) { return kind == AccelKind::KdTree ? "kdtree" : "bvh"; }
+
+bool parseAccel(const std::string& name, AccelKind* out)
+{
+    if (name == "bvh") *out = AccelKind::Bvh;
+    else if (name == "kdtree") *out = AccelKind::KdTree;
+    else return false;
+    return true;
+}
+
+glm::vec3 sunDirection(double elevationDeg, double azimuthDeg)
+{
+    const double el = elevationDeg * M_PI / 180.0, az = azimuthDeg * M_PI / 180.0;
+    return glm::vec3(float(std::cos(el) * std::sin(az)), float(std::sin(el)), float(std::cos(el) * std::cos(az)));
+}
+
+} // namespace sylva

@@ -1,0 +1,98 @@
+// A forest scene as the user describes it: species, instances, ground, sun, sky, camera, render settings.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/lb/lb_params.h"
+
+namespace sylva {
+
+// How a species' mesh is produced: a file (any format the importer reads) or the procedural grower.
+struct GrowSpec {
+    std::string species = "broadleaf";   // grower species name (broadleaf, birch, conifer, shrub)
+    uint64_t seed = 1;
+    uint64_t triangles = 100000;         // target triangle count
+    float height = 0.0f;                 // metres; 0 = the grower's default for the species
+};
+
+// One plant model shared by all its instances. Its lighting grid is solved once, in its own frame.
+struct SpeciesDesc {
+    std::string name;                    // unique within the scene; instances refer to it
+    std::string meshPath;                // absolute path (resolved against the scene file); empty when grown
+    std::optional<GrowSpec> grow;        // set when the mesh is grown instead of read
+    std::vector<std::string> leafMaterials;   // importer override: material names that are leaves
+    std::string preset = "leaf";         // LB preset the lighting starts from
+    lb::LbParams lighting;               // preset + overrides (sun is set from the scene's sun at solve time)
+    int grid = 64;                       // LB grid nodes along the longest edge
+};
+
+// One placed plant. World metres; rotation in degrees applied X, then Y, then Z (R = Rz * Ry * Rx),
+// then uniform scale, then translation. 64 bytes.
+struct InstanceDesc {
+    uint32_t species = 0;                // index into Scene::species
+    glm::dvec3 position{0.0};            // world metres of the mesh origin (doubles: terrains are km wide)
+    glm::vec3 rotationDeg{0.0f};
+    float scale = 1.0f;                  // uniform, > 0
+};
+
+struct GroundDesc {
+    bool enabled = true;
+    double height = 0.0;                 // world y of the plane, metres
+    glm::vec3 color{0.18f, 0.15f, 0.10f};   // linear RGB albedo
+};
+
+// Sun: direction toward the sun (world, +Y up), blackbody colour temperature, intensity (scales radiance).
+struct SunDesc {
+    glm::vec3 direction{0.4f, 0.8f, 0.3f};
+    double temperature = 6500.0;         // kelvin
+    float intensity = 1.0f;
+};
+
+// Pinhole camera. fovY in degrees (vertical field of view).
+struct CameraDesc {
+    glm::dvec3 position{0.0, 1.7, -10.0};
+    glm::dvec3 target{0.0, 1.7, 0.0};
+    glm::vec3 up{0.0f, 1.0f, 0.0f};
+    float fovY = 45.0f;
+};
+
+enum class RenderMode { Full, Local, Ambient, Lb };
+enum class AccelKind { Bvh, KdTree };
+
+struct RenderSettings {
+    int width = 896;
+    int height = 448;
+    int spp = 1;                         // samples per pixel (stratified; box-filtered to the pixel)
+    RenderMode mode = RenderMode::Full;
+    AccelKind accel = AccelKind::Bvh;
+    bool shadows = true;
+    float indirectScale = 1.0f;          // weight of the LB indirect light (1 = as solved, normalized to open sky)
+    float exposureKey = 0.18f;           // Reinhard key value a
+};
+
+struct Scene {
+    int version = 1;
+    std::vector<SpeciesDesc> species;
+    std::vector<InstanceDesc> instances;
+    GroundDesc ground;
+    SunDesc sun;
+    glm::vec3 sky{0.55f, 0.70f, 0.95f};  // linear RGB radiance of the background
+    CameraDesc camera;
+    RenderSettings render;
+};
+
+const char* renderModeName(RenderMode mode);      // "full", "local", "ambient", "lb"
+bool parseRenderMode(const std::string& name, RenderMode* out);
+const char* accelName(AccelKind kind);            // "bvh", "kdtree"
+bool parseAccel(const std::string& name, AccelKind* out);
+
+// Direction toward the sun from elevation (degrees above the horizon) and azimuth (degrees, 0 = +Z,
+// 90 = +X), +Y up.
+glm::vec3 sunDirection(double elevationDeg, double azimuthDeg);
+
+} // namespace sylva
