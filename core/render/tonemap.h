@@ -1,0 +1,67 @@
+// Tone mapping: Rec. 709 luminance, the sRGB transfer function and global Reinhard, per pixel for every backend.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+
+#include <glm/glm.hpp>
+
+#include "core/base/defines.h"
+
+namespace sylva {
+
+// Rec. 709 / sRGB relative luminance of a linear RGB colour.
+SYLVA_HD inline float luminance(glm::vec3 linearRgb)
+{
+    return 0.2126f * linearRgb.x + 0.7152f * linearRgb.y + 0.0722f * linearRgb.z;
+}
+
+// sRGB OETF (IEC 61966-2-1), exact piecewise form. Input clamped to [0,1] (NaN -> 0); output in [0,1].
+SYLVA_HD inline float srgbEncode(float linear)
+{
+    const float v = fminf(fmaxf(linear, 0.0f), 1.0f);
+    const float e = v <= 0.0031308f ? 12.92f * v : 1.055f * powf(v, 1.0f / 2.4f) - 0.055f;
+    return fminf(fmaxf(e, 0.0f), 1.0f);
+}
+
+// Inverse of srgbEncode. Input clamped to [0,1] (NaN -> 0); output in [0,1].
+SYLVA_HD inline float srgbDecode(float encoded)
+{
+    const float e = fminf(fmaxf(encoded, 0.0f), 1.0f);
+    const float v = e <= 0.04045f ? e / 12.92f : powf((e + 0.055f) / 1.055f, 2.4f);
+    return fminf(fmaxf(v, 0.0f), 1.0f);
+}
+
+// Global Reinhard on luminance (Reinhard et al. 2002, eq. 3): L = luminance(rgb) * scale, Ld = L / (1 + L),
+// colour scaled by Ld / luminance(rgb) so hue and saturation are kept. The output luminance is in [0, 1);
+// a single saturated channel may still exceed 1 (srgbEncode clamps it). Black or negative-luminance
+// pixels give 0, never NaN. scale is the exposure, key / log-average luminance, and must be >= 0.
+SYLVA_HD inline glm::vec3 reinhard(glm::vec3 rgb, float scale)
+{
+    const float lin = luminance(rgb);
+    if (!(lin > 0.0f)) return glm::vec3(0.0f);
+    const float l = lin * scale;
+    const float ld = l / (1.0f + l);
+    return rgb * (ld / lin);
+}
+
+// Exposure setting of toneMapToSrgb: the key is the grey the log-average luminance is mapped to
+// before the Reinhard curve (0.18 = "middle grey", Reinhard et al. 2002). 4 bytes.
+struct ToneMapParams {
+    float key = 0.18f;
+};
+
+// Log-average ("geometric mean") luminance of an image, exp(mean(log(delta + L))) with delta = 1e-4 and
+// L = max(luminance, 0). rgb points at pixelCount pixels, the first 3 floats of each being linear RGB;
+// consecutive pixels are strideFloats floats apart (3 for RGB, 4 for RGBA). Pixels with a non-finite
+// luminance are left out; returns 0 when no pixel is left. Deterministic (fixed reduction order), parallel.
+// Throws sylva::Error when strideFloats < 3 or rgb is null while pixelCount > 0.
+float logAverageLuminance(const float* rgb, size_t pixelCount, size_t strideFloats);
+
+// Tone maps `pixels` linear RGB pixels (3 floats each) into outRgb01 (3 floats each, sRGB-encoded, in [0,1]):
+// scale = key / logAverageLuminance(image), reinhard(rgb, scale), srgbEncode per channel. Parallel over
+// pixels; in and out may be the same buffer. Throws sylva::Error when key is not finite and > 0, or a
+// buffer is null while pixels > 0.
+void toneMapToSrgb(const float* linearRgb, size_t pixels, float* outRgb01, ToneMapParams params = {});
+
+} // namespace sylva

@@ -1,0 +1,223 @@
+// Tone mapping: luminance, the sRGB transfer function, global Reinhard and the log-average exposure.
+#include <QTest>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "core/base/error.h"
+#include "core/render/tonemap.h"
+
+using namespace sylva;
+
+namespace {
+
+// The sRGB OETF written out in double from IEC 61966-2-1.
+double srgbReference(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055; }
+
+// HDR-like RGB image: luminances log-normally spread over several decades (clipped to [0.05, 100]),
+// with every 97th pixel black when withBlack is set.
+std::vector<float> randomImage(size_t pixels, unsigned seed, bool withBlack)
+{
+    std::mt19937 rng(seed);
+    std::lognormal_distribution<float> radiance(0.0f, 1.5f);
+    std::uniform_real_distribution<float> tint(0.5f, 1.0f);
+    std::vector<float> img(pixels * 3);
+    for (size_t p = 0; p < pixels; ++p) {
+        const float l = std::clamp(radiance(rng), 0.05f, 100.0f);
+        for (int c = 0; c < 3; ++c) img[p * 3 + size_t(c)] = withBlack && p % 97 == 0 ? 0.0f : l * tint(rng);
+    }
+    return img;
+}
+
+} // namespace
+
+class TestToneMap : public QObject {
+    Q_OBJECT
+private Q_SLOTS:
+    void luminanceWeights()
+    {
+        QCOMPARE(luminance(glm::vec3(1.0f)), 1.0f);
+        QCOMPARE(luminance(glm::vec3(1.0f, 0.0f, 0.0f)), 0.2126f);
+        QCOMPARE(luminance(glm::vec3(0.0f, 1.0f, 0.0f)), 0.7152f);
+        QCOMPARE(luminance(glm::vec3(0.0f, 0.0f, 1.0f)), 0.0722f);
+    }
+
+    void srgbBreakpointsAndReference()
+    {
+        // The linear segment meets the power segment at linear 0.0031308 = encoded 0.04045.
+        QVERIFY(std::fabs(srgbEncode(0.0031308f) - 0.04045f) < 1e-5f);
+        QVERIFY(std::fabs(srgbDecode(0.04045f) - 0.0031308f) < 1e-6f);
+        QCOMPARE(srgbEncode(0.0f), 0.0f);
+        QCOMPARE(srgbEncode(1.0f), 1.0f);
+        QCOMPARE(srgbDecode(0.0f), 0.0f);
+        QCOMPARE(srgbDecode(1.0f), 1.0f);
+        QVERIFY(std::fabs(srgbEncode(0.18f) - 0.46135f) < 1e-4f);   // middle grey encodes to ~118/255
+        for (int i = 0; i <= 1000; ++i) {
+            const double v = i / 1000.0;
+            QVERIFY2(std::fabs(srgbEncode(float(v)) - srgbReference(v)) < 2e-6, qPrintable(QString::number(v)));
+        }
+    }
+
+    void srgbClamps()
+    {
+        QCOMPARE(srgbEncode(-1.0f), 0.0f);
+        QCOMPARE(srgbEncode(7.0f), 1.0f);
+        QCOMPARE(srgbEncode(std::numeric_limits<float>::infinity()), 1.0f);
+        QCOMPARE(srgbEncode(std::numeric_limits<float>::quiet_NaN()), 0.0f);
+        QCOMPARE(srgbDecode(-0.5f), 0.0f);
+        QCOMPARE(srgbDecode(2.0f), 1.0f);
+    }
+
+    void srgbRoundTrip()
+    {
+        for (int i = 0; i <= 4096; ++i) {
+            const float v = float(i) / 4096.0f;
+            QVERIFY2(std::fabs(srgbDecode(srgbEncode(v)) - v) < 2e-6f, qPrintable(QString::number(v)));
+            QVERIFY2(std::fabs(srgbEncode(srgbDecode(v)) - v) < 2e-6f, qPrintable(QString::number(v)));
+        }
+        // All 256 8-bit codes survive decode -> encode -> quantize.
+        for (int code = 0; code < 256; ++code)
+            QCOMPARE(int(std::lround(srgbEncode(srgbDecode(code / 255.0f)) * 255.0f)), code);
+    }
+
+    void reinhardBlackIsZero()
+    {
+        QCOMPARE(reinhard(glm::vec3(0.0f), 1.0f), glm::vec3(0.0f));
+        QCOMPARE(reinhard(glm::vec3(0.0f), 1e6f), glm::vec3(0.0f));
+        QCOMPARE(reinhard(glm::vec3(-1.0f, 0.0f, 0.0f), 1.0f), glm::vec3(0.0f));   // negative luminance
+        QCOMPARE(reinhard(glm::vec3(1.0f), 0.0f), glm::vec3(0.0f));
+    }
+
+    void reinhardMonotonicAndBelowOne()
+    {
+        const glm::vec3 tint(0.9f, 0.6f, 0.3f);
+        float previous = -1.0f;
+        for (double l = 1e-6; l < 1e5; l *= 1.1) {
+            const glm::vec3 out = reinhard(tint * float(l), 0.5f);
+            const float y = luminance(out);
+            QVERIFY2(y > previous, qPrintable(QString::number(l)));
+            QVERIFY2(y < 1.0f, qPrintable(QString("L = %1 -> %2").arg(l).arg(y)));
+            previous = y;
+        }
+        // Far beyond float resolution of 1 - Ld the curve saturates at 1 without overshoot or NaN.
+        for (float l : {1e8f, 1e20f, 1e37f}) {
+            const float y = luminance(reinhard(tint * l, 0.5f));
+            QVERIFY(std::isfinite(y) && y > 0.999f && y <= 1.0f + 1e-6f);
+        }
+        // Grey input: every channel follows L / (1 + L).
+        for (float g : {0.01f, 0.18f, 1.0f, 5.0f, 100.0f}) {
+            const glm::vec3 out = reinhard(glm::vec3(g), 1.0f);
+            for (int c = 0; c < 3; ++c) QVERIFY(std::fabs(out[c] - g / (1.0f + g)) < 1e-6f);
+        }
+    }
+
+    void reinhardKeepsChromaticity()
+    {
+        const glm::vec3 in(2.0f, 1.0f, 0.5f);
+        const glm::vec3 out = reinhard(in, 3.0f);
+        QVERIFY(std::fabs(out.x / out.y - 2.0f) < 1e-5f && std::fabs(out.z / out.y - 0.5f) < 1e-5f);
+        const float l = luminance(in) * 3.0f;
+        QVERIFY(std::fabs(luminance(out) - l / (1.0f + l)) < 1e-6f);
+    }
+
+    void logAverageOfConstantImage()
+    {
+        for (float c : {0.0f, 0.01f, 0.18f, 1.0f, 250.0f}) {
+            const std::vector<float> img(100000 * 3, c);
+            const float avg = logAverageLuminance(img.data(), 100000, 3);
+            // exp(log(delta + c)) = c + delta.
+            QVERIFY2(std::fabs(avg - (c + 1e-4f)) <= 1e-5f * (c + 1e-4f) + 1e-7f, qPrintable(QString("%1 -> %2").arg(c).arg(avg)));
+        }
+    }
+
+    void logAverageIsGeometricMeanAndHonoursStride()
+    {
+        // Half the pixels at 0.01, half at 1 (RGBA, stride 4, alpha ignored): exp of the mean log.
+        std::vector<float> img;
+        for (int i = 0; i < 1000; ++i) {
+            const float v = i % 2 ? 1.0f : 0.01f;
+            img.insert(img.end(), {v, v, v, 123.0f});
+        }
+        const double expected = std::sqrt((0.01 + 1e-4) * (1.0 + 1e-4));
+        QVERIFY(std::fabs(logAverageLuminance(img.data(), 1000, 4) - expected) < 1e-5 * expected);
+        // Non-finite pixels are left out; nothing left -> 0; an empty image -> 0.
+        img[0] = std::numeric_limits<float>::infinity();
+        img[4] = std::numeric_limits<float>::quiet_NaN();
+        QVERIFY(std::fabs(logAverageLuminance(img.data(), 2, 4)) == 0.0f);
+        QCOMPARE(logAverageLuminance(nullptr, 0, 3), 0.0f);
+        QVERIFY_THROWS_EXCEPTION(Error, logAverageLuminance(img.data(), 10, 2));
+    }
+
+    void logAverageIsDeterministic()
+    {
+        const std::vector<float> img = randomImage(300000, 3, true);
+        const float a = logAverageLuminance(img.data(), 300000, 3);
+        for (int i = 0; i < 5; ++i) QCOMPARE(logAverageLuminance(img.data(), 300000, 3), a);
+    }
+
+    void constantGreyMapsToReinhardOfKey()
+    {
+        // logAverage = L + delta, so scale * L = key * L / (L + delta) and the output is its Reinhard value.
+        for (float grey : {0.05f, 1.0f, 40.0f}) {
+            for (float key : {0.18f, 0.5f}) {
+                const size_t n = 4096;
+                const std::vector<float> img(n * 3, grey);
+                std::vector<float> out(n * 3, -1.0f);
+                toneMapToSrgb(img.data(), n, out.data(), ToneMapParams{key});
+                const double l = double(key) * grey / (grey + 1e-4);
+                const double expected = srgbReference(l / (1.0 + l));
+                for (size_t i = 0; i < n * 3; ++i)
+                    QVERIFY2(std::fabs(out[i] - expected) < 1e-5, qPrintable(QString("grey %1 key %2: %3 vs %4").arg(grey).arg(key).arg(out[i]).arg(expected)));
+            }
+        }
+    }
+
+    void exposureInvariance()
+    {
+        // Scaling the radiance by k scales the log-average by k too, so the result barely moves. This holds
+        // while the pixels stay well above delta = 1e-4 (here kL >= 2.5e-3); black pixels would break it,
+        // since log(delta + 0) does not shift with k (1% black pixels move the exposure by k^0.01).
+        const size_t n = 50000;
+        const std::vector<float> img = randomImage(n, 11, false);
+        std::vector<float> ref(n * 3);
+        toneMapToSrgb(img.data(), n, ref.data(), {});
+        for (float k : {0.1f, 3.0f, 1000.0f}) {
+            std::vector<float> scaled(img);
+            for (float& v : scaled) v *= k;
+            std::vector<float> out(n * 3);
+            toneMapToSrgb(scaled.data(), n, out.data(), {});
+            float worst = 0.0f;
+            for (size_t i = 0; i < n * 3; ++i) worst = std::max(worst, std::fabs(out[i] - ref[i]));
+            QVERIFY2(worst < 2e-3f, qPrintable(QString("k = %1: max difference %2").arg(k).arg(worst)));
+        }
+    }
+
+    void outputInUnitRangeAndInPlace()
+    {
+        const size_t n = 70000;
+        std::vector<float> img = randomImage(n, 5, true);
+        img[3] = 1e30f;   // a very bright (firefly) pixel
+        img[4] = std::numeric_limits<float>::quiet_NaN();
+        std::vector<float> out(n * 3);
+        toneMapToSrgb(img.data(), n, out.data(), {});
+        for (float v : out) QVERIFY(v >= 0.0f && v <= 1.0f);
+        toneMapToSrgb(img.data(), n, img.data(), {});   // in place gives the same result
+        QVERIFY(img == out);
+    }
+
+    void badParamsThrow()
+    {
+        std::vector<float> img(30, 0.5f), out(30);
+        QVERIFY_THROWS_EXCEPTION(Error, toneMapToSrgb(img.data(), 10, out.data(), ToneMapParams{0.0f}));
+        QVERIFY_THROWS_EXCEPTION(Error, toneMapToSrgb(img.data(), 10, out.data(), ToneMapParams{-0.18f}));
+        QVERIFY_THROWS_EXCEPTION(Error, toneMapToSrgb(img.data(), 10, out.data(), ToneMapParams{std::numeric_limits<float>::quiet_NaN()}));
+        QVERIFY_THROWS_EXCEPTION(Error, toneMapToSrgb(nullptr, 10, out.data(), {}));
+        toneMapToSrgb(nullptr, 0, nullptr, {});   // empty image: nothing to do
+    }
+};
+
+QTEST_APPLESS_MAIN(TestToneMap)
+#include "tst_tonemap.moc"
