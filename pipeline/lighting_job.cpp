@@ -85,7 +85,16 @@ DensityGrid densityForMesh(const DensityJob& job, GridCache* cache, Progress* pr
         for (const auto& w : report.warnings)
             log->warnings.push_back(w.find(job.meshPath) == std::string::npos ? job.meshPath + ": " + w : w);
     }
-    const CacheKey key = meshKey(mesh, job.voxel);
+    SubProgress rest(progress, 0.1, 1.0);
+    Progress sub([&](double f, const std::string& msg) { rest.report(f, msg); });
+    if (progress && progress->isCancelled()) sub.cancel();
+    return densityForTriangles(mesh, job.voxel, cache, progress ? &sub : nullptr, log);
+}
+
+DensityGrid densityForTriangles(const TriangleMesh& mesh, const VoxelizeSettings& voxel, GridCache* cache,
+                                Progress* progress, JobLog* log)
+{
+    const CacheKey key = meshKey(mesh, voxel);
     if (cache) {
         std::string why;
         if (auto hit = cache->loadDensity(key, &why)) {
@@ -95,11 +104,7 @@ DensityGrid densityForMesh(const DensityJob& job, GridCache* cache, Progress* pr
         }
         if (log && why.find("no cache entry") == std::string::npos) log->warnings.push_back(why);
     }
-    Progress sub([&](double f, const std::string& msg) {
-        if (progress) progress->report(0.1 + 0.9 * f, msg);
-    });
-    if (progress && progress->isCancelled()) sub.cancel();
-    DensityGrid grid = voxelize(mesh, job.voxel, progress ? &sub : nullptr);
+    DensityGrid grid = voxelize(mesh, voxel, progress);
     if (log) log->stages.push_back("voxelize");
     if (cache) {
         try {

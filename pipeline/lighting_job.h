@@ -31,6 +31,10 @@ struct DensityJob {
 // voxelizer settings, cache format). cache may be null (no caching).
 DensityGrid densityForMesh(const DensityJob& job, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr);
 
+// As densityForMesh for a mesh already in memory (grown species): voxelizes or loads from the cache.
+DensityGrid densityForTriangles(const TriangleMesh& mesh, const VoxelizeSettings& voxel, GridCache* cache,
+                                Progress* progress = nullptr, JobLog* log = nullptr);
+
 // Hash of a density grid's content and placement, for lighting cache keys.
 std::string densityHash(const DensityGrid& density);
 

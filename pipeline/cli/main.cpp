@@ -25,6 +25,8 @@
 #include "pipeline/io/npy.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/lighting_job.h"
+#include "pipeline/render/render_job.h"
+#include "pipeline/scene/scene_file.h"
 
 namespace fs = std::filesystem;
 using namespace sylva;
@@ -161,6 +163,18 @@ std::vector<Command> commands()
                      {"--backend", "auto|cpu|cuda", "compute backend (default auto)"},
                      kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
                     0, 0});
+    list.push_back({"render", "[SCENE.sylva.json] [-o OUT.png|.exr|.tif]",
+                    "render a scene (the bundled default forest when none is given)",
+                    {{"--width", "W", "image width in pixels (default: the scene's)"},
+                     {"--height", "H", "image height in pixels (default: the scene's)"},
+                     {"--spp", "N", "samples per pixel, 1..4096 (default: the scene's)"},
+                     {"--mode", "M", "full (LB indirect + sun), local (sun only), ambient (sun + matched constant), lb"},
+                     {"--accel", "bvh|kdtree", "acceleration structure (default: the scene's, bvh)"},
+                     {"--no-shadows", "", "no shadow rays"},
+                     {"--backend", "auto|cpu|cuda", "compute backend (default auto)"},
+                     {"--stats", "", "print timings and acceleration structure sizes"},
+                     kOutput, kCache, kNoCache, kThreads, kQuiet},
+                    0, 1});
     list.push_back({"info", "FILE", "print what a mesh, grid (.npy) or cache file holds", {}, 1, 1});
     return list;
 }
@@ -467,6 +481,65 @@ std::string lowerExtension(const std::string& path)
     return ext;
 }
 
+int cmdRender(const Args& args)
+{
+    auto threads = threadLimit(args);
+    const std::string backend = args.get("--backend", "auto");
+    if (backend != "auto" && backend != "cpu" && backend != "cuda")
+        throw UsageError("option --backend: expected auto, cpu or cuda, got '" + backend + "'");
+    Scene scene;
+    std::string stem = "default_forest";
+    if (args.positional().empty()) {
+        scene = defaultScene();
+    } else {
+        const std::string path = args.positional()[0];
+        requireReadable(path, "scene file");
+        scene = readSceneFile(path);
+        stem = fs::path(path).stem().string();
+        if (stem.size() > 6 && stem.substr(stem.size() - 6) == ".sylva") stem.resize(stem.size() - 6);
+    }
+    RenderSettings& r = scene.render;
+    if (args.has("--width")) r.width = int(parseInteger("--width", args.get("--width"), 1, 32768));
+    if (args.has("--height")) r.height = int(parseInteger("--height", args.get("--height"), 1, 32768));
+    if (args.has("--spp")) r.spp = int(parseInteger("--spp", args.get("--spp"), 1, 4096));
+    if (args.has("--mode") && !parseRenderMode(args.get("--mode"), &r.mode))
+        throw UsageError("option --mode: expected full, local, ambient or lb, got '" + args.get("--mode") + "'");
+    if (args.has("--accel") && !parseAccel(args.get("--accel"), &r.accel))
+        throw UsageError("option --accel: expected bvh or kdtree, got '" + args.get("--accel") + "'");
+    if (args.has("--no-shadows")) r.shadows = false;
+    const std::string out = args.get("--output", stem + ".png");
+    const std::string ext = lowerExtension(out);
+    if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff")
+        throw UsageError("output " + out + ": unknown image extension (use .png, .exr, .tif or .tiff)");
+    requireReplaceableFile(out);
+    if (backend == "cuda") std::fprintf(stderr, "note: the CUDA renderer is not in this build yet; rendering on the CPU\n");
+    auto cache = openCache(args);
+    JobLog log;
+    ProgressPrinter bar("render", args.has("--quiet"));
+    const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log);
+    bar.finish();
+    for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    float ambient = 0.0f;
+    const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, scene.sky, &ambient);
+    writeRender(out, linear, r.width, r.height, r.exposureKey);
+    const AccelStats& st = result.stats;
+    std::printf("rendered %dx%d, %d spp, mode %s, %zu instances of %zu species (%.0f instanced triangles)\nwrote %s\n",
+                r.width, r.height, r.spp, renderModeName(r.mode), st.instances, scene.species.size(), st.instancedTriangles,
+                out.c_str());
+    if (args.has("--stats")) {
+        std::printf("time: assets %.3f s, build %.3f s, trace %.3f s\n", result.timings.assets, result.timings.build,
+                    result.timings.trace);
+        const double accelBytes = double(st.tlasBytes + st.instanceBytes + st.blasBytes + st.triangleBytes);
+        std::printf("acceleration structures: %.1f MB (tlas %zu B, instances %zu B, blas %zu B, triangles %zu B); "
+                    "%.4f B per instanced triangle, %.1f B per instance; depth tlas %d, blas %d\n",
+                    accelBytes / 1e6, st.tlasBytes, st.instanceBytes, st.blasBytes, st.triangleBytes,
+                    accelBytes / std::max(1.0, st.instancedTriangles), double(st.tlasBytes + st.instanceBytes) / double(std::max<size_t>(1, st.instances)),
+                    st.tlasDepth, st.maxBlasDepth);
+        if (r.mode == RenderMode::Ambient) std::printf("ambient constant %.4f\n", ambient);
+    }
+    return kOk;
+}
+
 int cmdInfo(const Args& args)
 {
     const std::string path = args.positional()[0];
@@ -547,6 +620,7 @@ int main(int argc, char** argv)
         if (cmd->name == "grow") return cmdGrow(args);
         if (cmd->name == "voxelize") return cmdVoxelize(args);
         if (cmd->name == "light") return cmdLight(args);
+        if (cmd->name == "render") return cmdRender(args);
         if (cmd->name == "info") return cmdInfo(args);
     } catch (const UsageError& e) {
         std::fprintf(stderr, "sylva %s: %s\n", cmd->name.c_str(), e.what());

@@ -1,0 +1,215 @@
+// Binned-SAH BVH build: a temporary tree built with oneTBB tasks, flattened depth-first into 64-byte nodes.
+#include "core/accel/bvh.h"
+
+#include <algorithm>
+#include <memory>
+#include <numeric>
+
+#include <tbb/parallel_invoke.h>
+
+namespace sylva {
+namespace {
+
+constexpr int kMaxBins = 64;
+constexpr int kMedianDepth = 40;   // below this depth splits are object medians: depth stays < kBvhStackSize
+constexpr uint32_t kParallelThreshold = 16384;
+
+struct BuildNode {
+    Bounds3 bounds;
+    uint32_t begin = 0, end = 0;   // range of the reference array (leaf when children are null)
+    std::unique_ptr<BuildNode> child[2];
+    bool leaf() const { return !child[0]; }
+};
+
+struct Builder {
+    const std::vector<Bounds3>& boxes;
+    std::vector<glm::vec3> centroid;
+    std::vector<uint32_t> refs;
+    BvhBuildSettings s;
+
+    float area(const Bounds3& b) const
+    {
+        if (!b.valid()) return 0.0f;
+        const glm::vec3 e = b.extent();
+        return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
+    }
+
+    static Bounds3 merge(Bounds3 a, const Bounds3& b)
+    {
+        a.lo = glm::min(a.lo, b.lo);
+        a.hi = glm::max(a.hi, b.hi);
+        return a;
+    }
+
+    std::unique_ptr<BuildNode> build(uint32_t begin, uint32_t end, int depth)
+    {
+        auto node = std::make_unique<BuildNode>();
+        node->begin = begin;
+        node->end = end;
+        Bounds3 cb;
+        for (uint32_t i = begin; i < end; ++i) {
+            node->bounds = merge(node->bounds, boxes[refs[i]]);
+            cb.extend(centroid[refs[i]]);
+        }
+        const uint32_t n = end - begin;
+        if (n <= 1) return node;
+        const glm::vec3 ext = cb.extent();
+        int axis = 0;
+        if (ext.y > ext[axis]) axis = 1;
+        if (ext.z > ext[axis]) axis = 2;
+        uint32_t mid = begin;
+        if (ext[axis] <= 0.0f) {
+            // All centroids coincide: only a leaf or an arbitrary halving can separate them.
+            if (n <= uint32_t(s.maxLeafSize)) return node;
+            mid = begin + n / 2;
+        } else if (depth >= kMedianDepth) {
+            mid = begin + n / 2;
+            std::nth_element(refs.begin() + begin, refs.begin() + mid, refs.begin() + end,
+                             [&](uint32_t a, uint32_t b) { return centroid[a][axis] < centroid[b][axis]; });
+        } else {
+            // SAH over bins on all three axes.
+            const int nb = std::clamp(s.bins, 2, kMaxBins);
+            float bestCost = 1e38f;
+            int bestAxis = -1, bestSplit = 0;
+            for (int a = 0; a < 3; ++a) {
+                if (ext[a] <= 0.0f) continue;
+                Bounds3 binBox[kMaxBins];
+                uint32_t binCount[kMaxBins] = {};
+                const float scale = float(nb) / ext[a];
+                for (uint32_t i = begin; i < end; ++i) {
+                    const uint32_t r = refs[i];
+                    const int b = std::min(nb - 1, int((centroid[r][a] - cb.lo[a]) * scale));
+                    binBox[b] = merge(binBox[b], boxes[r]);
+                    ++binCount[b];
+                }
+                float rightArea[kMaxBins];
+                uint32_t rightCount[kMaxBins];
+                Bounds3 acc;
+                uint32_t cnt = 0;
+                for (int b = nb - 1; b > 0; --b) {
+                    acc = merge(acc, binBox[b]);
+                    cnt += binCount[b];
+                    rightArea[b] = area(acc);
+                    rightCount[b] = cnt;
+                }
+                acc = Bounds3();
+                cnt = 0;
+                for (int b = 0; b < nb - 1; ++b) {
+                    acc = merge(acc, binBox[b]);
+                    cnt += binCount[b];
+                    if (cnt == 0 || rightCount[b + 1] == 0) continue;
+                    const float cost = area(acc) * float(cnt) + rightArea[b + 1] * float(rightCount[b + 1]);
+                    if (cost < bestCost) {
+                        bestCost = cost;
+                        bestAxis = a;
+                        bestSplit = b;
+                    }
+                }
+            }
+            const float leafCost = area(node->bounds) * float(n);
+            const float splitCost = area(node->bounds) * s.traversalCost + bestCost;
+            if (bestAxis < 0 || (n <= uint32_t(s.maxLeafSize) && leafCost <= splitCost)) {
+                if (n <= uint32_t(s.maxLeafSize)) return node;
+                mid = begin + n / 2;   // cannot separate by bins: halve along the widest axis
+                std::nth_element(refs.begin() + begin, refs.begin() + mid, refs.begin() + end,
+                                 [&](uint32_t a, uint32_t b) { return centroid[a][axis] < centroid[b][axis]; });
+            } else {
+                const float scale = float(nb) / ext[bestAxis];
+                const float lo = cb.lo[bestAxis];
+                auto it = std::partition(refs.begin() + begin, refs.begin() + end, [&](uint32_t r) {
+                    return std::min(nb - 1, int((centroid[r][bestAxis] - lo) * scale)) <= bestSplit;
+                });
+                mid = uint32_t(it - refs.begin());
+            }
+        }
+        if (n > kParallelThreshold) {
+            tbb::parallel_invoke([&] { node->child[0] = build(begin, mid, depth + 1); },
+                                 [&] { node->child[1] = build(mid, end, depth + 1); });
+        } else {
+            node->child[0] = build(begin, mid, depth + 1);
+            node->child[1] = build(mid, end, depth + 1);
+        }
+        return node;
+    }
+};
+
+void setChild(const BuildNode* c, glm::vec3& lo, glm::vec3& hi, uint32_t& index, uint32_t& count)
+{
+    if (!c || c->begin == c->end) {
+        lo = glm::vec3(1e30f);
+        hi = glm::vec3(-1e30f);
+        index = 0;
+        count = 0;
+        return;
+    }
+    lo = c->bounds.lo;
+    hi = c->bounds.hi;
+    index = c->begin;   // leaves: final; inner nodes: patched by flatten
+    count = c->leaf() ? c->end - c->begin : 0;
+}
+
+// Writes the pair of `parent`'s children at nodes[slot] and recurses into inner children.
+void flatten(const BuildNode* parent, uint32_t slot, std::vector<BvhNode>& nodes, int depth, int& maxDepth)
+{
+    const BuildNode* c0 = parent->child[0].get();
+    const BuildNode* c1 = parent->child[1].get();
+    {
+        BvhNode& n = nodes[slot];
+        setChild(c0, n.lo0, n.hi0, n.index0, n.count0);
+        setChild(c1, n.lo1, n.hi1, n.index1, n.count1);
+    }
+    const BuildNode* kids[2] = {c0, c1};
+    for (int k = 0; k < 2; ++k) {
+        const BuildNode* c = kids[k];
+        if (!c || c->begin == c->end) continue;
+        if (c->leaf()) {
+            maxDepth = std::max(maxDepth, depth);
+            continue;
+        }
+        const uint32_t childSlot = uint32_t(nodes.size());
+        nodes.emplace_back();
+        (k == 0 ? nodes[slot].index0 : nodes[slot].index1) = childSlot;
+        flatten(c, childSlot, nodes, depth + 1, maxDepth);
+    }
+}
+
+} // namespace
+
+Bvh buildBvh(const std::vector<Bounds3>& primBounds, const BvhBuildSettings& settings)
+{
+    Builder b{primBounds, {}, {}, settings};
+    b.s.maxLeafSize = std::max(1, settings.maxLeafSize);
+    b.centroid.assign(primBounds.size(), glm::vec3(0.0f));
+    b.refs.reserve(primBounds.size());
+    for (uint32_t i = 0; i < primBounds.size(); ++i) {
+        if (!primBounds[i].valid()) continue;
+        b.centroid[i] = primBounds[i].center();
+        b.refs.push_back(i);
+    }
+    Bvh out;
+    out.nodes.emplace_back();
+    BvhNode& root = out.nodes[0];
+    root.lo0 = root.lo1 = glm::vec3(1e30f);
+    root.hi0 = root.hi1 = glm::vec3(-1e30f);
+    root.index0 = root.index1 = root.count0 = root.count1 = 0;
+    if (!b.refs.empty()) {
+        std::unique_ptr<BuildNode> top = b.build(0, uint32_t(b.refs.size()), 0);
+        out.bounds = top->bounds;
+        if (top->leaf()) {
+            // A single leaf: the root pair holds it as its first child.
+            root.lo0 = top->bounds.lo;
+            root.hi0 = top->bounds.hi;
+            root.index0 = 0;
+            root.count0 = uint32_t(b.refs.size());
+            out.depth = 1;
+        } else {
+            int maxDepth = 1;
+            flatten(top.get(), 0, out.nodes, 1, maxDepth);
+            out.depth = maxDepth;
+        }
+    }
+    out.primOrder = std::move(b.refs);
+    return out;
+}
+
+} // namespace sylva

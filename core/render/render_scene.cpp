@@ -1,0 +1,268 @@
+// Flattens species, instances, textures and lighting grids into the RenderView arrays; builds the BVHs.
+#include "core/render/render_scene.h"
+
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "core/base/error.h"
+#include "core/render/tonemap.h"
+
+namespace sylva {
+namespace {
+
+glm::dmat3 rotationDeg(const glm::vec3& deg)
+{
+    const glm::dvec3 r = glm::dvec3(deg) * (M_PI / 180.0);
+    const double cx = std::cos(r.x), sx = std::sin(r.x), cy = std::cos(r.y), sy = std::sin(r.y);
+    const double cz = std::cos(r.z), sz = std::sin(r.z);
+    // glm matrices are column-major: m[col][row].
+    const glm::dmat3 rx(1, 0, 0, 0, cx, sx, 0, -sx, cx);
+    const glm::dmat3 ry(cy, 0, -sy, 0, 1, 0, sy, 0, cy);
+    const glm::dmat3 rz(cz, sz, 0, -sz, cz, 0, 0, 0, 1);
+    return rz * ry * rx;
+}
+
+void addCutout(const ImageRgba& img, RenderScene& rs, MaterialRecord& m)
+{
+    if (img.empty()) return;
+    bool anyClear = false;
+    for (size_t p = 0; p < size_t(img.width) * size_t(img.height) && !anyClear; ++p) anyClear = img.pixels[p * 4 + 3] < 0.5f;
+    if (!anyClear) return;
+    AlphaMaskRecord rec{img.width, img.height, uint32_t(rs.alphaBits.size()), 0};
+    const size_t bits = size_t(img.width) * size_t(img.height);
+    rs.alphaBits.resize(rs.alphaBits.size() + (bits + 31) / 32, 0u);
+    for (size_t b = 0; b < bits; ++b)
+        if (img.pixels[b * 4 + 3] >= 0.5f) rs.alphaBits[rec.offset + b / 32] |= 1u << (b % 32);
+    m.alphaMask = int32_t(rs.alphaMasks.size());
+    rs.alphaMasks.push_back(rec);
+}
+
+void addTexture(const ImageRgba& img, RenderScene& rs, MaterialRecord& m)
+{
+    if (img.empty()) return;
+    TextureRecord rec{img.width, img.height, uint32_t(rs.texels.size()), 0};
+    const size_t n = size_t(img.width) * size_t(img.height);
+    rs.texels.reserve(rs.texels.size() + n);
+    for (size_t p = 0; p < n; ++p) {
+        const float* px = &img.pixels[p * 4];
+        rs.texels.emplace_back(srgbDecode(px[0]), srgbDecode(px[1]), srgbDecode(px[2]), px[3]);
+    }
+    m.texture = int32_t(rs.textures.size());
+    rs.textures.push_back(rec);
+}
+
+} // namespace
+
+CameraRecord makeCamera(const CameraDesc& c, int width, int height)
+{
+    const glm::dvec3 fwd = c.target - c.position;
+    if (!(glm::length(fwd) > 0.0)) throw Error("camera: position and target coincide");
+    CameraRecord r;
+    r.forward = glm::vec3(glm::normalize(fwd));
+    const glm::vec3 right = glm::cross(r.forward, c.up);
+    if (!(glm::length(right) > 1e-6f)) throw Error("camera: up is parallel to the view direction");
+    r.right = glm::normalize(right);
+    r.up = glm::cross(r.right, r.forward);
+    r.tanHalfY = std::tan(double(c.fovY) * M_PI / 360.0);
+    r.tanHalfX = r.tanHalfY * float(width) / float(height);
+    return r;
+}
+
+InstanceRecord makeInstance(const InstanceDesc& inst, const glm::dvec3& frameOrigin)
+{
+    // world = R (s x_local) + p  =>  x_local = R^T (world - p) / s, with world = rel + frameOrigin.
+    const glm::dmat3 rt = glm::transpose(rotationDeg(inst.rotationDeg)) * (1.0 / double(inst.scale));
+    const glm::dvec3 t = -(rt * (inst.position - frameOrigin));
+    InstanceRecord r{};
+    for (int i = 0; i < 3; ++i) r.row[i] = glm::vec4(float(rt[0][i]), float(rt[1][i]), float(rt[2][i]), float(t[i]));
+    r.species = inst.species;
+    r.scale = inst.scale;
+    return r;
+}
+
+RenderView RenderScene::view() const
+{
+    RenderView v = base;
+    v.tlasNodes = tlasNodes.data();
+    v.tlasOrder = tlasOrder.data();
+    v.instances = instances.data();
+    v.instanceCount = uint32_t(instances.size());
+    v.species = species.data();
+    v.blasNodes = blasNodes.data();
+    v.tris = tris.data();
+    v.kdTlas = nullptr;
+    v.kdBlas = nullptr;
+    v.triVerts = triVerts.data();
+    v.triMaterial = triMaterial.data();
+    v.normals = normals.data();
+    v.uvs = uvs.data();
+    v.materials = materials.data();
+    v.textures = textures.data();
+    v.texels = texels.data();
+    v.alphaMasks = alphaMasks.data();
+    v.alphaBits = alphaBits.data();
+    v.lighting = lighting.data();
+    return v;
+}
+
+RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
+                             Progress* progress)
+{
+    if (assets.size() != scene.species.size()) throw Error("render: one set of assets per species is required");
+    if (scene.instances.empty()) throw Error("render: the scene has no instances");
+    RenderScene rs;
+    const size_t ns = assets.size();
+
+    // Bottom level: one BVH per species, built in parallel.
+    std::vector<Bvh> blas(ns);
+    tbb::parallel_for(size_t(0), ns, [&](size_t s) {
+        const TriangleMesh& m = assets[s].mesh;
+        std::vector<Bounds3> boxes(m.triangles.size());
+        for (size_t t = 0; t < boxes.size(); ++t)
+            for (int c = 0; c < 3; ++c) boxes[t].extend(m.positions[m.triangles[t][c]]);
+        BvhBuildSettings bs;
+        bs.maxLeafSize = 4;
+        blas[s] = buildBvh(boxes, bs);
+    });
+    if (progress) progress->report(0.7, "species BVHs built");
+
+    std::vector<Bounds3> speciesBounds(ns);
+    for (size_t s = 0; s < ns; ++s) {
+        const SpeciesAssets& a = assets[s];
+        const TriangleMesh& m = a.mesh;
+        if (m.triangles.empty()) throw Error("render: species '" + scene.species[s].name + "' has no triangles");
+        const uint32_t vertBase = uint32_t(rs.normals.size());
+        const uint32_t triBase = uint32_t(rs.triVerts.size());
+        const uint32_t matBase = uint32_t(rs.materials.size());
+        speciesBounds[s] = blas[s].bounds;
+
+        // Shading arrays (normals: given, else from the faces).
+        std::vector<glm::vec3> normals = m.normals;
+        if (normals.size() != m.positions.size()) {
+            normals.assign(m.positions.size(), glm::vec3(0.0f));
+            for (const auto& t : m.triangles) {
+                const glm::vec3 n = glm::cross(m.positions[t.y] - m.positions[t.x], m.positions[t.z] - m.positions[t.x]);
+                for (int c = 0; c < 3; ++c) normals[t[c]] += n;
+            }
+        }
+        for (glm::vec3& n : normals) {
+            const float l = glm::length(n);
+            n = l > 0.0f ? n / l : glm::vec3(0.0f, 1.0f, 0.0f);
+        }
+        rs.normals.insert(rs.normals.end(), normals.begin(), normals.end());
+        if (m.uvs.size() == m.positions.size()) rs.uvs.insert(rs.uvs.end(), m.uvs.begin(), m.uvs.end());
+        else rs.uvs.resize(rs.uvs.size() + m.positions.size(), glm::vec2(0.0f));
+        for (const auto& t : m.triangles) rs.triVerts.push_back(t + glm::uvec3(vertBase));
+        for (size_t t = 0; t < m.triangles.size(); ++t)
+            rs.triMaterial.push_back(matBase + (m.triangleMaterial.empty() ? 0u : m.triangleMaterial[t]));
+
+        // Materials, textures, cut-outs.
+        const size_t nm = std::max<size_t>(1, m.materials.size());
+        for (size_t i = 0; i < nm; ++i) {
+            MaterialRecord r{};
+            const Material def;
+            const Material& mat = i < m.materials.size() ? m.materials[i] : def;
+            r.diffuse = mat.diffuse;
+            r.specular = mat.specular;
+            r.shininess = mat.shininess;
+            r.isLeaf = mat.isLeaf ? 1u : 0u;
+            r.texture = -1;
+            r.alphaMask = -1;
+            if (i < a.diffuse.size()) addTexture(a.diffuse[i], rs, r);
+            if (i < a.cutout.size()) addCutout(a.cutout[i], rs, r);
+            rs.materials.push_back(r);
+        }
+
+        // Triangles in BVH order.
+        SpeciesRecord sr{};
+        sr.nodeOffset = uint32_t(rs.blasNodes.size());
+        sr.triOffset = uint32_t(rs.tris.size());
+        rs.blasNodes.insert(rs.blasNodes.end(), blas[s].nodes.begin(), blas[s].nodes.end());
+        for (uint32_t t : blas[s].primOrder) {
+            const glm::uvec3 tri = m.triangles[t];
+            const glm::vec3 v0 = m.positions[tri.x];
+            TriAccel ta{};
+            ta.v0 = v0;
+            ta.e1 = m.positions[tri.y] - v0;
+            ta.e2 = m.positions[tri.z] - v0;
+            ta.tri = triBase + t;
+            const MaterialRecord& mr = rs.materials[rs.triMaterial[triBase + t]];
+            ta.alpha = mr.alphaMask >= 0 ? uint32_t(mr.alphaMask) + 1u : 0u;
+            rs.tris.push_back(ta);
+        }
+
+        // Lighting grid, normalized by the unobstructed photon density.
+        const LightingGrid& g = a.lighting;
+        if (!g.rgb.empty()) {
+            if (g.rgb.size() != g.geometry.nodeCount() * 3) throw Error("render: lighting grid size does not match its dims");
+            sr.gridOrigin = glm::vec3(g.geometry.origin);
+            sr.gridInvSpacing = float(1.0 / g.geometry.spacing);
+            sr.gridDims = g.geometry.dims;
+            sr.gridOffset = uint32_t(rs.lighting.size());
+            for (size_t i = 0; i < g.rgb.size(); ++i) {
+                const float norm = a.lightingNorm[int(i % 3)];
+                rs.lighting.push_back(norm > 0.0f ? g.rgb[i] / norm : 0.0f);
+            }
+        }
+        rs.species.push_back(sr);
+        rs.m_stats.speciesTriangles += m.triangles.size();
+        rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, blas[s].depth);
+    }
+
+    // Top level over the instances' camera-relative boxes.
+    const glm::dvec3 origin = scene.camera.position;
+    rs.instances.reserve(scene.instances.size());
+    std::vector<Bounds3> boxes(scene.instances.size());
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const InstanceDesc& d = scene.instances[i];
+        if (d.species >= ns) throw Error("render: instance " + std::to_string(i) + " names a missing species");
+        rs.instances.push_back(makeInstance(d, origin));
+        const Bounds3& lb = speciesBounds[d.species];
+        const glm::dmat3 r = rotationDeg(d.rotationDeg) * double(d.scale);
+        for (int c = 0; c < 8; ++c) {
+            const glm::dvec3 corner((c & 1) ? lb.hi.x : lb.lo.x, (c & 2) ? lb.hi.y : lb.lo.y, (c & 4) ? lb.hi.z : lb.lo.z);
+            boxes[i].extend(glm::vec3(r * corner + (d.position - origin)));
+        }
+        // Grow by a relative epsilon so float rounding of the transform never clips geometry.
+        const glm::vec3 pad = 1e-5f * (glm::abs(boxes[i].lo) + glm::abs(boxes[i].hi)) + 1e-6f;
+        boxes[i].lo -= pad;
+        boxes[i].hi += pad;
+        rs.m_stats.instancedTriangles += double(assets[d.species].mesh.triangles.size());
+    }
+    BvhBuildSettings ts;
+    ts.maxLeafSize = 2;
+    Bvh tlas = buildBvh(boxes, ts);
+    rs.tlasNodes = std::move(tlas.nodes);
+    rs.tlasOrder = std::move(tlas.primOrder);
+    rs.m_stats.tlasDepth = tlas.depth;
+
+    // Environment, camera, settings.
+    RenderView& b = rs.base;
+    b.groundEnabled = scene.ground.enabled;
+    b.groundY = float(scene.ground.height - origin.y);
+    b.groundColor = scene.ground.color;
+    const glm::vec3 sd = scene.sun.direction;
+    if (!(glm::length(sd) > 0.0f)) throw Error("sun: direction must not be zero");
+    b.sunDir = glm::normalize(sd);
+    b.sunRadiance = sunRadiance;
+    b.sky = scene.sky;
+    b.camera = makeCamera(scene.camera, scene.render.width, scene.render.height);
+    b.width = scene.render.width;
+    b.height = scene.render.height;
+    b.spp = scene.render.spp;
+    b.accel = scene.render.accel;
+    b.shadows = scene.render.shadows;
+    b.indirectScale = scene.render.indirectScale;
+
+    AccelStats& st = rs.m_stats;
+    st.tlasBytes = rs.tlasNodes.size() * sizeof(BvhNode) + rs.tlasOrder.size() * sizeof(uint32_t);
+    st.instanceBytes = rs.instances.size() * sizeof(InstanceRecord);
+    st.blasBytes = rs.blasNodes.size() * sizeof(BvhNode);
+    st.triangleBytes = rs.tris.size() * sizeof(TriAccel);
+    st.instances = rs.instances.size();
+    if (progress) progress->report(1.0, "acceleration structures built");
+    return rs;
+}
+
+} // namespace sylva

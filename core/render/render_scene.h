@@ -1,0 +1,73 @@
+// Host side of a frame: species geometry, textures and lighting grids flattened into the arrays a RenderView points at.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "core/base/progress.h"
+#include "core/grid/grid.h"
+#include "core/image/image.h"
+#include "core/mesh/triangle_mesh.h"
+#include "core/render/render_view.h"
+#include "core/scene/scene.h"
+
+namespace sylva {
+
+// What the renderer needs of one species, already in memory.
+struct SpeciesAssets {
+    TriangleMesh mesh;                  // species frame, metres
+    std::vector<ImageRgba> diffuse;     // per material: colour texture (sRGB-encoded), empty = none
+    std::vector<ImageRgba> cutout;      // per material: coverage in the alpha channel, empty = opaque
+    LightingGrid lighting;              // species frame; empty rgb = none (indirect light as in open sky)
+    glm::vec3 lightingNorm{1.0f};       // photon density of unobstructed space per channel (divides the grid)
+};
+
+// Sizes in bytes of what the traversal reads, for the performance notes.
+struct AccelStats {
+    size_t tlasBytes = 0, instanceBytes = 0, blasBytes = 0, triangleBytes = 0;
+    size_t instances = 0, speciesTriangles = 0;
+    double instancedTriangles = 0.0;
+    int tlasDepth = 0, maxBlasDepth = 0;
+};
+
+// Owns the flat arrays; view() points into them (valid while this object lives and is not modified).
+class RenderScene {
+public:
+    RenderView view() const;
+    const AccelStats& stats() const { return m_stats; }
+
+    // Everything below is filled by buildRenderScene; the CUDA backend uploads these arrays as they are.
+    std::vector<BvhNode> tlasNodes;
+    std::vector<uint32_t> tlasOrder;
+    std::vector<InstanceRecord> instances;
+    std::vector<SpeciesRecord> species;
+    std::vector<BvhNode> blasNodes;
+    std::vector<TriAccel> tris;
+    std::vector<glm::uvec3> triVerts;
+    std::vector<uint32_t> triMaterial;
+    std::vector<glm::vec3> normals;
+    std::vector<glm::vec2> uvs;
+    std::vector<MaterialRecord> materials;
+    std::vector<TextureRecord> textures;
+    std::vector<glm::vec4> texels;
+    std::vector<AlphaMaskRecord> alphaMasks;
+    std::vector<uint32_t> alphaBits;
+    std::vector<float> lighting;
+    RenderView base{};                  // environment, camera and settings (pointers filled by view())
+    AccelStats m_stats;
+};
+
+// Builds the arrays for a scene: one BVH per species (in parallel), one over the instances in the
+// camera-relative frame (world minus the camera position, computed in double: precision does not
+// depend on the distance from the world origin). assets[i] belongs to scene.species[i].
+// sunRadiance is the sun's linear RGB (colour x intensity). Throws Error on inconsistent input.
+RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
+                             Progress* progress = nullptr);
+
+// Camera basis and image extents for a camera and image size (throws Error on a degenerate camera).
+CameraRecord makeCamera(const CameraDesc& camera, int width, int height);
+
+// The instance's world -> species map in the frame whose origin is `frameOrigin` (world metres).
+InstanceRecord makeInstance(const InstanceDesc& inst, const glm::dvec3& frameOrigin);
+
+} // namespace sylva

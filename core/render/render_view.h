@@ -1,0 +1,122 @@
+// The flat, device-friendly arrays a frame is traced from (the same struct is uploaded to the GPU as-is).
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "core/accel/bvh.h"
+#include "core/base/defines.h"
+#include "core/scene/scene.h"
+
+namespace sylva {
+
+// A mesh triangle as the traversal tests it, in its species' frame (metres): v0 and the edges
+// e1 = v1 - v0, e2 = v2 - v0. tri = global triangle index (shading arrays); alpha = alpha mask
+// index + 1 (0 = opaque). 48 bytes.
+struct TriAccel {
+    glm::vec3 v0; uint32_t tri;
+    glm::vec3 e1; uint32_t alpha;
+    glm::vec3 e2; uint32_t pad;
+};
+static_assert(sizeof(TriAccel) == 48);
+
+// A placed plant: world (camera-relative) -> species frame as a 3x4 row-major affine map
+// (rotation and uniform scale only, so normals map back with the transpose). 64 bytes.
+struct InstanceRecord {
+    glm::vec4 row[3];        // local = row[i].xyz . world + row[i].w
+    uint32_t species;
+    float scale;             // world metres per species metre
+    uint32_t pad[2];
+};
+static_assert(sizeof(InstanceRecord) == 64);
+
+// Per species: where its BVH nodes and triangles start in the flat arrays, its lighting grid. 48 bytes.
+struct SpeciesRecord {
+    uint32_t nodeOffset;     // into RenderView::blasNodes
+    uint32_t triOffset;      // into RenderView::tris (BVH slot order)
+    uint32_t kdNodeOffset;   // into the kd-tree arrays (kd-tree runs)
+    uint32_t kdRefOffset;
+    glm::vec3 gridOrigin;    // species frame, metres, node (0,0,0)
+    float gridInvSpacing;    // 1 / node spacing; 0 = no lighting grid
+    glm::ivec3 gridDims;
+    uint32_t gridOffset;     // into RenderView::lighting (3 floats per node, already normalized)
+};
+static_assert(sizeof(SpeciesRecord) == 48);
+
+// A surface material for shading. Texture indices are into RenderView::textures, -1 = none. 48 bytes.
+struct MaterialRecord {
+    glm::vec3 diffuse;       // linear RGB, times the texture colour
+    float shininess;
+    glm::vec3 specular;
+    int32_t texture;
+    uint32_t isLeaf;
+    int32_t alphaMask;       // into RenderView::alphaMasks, -1 = opaque
+    uint32_t pad[2];
+};
+static_assert(sizeof(MaterialRecord) == 48);
+
+// A texture of linear RGBA float texels (offset into RenderView::texels, in texels). 16 bytes.
+struct TextureRecord {
+    int32_t width, height;
+    uint32_t offset;
+    uint32_t pad;
+};
+
+// A 1-bit cut-out (alpha >= 0.5) in 32-bit words, row-major, top row first. 16 bytes.
+struct AlphaMaskRecord {
+    int32_t width, height;
+    uint32_t offset;         // into RenderView::alphaBits, in words
+    uint32_t pad;
+};
+
+// Camera in the camera-relative frame: origin at the eye, orthonormal basis, image plane extents.
+struct CameraRecord {
+    glm::vec3 forward, right, up;
+    float tanHalfX, tanHalfY;
+};
+
+// Everything a frame needs, as pointers into flat arrays (host or device memory).
+struct RenderView {
+    // top level (instances) and bottom level (per species) BVHs
+    const BvhNode* tlasNodes;
+    const uint32_t* tlasOrder;       // BVH slot -> instance index
+    const InstanceRecord* instances;
+    uint32_t instanceCount;
+    const SpeciesRecord* species;
+    const BvhNode* blasNodes;
+    const TriAccel* tris;
+
+    // kd-tree alternative (same instances and triangles); null when not built
+    const void* kdTlas;              // reserved for the kd-tree layout
+    const void* kdBlas;
+
+    // shading data, indexed by TriAccel::tri
+    const glm::uvec3* triVerts;      // global vertex indices
+    const uint32_t* triMaterial;     // global material index
+    const glm::vec3* normals;        // per vertex, species frame
+    const glm::vec2* uvs;            // per vertex
+    const MaterialRecord* materials;
+    const TextureRecord* textures;
+    const glm::vec4* texels;
+    const AlphaMaskRecord* alphaMasks;
+    const uint32_t* alphaBits;
+    const float* lighting;           // normalized LB photon density, 3 floats per node
+
+    // environment
+    bool groundEnabled;
+    float groundY;                   // camera-relative height of the ground plane
+    glm::vec3 groundColor;
+    glm::vec3 sunDir;                // toward the sun, normalized
+    glm::vec3 sunRadiance;           // blackbody colour (luminance 1) x intensity
+    glm::vec3 sky;
+    CameraRecord camera;
+
+    // settings
+    int width, height, spp;
+    AccelKind accel;
+    bool shadows;
+    float indirectScale;
+};
+
+} // namespace sylva

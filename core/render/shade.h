@@ -1,0 +1,183 @@
+// Shading of one camera sample: sun light with shadow rays, LB indirect light, sky (host and device).
+#pragma once
+
+#include "core/render/render_view.h"
+#include "core/render/trace.h"
+
+namespace sylva {
+
+// The three parts a render mode combines (linear RGB): local = sun light only, indirect = LB
+// indirect light (ground: sky light), albedo = the surface colour the indirect light multiplies
+// (for the constant-ambient comparison), skyCover = share of samples that saw the sky. 40 bytes.
+struct SampleParts {
+    glm::vec3 local;
+    glm::vec3 indirect;
+    glm::vec3 albedo;
+    float skyCover;
+};
+
+// Bilinear, wrapped texture lookup (v = 0 is the bottom row, as in OBJ).
+SYLVA_HD inline glm::vec4 sampleTexture(const RenderView& v, int32_t index, glm::vec2 uv)
+{
+    const TextureRecord t = v.textures[index];
+    const float x = (uv.x - floorf(uv.x)) * float(t.width) - 0.5f;
+    const float y = (1.0f - (uv.y - floorf(uv.y))) * float(t.height) - 0.5f;
+    const float fx = floorf(x), fy = floorf(y);
+    const float ax = x - fx, ay = y - fy;
+    int x0 = int(fx), y0 = int(fy);
+    x0 = ((x0 % t.width) + t.width) % t.width;
+    y0 = ((y0 % t.height) + t.height) % t.height;
+    const int x1 = (x0 + 1) % t.width, y1 = (y0 + 1) % t.height;
+    const glm::vec4* p = v.texels + t.offset;
+    return (1.0f - ay) * ((1.0f - ax) * p[y0 * t.width + x0] + ax * p[y0 * t.width + x1]) +
+           ay * ((1.0f - ax) * p[y1 * t.width + x0] + ax * p[y1 * t.width + x1]);
+}
+
+// Trilinear lookup of a species' normalized lighting grid at a species-frame point (clamped to the grid).
+SYLVA_HD inline glm::vec3 sampleLighting(const RenderView& v, const SpeciesRecord& sp, const glm::vec3& p)
+{
+    if (sp.gridInvSpacing == 0.0f) return glm::vec3(1.0f);
+    const glm::vec3 g = (p - sp.gridOrigin) * sp.gridInvSpacing;
+    const glm::vec3 hi = glm::vec3(sp.gridDims - 1) - 1e-4f;
+    const glm::vec3 c = glm::clamp(g, glm::vec3(0.0f), hi);
+    const glm::ivec3 i = glm::ivec3(c);
+    const glm::vec3 f = c - glm::vec3(i);
+    const float* L = v.lighting + sp.gridOffset;
+    const int sy = sp.gridDims.z, sx = sp.gridDims.y * sp.gridDims.z;
+    glm::vec3 out(0.0f);
+    for (int corner = 0; corner < 8; ++corner) {
+        const int dx = corner >> 2, dy = (corner >> 1) & 1, dz = corner & 1;
+        const float w = (dx ? f.x : 1.0f - f.x) * (dy ? f.y : 1.0f - f.y) * (dz ? f.z : 1.0f - f.z);
+        const int node = (i.x + dx) * sx + (i.y + dy) * sy + (i.z + dz);
+        out += w * glm::vec3(L[node * 3], L[node * 3 + 1], L[node * 3 + 2]);
+    }
+    return out;
+}
+
+// Is the sun visible from camera-relative point p (already offset off its surface)?
+SYLVA_HD inline bool sunVisible(const RenderView& v, const glm::vec3& p)
+{
+    if (!v.shadows) return true;
+    Ray r{p, 0.0f, v.sunDir, 1e30f};
+    Hit h{};
+    return !traceScene<true>(v, r, h);
+}
+
+// Offset along the geometric normal, scaled to the coordinates' magnitude (no self-shadowing acne).
+SYLVA_HD SYLVA_INLINE glm::vec3 offsetPoint(const glm::vec3& p, const glm::vec3& ng)
+{
+    const float m = fmaxf(fmaxf(fabsf(p.x), fabsf(p.y)), fmaxf(fabsf(p.z), 1.0f));
+    return p + ng * (m * 2e-5f);
+}
+
+// Shades the first surface along a camera ray.
+SYLVA_HD inline SampleParts shadeRay(const RenderView& v, const Ray& ray)
+{
+    SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f};
+    Hit hit{};
+    if (!traceScene<false>(v, ray, hit)) {
+        out.skyCover = 1.0f;
+        return out;
+    }
+    const glm::vec3 p = ray.org + hit.t * ray.dir;
+    const glm::vec3 viewDir = glm::normalize(-ray.dir);
+    if (hit.prim == kGroundPrim) {
+        const glm::vec3 n(0.0f, ray.dir.y < 0.0f ? 1.0f : -1.0f, 0.0f);
+        const float nl = glm::dot(n, v.sunDir);
+        if (nl > 0.0f && sunVisible(v, offsetPoint(p, n))) out.local = v.groundColor * v.sunRadiance * nl;
+        out.indirect = v.groundColor * v.sky;   // Lambertian ground under a uniform sky
+        out.albedo = v.groundColor;
+        return out;
+    }
+    const InstanceRecord& in = v.instances[hit.inst];
+    const SpeciesRecord& sp = v.species[in.species];
+    const glm::uvec3 tv = v.triVerts[hit.prim];
+    const MaterialRecord m = v.materials[v.triMaterial[hit.prim]];
+    // Geometric normal from the triangle's vertices (species frame) and the interpolated shading normal.
+    const glm::vec3 lp = toLocalPoint(in, ray.org) + hit.t * toLocalDir(in, ray.dir);
+    const float b0 = 1.0f - hit.u - hit.v;
+    glm::vec3 ns = b0 * v.normals[tv.x] + hit.u * v.normals[tv.y] + hit.v * v.normals[tv.z];
+    glm::vec3 ng = glm::normalize(toWorldNormal(in, ns));
+    if (!(glm::dot(ng, ng) > 0.5f)) ng = glm::vec3(0.0f, 1.0f, 0.0f);
+    if (glm::dot(ng, viewDir) < 0.0f) ng = -ng;   // two-sided: face the viewer
+    glm::vec3 kd = m.diffuse;
+    if (m.texture >= 0) {
+        const glm::vec2 uv = b0 * v.uvs[tv.x] + hit.u * v.uvs[tv.y] + hit.v * v.uvs[tv.z];
+        kd *= glm::vec3(sampleTexture(v, m.texture, uv));
+    }
+    out.albedo = kd;
+    const float nl = glm::dot(ng, v.sunDir);
+    if (nl > 0.0f && sunVisible(v, offsetPoint(p, ng))) {
+        glm::vec3 c = kd * nl;
+        if (m.shininess > 0.0f && (m.specular.x > 0.0f || m.specular.y > 0.0f || m.specular.z > 0.0f)) {
+            const glm::vec3 r = 2.0f * nl * ng - v.sunDir;
+            const float vr = glm::dot(viewDir, r);
+            if (vr > 0.0f) c += m.specular * powf(vr, m.shininess);
+        }
+        out.local = c * v.sunRadiance;
+    }
+    out.indirect = kd * sampleLighting(v, sp, lp) * v.sunRadiance * v.indirectScale;
+    return out;
+}
+
+// Camera ray through image position (x, y) in pixels (y down, 0..width/height), camera-relative.
+SYLVA_HD SYLVA_INLINE Ray cameraRay(const RenderView& v, float x, float y)
+{
+    const float sx = (2.0f * x / float(v.width) - 1.0f) * v.camera.tanHalfX;
+    const float sy = (1.0f - 2.0f * y / float(v.height)) * v.camera.tanHalfY;
+    Ray r;
+    r.org = glm::vec3(0.0f);
+    r.dir = glm::normalize(v.camera.forward + sx * v.camera.right + sy * v.camera.up);
+    r.tmin = 0.0f;
+    r.tmax = 1e30f;
+    return r;
+}
+
+// A hash-based random number in [0,1) for sample positions (deterministic per pixel and sample).
+SYLVA_HD SYLVA_INLINE float hashToUnit(uint32_t a, uint32_t b, uint32_t c)
+{
+    uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u) * 0x85EBCA77u ^ (c + 0x165667B1u) * 0xC2B2AE3Du;
+    h ^= h >> 16;
+    h *= 0x7FEB352Du;
+    h ^= h >> 15;
+    h *= 0x846CA68Bu;
+    h ^= h >> 16;
+    return float(h >> 8) * (1.0f / 16777216.0f);
+}
+
+// Sample s of spp inside pixel (px, py): one sample at the centre; a stratified n x n grid when spp
+// is a square; otherwise jittered random positions.
+SYLVA_HD SYLVA_INLINE glm::vec2 samplePosition(int px, int py, int s, int spp)
+{
+    if (spp == 1) return glm::vec2(float(px) + 0.5f, float(py) + 0.5f);
+    int n = int(sqrtf(float(spp)) + 0.5f);
+    const float jx = hashToUnit(uint32_t(px), uint32_t(py), uint32_t(2 * s));
+    const float jy = hashToUnit(uint32_t(px), uint32_t(py), uint32_t(2 * s + 1));
+    if (n * n == spp) {
+        const int sx = s % n, sy = s / n;
+        return glm::vec2(float(px) + (float(sx) + jx) / float(n), float(py) + (float(sy) + jy) / float(n));
+    }
+    return glm::vec2(float(px) + jx, float(py) + jy);
+}
+
+// All samples of one pixel, box-filtered.
+SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
+{
+    SampleParts sum{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f};
+    for (int s = 0; s < v.spp; ++s) {
+        const glm::vec2 pos = samplePosition(px, py, s, v.spp);
+        const SampleParts p = shadeRay(v, cameraRay(v, pos.x, pos.y));
+        sum.local += p.local;
+        sum.indirect += p.indirect;
+        sum.albedo += p.albedo;
+        sum.skyCover += p.skyCover;
+    }
+    const float inv = 1.0f / float(v.spp);
+    sum.local *= inv;
+    sum.indirect *= inv;
+    sum.albedo *= inv;
+    sum.skyCover *= inv;
+    return sum;
+}
+
+} // namespace sylva

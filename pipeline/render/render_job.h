@@ -1,0 +1,56 @@
+// `sylva render` as a library call: species meshes, textures and lighting grids for a scene, the frame, the picture.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/base/progress.h"
+#include "core/color/color.h"
+#include "core/render/render_cpu.h"
+#include "core/render/render_scene.h"
+#include "core/scene/scene.h"
+#include "pipeline/lighting_job.h"
+
+namespace sylva {
+
+class GridCache;
+
+// The CIE 1931 table bundled with the program (resources/color).
+const CieTable& bundledCieTable();
+
+// Linear RGB radiance of the scene's sun: blackbody colour (luminance 1) x intensity.
+glm::vec3 sunRadiance(const SunDesc& sun);
+
+// The bundled default forest (resources/default_forest.sylva.json): five grown broadleaf species,
+// 962 instances, 896x448.
+Scene defaultScene();
+
+// Whether a render mode uses the LB lighting grids (local does not: no grid is solved for it).
+bool modeNeedsLighting(RenderMode mode);
+
+// Loads or grows every species' mesh and textures, and (when needLighting) its density and lighting
+// grids through the cache. Stages go to log as "SPECIES: grow|import", then the lighting job's stages.
+// The LB solve uses the scene's sun in the species frame (instances share their species' grid).
+std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cache, bool needLighting,
+                                             Progress* progress = nullptr, JobLog* log = nullptr);
+
+// Timings of one render, seconds.
+struct RenderTimings {
+    double assets = 0.0, build = 0.0, trace = 0.0;
+};
+
+// Assets, acceleration structures and the film of a scene, with progress (assets 0-60%, build, trace).
+struct RenderOutput {
+    Film film;
+    AccelStats stats;
+    RenderTimings timings;
+};
+RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr);
+
+// Tone-mapped (Reinhard, log-average key) sRGB picture of linear RGB pixels, alpha 1.
+ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key);
+
+// Writes a render: .png/.tif/.tiff tone-mapped 8-bit sRGB, .exr linear half float. Error on other extensions.
+void writeRender(const std::string& path, const std::vector<glm::vec3>& linear, int width, int height, float key);
+
+} // namespace sylva
