@@ -1,4 +1,4 @@
-// Binned-SAH BVH build: a temporary tree built with oneTBB tasks, flattened depth-first into 64-byte nodes.
+// Binned-SAH BVH build: a temporary tree built with oneTBB tasks, collapsed into 4-wide 128-byte nodes.
 #include "core/accel/bvh.h"
 
 #include <algorithm>
@@ -133,42 +133,65 @@ struct Builder {
     }
 };
 
-void setChild(const BuildNode* c, glm::vec3& lo, glm::vec3& hi, uint32_t& index, uint32_t& count)
+float surfaceArea(const Bounds3& b)
 {
-    if (!c || c->begin == c->end) {
-        lo = glm::vec3(1e30f);
-        hi = glm::vec3(-1e30f);
-        index = 0;
-        count = 0;
-        return;
-    }
-    lo = c->bounds.lo;
-    hi = c->bounds.hi;
-    index = c->begin;   // leaves: final; inner nodes: patched by flatten
-    count = c->leaf() ? c->end - c->begin : 0;
+    const glm::vec3 e = b.extent();
+    return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
-// Writes the pair of `parent`'s children at nodes[slot] and recurses into inner children.
+void clearNode(BvhNode& n)
+{
+    for (int k = 0; k < 4; ++k) {
+        n.lox[k] = n.loy[k] = n.loz[k] = 1e30f;
+        n.hix[k] = n.hiy[k] = n.hiz[k] = -1e30f;
+        n.child[k] = kNoHit;
+        n.count[k] = 0;
+    }
+}
+
+// Writes the (up to four) children of `parent` at nodes[slot]: its two children, with the inner
+// child of largest area replaced by its own two children while there is room. Recurses depth-first.
 void flatten(const BuildNode* parent, uint32_t slot, std::vector<BvhNode>& nodes, int depth, int& maxDepth)
 {
-    const BuildNode* c0 = parent->child[0].get();
-    const BuildNode* c1 = parent->child[1].get();
-    {
-        BvhNode& n = nodes[slot];
-        setChild(c0, n.lo0, n.hi0, n.index0, n.count0);
-        setChild(c1, n.lo1, n.hi1, n.index1, n.count1);
+    const BuildNode* kids[4] = {parent->child[0].get(), parent->child[1].get(), nullptr, nullptr};
+    int nk = 2;
+    while (nk < 4) {
+        int best = -1;
+        float bestArea = -1.0f;
+        for (int k = 0; k < nk; ++k)
+            if (!kids[k]->leaf() && surfaceArea(kids[k]->bounds) > bestArea) {
+                bestArea = surfaceArea(kids[k]->bounds);
+                best = k;
+            }
+        if (best < 0) break;
+        const BuildNode* open = kids[best];
+        kids[best] = open->child[0].get();
+        kids[nk++] = open->child[1].get();
     }
-    const BuildNode* kids[2] = {c0, c1};
-    for (int k = 0; k < 2; ++k) {
+    clearNode(nodes[slot]);
+    for (int k = 0; k < nk; ++k) {
         const BuildNode* c = kids[k];
-        if (!c || c->begin == c->end) continue;
+        BvhNode& n = nodes[slot];
+        n.lox[k] = c->bounds.lo.x;
+        n.loy[k] = c->bounds.lo.y;
+        n.loz[k] = c->bounds.lo.z;
+        n.hix[k] = c->bounds.hi.x;
+        n.hiy[k] = c->bounds.hi.y;
+        n.hiz[k] = c->bounds.hi.z;
+        n.child[k] = 0;   // set below for inner children
         if (c->leaf()) {
+            n.child[k] = c->begin;
+            n.count[k] = c->end - c->begin;
             maxDepth = std::max(maxDepth, depth);
-            continue;
         }
+    }
+    for (int k = 0; k < nk; ++k) {
+        const BuildNode* c = kids[k];
+        if (c->leaf()) continue;
         const uint32_t childSlot = uint32_t(nodes.size());
         nodes.emplace_back();
-        (k == 0 ? nodes[slot].index0 : nodes[slot].index1) = childSlot;
+        nodes[slot].child[k] = childSlot;
+        nodes[slot].count[k] = 0;
         flatten(c, childSlot, nodes, depth + 1, maxDepth);
     }
 }
@@ -188,19 +211,21 @@ Bvh buildBvh(const std::vector<Bounds3>& primBounds, const BvhBuildSettings& set
     }
     Bvh out;
     out.nodes.emplace_back();
-    BvhNode& root = out.nodes[0];
-    root.lo0 = root.lo1 = glm::vec3(1e30f);
-    root.hi0 = root.hi1 = glm::vec3(-1e30f);
-    root.index0 = root.index1 = root.count0 = root.count1 = 0;
+    clearNode(out.nodes[0]);
     if (!b.refs.empty()) {
         std::unique_ptr<BuildNode> top = b.build(0, uint32_t(b.refs.size()), 0);
         out.bounds = top->bounds;
         if (top->leaf()) {
-            // A single leaf: the root pair holds it as its first child.
-            root.lo0 = top->bounds.lo;
-            root.hi0 = top->bounds.hi;
-            root.index0 = 0;
-            root.count0 = uint32_t(b.refs.size());
+            // A single leaf: the root holds it as its first child.
+            BvhNode& root = out.nodes[0];
+            root.lox[0] = top->bounds.lo.x;
+            root.loy[0] = top->bounds.lo.y;
+            root.loz[0] = top->bounds.lo.z;
+            root.hix[0] = top->bounds.hi.x;
+            root.hiy[0] = top->bounds.hi.y;
+            root.hiz[0] = top->bounds.hi.z;
+            root.child[0] = 0;
+            root.count[0] = uint32_t(b.refs.size());
             out.depth = 1;
         } else {
             int maxDepth = 1;

@@ -12,16 +12,17 @@
 
 namespace sylva {
 
-// One node holds the boxes of both its children, so one fetch tests two boxes. A child with
-// count == 0 is an inner node at index `index`; count > 0 is a leaf of primitives
-// [index, index + count) in the BVH's primitive order; an empty child has an inverted box. 64 bytes.
-struct BvhNode {
-    glm::vec3 lo0; uint32_t index0;
-    glm::vec3 hi0; uint32_t count0;
-    glm::vec3 lo1; uint32_t index1;
-    glm::vec3 hi1; uint32_t count1;
+// A 4-wide node: the boxes of up to four children as structure of arrays (one SIMD test for all
+// four). Child k with count[k] == 0 is an inner node at index child[k]; count[k] > 0 is a leaf of
+// primitives [child[k], child[k] + count[k]) in the BVH's primitive order; unused children have
+// child[k] == kNoHit and count 0 (their boxes are not tested: an inverted box is still a slab hit).
+// 128 bytes, 64-byte aligned.
+struct alignas(64) BvhNode {
+    float lox[4], hix[4], loy[4], hiy[4], loz[4], hiz[4];
+    uint32_t child[4];
+    uint32_t count[4];
 };
-static_assert(sizeof(BvhNode) == 64);
+static_assert(sizeof(BvhNode) == 128);
 
 struct BvhBuildSettings {
     int maxLeafSize = 8;          // primitives per leaf at most
@@ -47,7 +48,47 @@ struct BvhView {
     const BvhNode* nodes;
 };
 
-inline constexpr int kBvhStackSize = 64;
+// Every visit pushes at most three children; build depth is capped below 64.
+inline constexpr int kBvhStackSize = 192;
+
+#if !defined(__CUDA_ARCH__)
+namespace detail {
+typedef float Float4 __attribute__((vector_size(16)));
+typedef int Int4 __attribute__((vector_size(16)));
+SYLVA_INLINE Float4 load4(const float* p)
+{
+    Float4 v;
+    __builtin_memcpy(&v, p, 16);
+    return v;
+}
+SYLVA_INLINE Float4 min4(Float4 a, Float4 b) { return a < b ? a : b; }
+SYLVA_INLINE Float4 max4(Float4 a, Float4 b) { return a > b ? a : b; }
+} // namespace detail
+#endif
+
+// Entry distances of the ray into the node's four child boxes; a lane is > tmax when missed.
+SYLVA_HD SYLVA_INLINE void nodeEntry(const BvhNode& n, const glm::vec3& org, const glm::vec3& inv, float tmin, float tmax,
+                                     float tn[4])
+{
+#if !defined(__CUDA_ARCH__)
+    using namespace detail;
+    const Float4 ox = {org.x, org.x, org.x, org.x}, oy = {org.y, org.y, org.y, org.y}, oz = {org.z, org.z, org.z, org.z};
+    const Float4 ix = {inv.x, inv.x, inv.x, inv.x}, iy = {inv.y, inv.y, inv.y, inv.y}, iz = {inv.z, inv.z, inv.z, inv.z};
+    const Float4 x0 = (load4(n.lox) - ox) * ix, x1 = (load4(n.hix) - ox) * ix;
+    const Float4 y0 = (load4(n.loy) - oy) * iy, y1 = (load4(n.hiy) - oy) * iy;
+    const Float4 z0 = (load4(n.loz) - oz) * iz, z1 = (load4(n.hiz) - oz) * iz;
+    const Float4 lo = {tmin, tmin, tmin, tmin}, hi = {tmax, tmax, tmax, tmax};
+    const Float4 tnear = max4(max4(min4(x0, x1), min4(y0, y1)), max4(min4(z0, z1), lo));
+    const Float4 tfar = min4(min4(max4(x0, x1), max4(y0, y1)), min4(max4(z0, z1), hi));
+    const Float4 miss = {1e38f, 1e38f, 1e38f, 1e38f};
+    const Float4 r = tnear <= tfar ? tnear : miss;
+    __builtin_memcpy(tn, &r, 16);
+#else
+    for (int k = 0; k < 4; ++k)
+        tn[k] = rayBoxEntry(glm::vec3(n.lox[k], n.loy[k], n.loz[k]), glm::vec3(n.hix[k], n.hiy[k], n.hiz[k]), org, inv,
+                            tmin, tmax);
+#endif
+}
 
 // Visits, in roughly front-to-back order, every leaf primitive whose leaf box the ray
 // [tmin, tmax] enters, calling leaf(slot, tmax) with the primitive's slot in BVH order. The callback
@@ -64,31 +105,38 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
     uint32_t node = 0;
     for (;;) {
         const BvhNode& n = bvh.nodes[node];
-        const float d0 = rayBoxEntry(n.lo0, n.hi0, org, inv, tmin, tmax);
-        const float d1 = rayBoxEntry(n.lo1, n.hi1, org, inv, tmin, tmax);
-        uint32_t next = kNoHit;
-        // Leaves are handled at once (they may shrink tmax); inner children continue or are stacked.
-        const bool firstIs0 = d0 <= d1;
-        for (int k = 0; k < 2; ++k) {
-            const bool c0 = (k == 0) == firstIs0;
-            const float d = c0 ? d0 : d1;
-            if (!(d <= tmax)) continue;
-            const uint32_t index = c0 ? n.index0 : n.index1;
-            const uint32_t count = c0 ? n.count0 : n.count1;
-            if (count > 0) {
-                for (uint32_t p = 0; p < count; ++p)
-                    if (leaf(index + p, tmax)) return true;
-            } else if (next == kNoHit) {
-                next = index;
+        float tn[4];
+        nodeEntry(n, org, inv, tmin, tmax, tn);
+        // Leaves are handled at once (they may shrink tmax); inner children are sorted near to far.
+        uint32_t innerNode[4];
+        float innerDist[4];
+        int inner = 0;
+        for (int k = 0; k < 4; ++k) {
+            if (!(tn[k] <= tmax) || n.child[k] == kNoHit) continue;
+            if (n.count[k] > 0) {
+                for (uint32_t p = 0; p < n.count[k]; ++p)
+                    if (leaf(n.child[k] + p, tmax)) return true;
             } else {
-                SYLVA_KERNEL_ASSERT(sp < kBvhStackSize);
-                stackNode[sp] = index;
-                stackDist[sp] = d;
-                ++sp;
+                int j = inner++;
+                while (j > 0 && innerDist[j - 1] < tn[k]) {   // descending: the nearest ends last
+                    innerDist[j] = innerDist[j - 1];
+                    innerNode[j] = innerNode[j - 1];
+                    --j;
+                }
+                innerDist[j] = tn[k];
+                innerNode[j] = n.child[k];
             }
         }
-        if (next != kNoHit) {
-            node = next;
+        // Push the farther ones, continue with the nearest (re-checked against a shrunken tmax).
+        for (int j = 0; j + 1 < inner; ++j) {
+            if (!(innerDist[j] <= tmax)) continue;
+            SYLVA_KERNEL_ASSERT(sp < kBvhStackSize);
+            stackNode[sp] = innerNode[j];
+            stackDist[sp] = innerDist[j];
+            ++sp;
+        }
+        if (inner > 0 && innerDist[inner - 1] <= tmax) {
+            node = innerNode[inner - 1];
             continue;
         }
         for (;;) {

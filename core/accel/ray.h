@@ -30,6 +30,10 @@ struct Hit {
     uint32_t inst;
 };
 
+// min/max that compile to one instruction (fminf/fmaxf handle NaN and become libm calls on x86).
+SYLVA_HD SYLVA_INLINE float minf(float a, float b) { return a < b ? a : b; }
+SYLVA_HD SYLVA_INLINE float maxf(float a, float b) { return a > b ? a : b; }
+
 // Reciprocal direction with zeros replaced by huge values of the right sign (no NaN in slab tests).
 SYLVA_HD SYLVA_INLINE glm::vec3 safeReciprocal(const glm::vec3& d)
 {
@@ -45,8 +49,8 @@ SYLVA_HD SYLVA_INLINE float rayBoxEntry(const glm::vec3& lo, const glm::vec3& hi
     const float tx0 = (lo.x - org.x) * invDir.x, tx1 = (hi.x - org.x) * invDir.x;
     const float ty0 = (lo.y - org.y) * invDir.y, ty1 = (hi.y - org.y) * invDir.y;
     const float tz0 = (lo.z - org.z) * invDir.z, tz1 = (hi.z - org.z) * invDir.z;
-    const float tnear = fmaxf(fmaxf(fminf(tx0, tx1), fminf(ty0, ty1)), fmaxf(fminf(tz0, tz1), tmin));
-    const float tfar = fminf(fminf(fmaxf(tx0, tx1), fmaxf(ty0, ty1)), fminf(fmaxf(tz0, tz1), tmax));
+    const float tnear = maxf(maxf(minf(tx0, tx1), minf(ty0, ty1)), maxf(minf(tz0, tz1), tmin));
+    const float tfar = minf(minf(maxf(tx0, tx1), maxf(ty0, ty1)), minf(maxf(tz0, tz1), tmax));
     return tnear <= tfar ? tnear : 1e38f;
 }
 

@@ -1,0 +1,412 @@
+// The renderer: accelerated queries against brute force, instancing against a flattened copy, alpha
+// cut-outs, render-mode relations, precision far from the origin, and golden images.
+#include <QDir>
+#include <QTest>
+
+#include <cmath>
+#include <random>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+#include "core/render/render_cpu.h"
+#include "core/render/render_scene.h"
+#include "core/render/shade.h"
+#include "core/render/tonemap.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/grow/tree_grower.h"
+#include "pipeline/import/mesh_import.h"
+#include "pipeline/io/image_io.h"
+#include "pipeline/render/render_job.h"
+
+using namespace sylva;
+
+namespace {
+
+// Scene with one species and the given instances; ground off unless asked.
+Scene sceneFor(std::vector<InstanceDesc> instances, bool ground = false)
+{
+    Scene s;
+    s.species.resize(1);
+    s.species[0].name = "test";
+    s.instances = std::move(instances);
+    s.ground.enabled = ground;
+    s.render.width = 64;
+    s.render.height = 48;
+    s.camera.position = {0.0, 2.0, -20.0};
+    s.camera.target = {0.0, 2.0, 0.0};
+    return s;
+}
+
+SpeciesAssets assetsFor(TriangleMesh mesh)
+{
+    SpeciesAssets a;
+    a.mesh = std::move(mesh);
+    return a;
+}
+
+// Reference: every triangle of every instance, with the same alpha rule. Closest t, or -1.
+float bruteForce(const RenderView& v, size_t triCount, const Ray& ray, uint32_t* prim)
+{
+    float best = ray.tmax;
+    *prim = kNoHit;
+    for (uint32_t i = 0; i < v.instanceCount; ++i) {
+        const InstanceRecord& in = v.instances[i];
+        const SpeciesRecord& sp = v.species[in.species];
+        const glm::vec3 o = toLocalPoint(in, ray.org), d = toLocalDir(in, ray.dir);
+        for (size_t t = 0; t < triCount; ++t) {
+            float u, w;
+            if (hitTriangle(v, v.tris[sp.triOffset + t], o, d, ray.tmin, best, u, w)) *prim = v.tris[sp.triOffset + t].tri;
+        }
+    }
+    return *prim == kNoHit ? -1.0f : best;
+}
+
+TriangleMesh randomSoup(int n, uint32_t seed)
+{
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> pos(-5.0f, 5.0f), off(-0.8f, 0.8f);
+    TriangleMesh m;
+    for (int i = 0; i < n; ++i) {
+        const glm::vec3 c(pos(rng), pos(rng), pos(rng));
+        for (int k = 0; k < 3; ++k) m.positions.push_back(c + glm::vec3(off(rng), off(rng), off(rng)));
+        m.triangles.emplace_back(3 * i, 3 * i + 1, 3 * i + 2);
+        m.triangleMaterial.push_back(0);
+    }
+    m.materials.resize(1);
+    return m;
+}
+
+Ray randomRay(std::mt19937& rng, const Bounds3& b)
+{
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const glm::vec3 e = b.extent();
+    Ray r;
+    r.org = b.lo - 0.3f * e + 1.6f * e * glm::vec3(u(rng), u(rng), u(rng));
+    glm::vec3 d(u(rng) - 0.5f, u(rng) - 0.5f, u(rng) - 0.5f);
+    const int kind = int(u(rng) * 8.0f);
+    if (kind == 0) d = glm::vec3(0.0f, 0.0f, d.z);   // axis-parallel
+    if (kind == 1) d.x = 0.0f;                       // in a coordinate plane
+    if (!(glm::length(d) > 0.0f)) d = glm::vec3(0.0f, 1.0f, 0.0f);
+    r.dir = glm::normalize(d);
+    r.tmin = 0.0f;
+    r.tmax = 1e30f;
+    return r;
+}
+
+float luminanceMean(const std::vector<glm::vec3>& img)
+{
+    double s = 0.0;
+    for (const glm::vec3& c : img) s += luminance(c);
+    return float(s / double(img.size()));
+}
+
+} // namespace
+
+class TestRender : public QObject {
+    Q_OBJECT
+
+    QString m_out;
+
+private Q_SLOTS:
+    void initTestCase()
+    {
+        m_out = QString(SYLVA_TEST_OUTPUT) + "/render";
+        QDir().mkpath(m_out);
+    }
+
+    void bvhMatchesBruteForce_data()
+    {
+        QTest::addColumn<QString>("what");
+        QTest::newRow("Tree_1.obj") << "Tree_1";
+        QTest::newRow("Birch_1.obj") << "Birch_1";
+        QTest::newRow("grown birch") << "grown";
+        QTest::newRow("random soup") << "soup";
+    }
+
+    // 100k random rays per mesh: same closest hit (t and triangle) and the same any-hit answer.
+    void bvhMatchesBruteForce()
+    {
+        QFETCH(QString, what);
+        TriangleMesh mesh;
+        if (what == "grown") {
+            GrowOptions g;
+            g.species = TreeSpecies::Birch;
+            g.targetTriangles = 3000;
+            mesh = growTree(g).mesh;
+        } else if (what == "soup") {
+            mesh = randomSoup(3000, 7);
+        } else {
+            const std::string path = std::string(SYLVA_SHARED_DATA) + "/trees/quaternius/OBJ/" + what.toStdString() + ".obj";
+            if (!QFile::exists(QString::fromStdString(path))) QSKIP("shared tree data not present");
+            mesh = importMesh(path);
+        }
+        const size_t triCount = mesh.triangles.size();
+        const Bounds3 bounds = meshBounds(mesh);
+        const Scene scene = sceneFor({InstanceDesc{}});
+        std::vector<SpeciesAssets> assets{assetsFor(std::move(mesh))};
+        const RenderScene rs = buildRenderScene(scene, assets, glm::vec3(1.0f));
+        const RenderView v = rs.view();
+        // The instance lives in the camera-relative frame: move the rays there too.
+        const glm::vec3 cam = glm::vec3(scene.camera.position);
+        std::mt19937 rng(1234);
+        int hits = 0, primMismatch = 0;
+        const int rays = 100000;
+        for (int i = 0; i < rays; ++i) {
+            Ray r = randomRay(rng, bounds);
+            r.org -= cam;
+            uint32_t refPrim;
+            const float ref = bruteForce(v, triCount, r, &refPrim);
+            Hit h{};
+            const bool got = traceScene<false>(v, r, h);
+            QCOMPARE(got, ref >= 0.0f);
+            Hit any{};
+            QCOMPARE(traceScene<true>(v, r, any), ref >= 0.0f);
+            if (!got) continue;
+            ++hits;
+            QVERIFY2(std::fabs(h.t - ref) <= 1e-5f * std::max(1.0f, ref), qPrintable(QString("t %1 vs %2").arg(h.t).arg(ref)));
+            if (h.prim != refPrim) ++primMismatch;   // equal t: two triangles sharing the hit point
+        }
+        QVERIFY(hits > rays / 20);
+        QVERIFY2(primMismatch <= hits / 1000, qPrintable(QString("%1 triangle mismatches").arg(primMismatch)));
+    }
+
+    // Fifty rotated, scaled, translated instances trace exactly like one flattened copy of their triangles.
+    void instancesMatchFlattenedCopy()
+    {
+        GrowOptions g;
+        g.species = TreeSpecies::Shrub;
+        g.targetTriangles = 2000;
+        const TriangleMesh mesh = growTree(g).mesh;
+        std::mt19937 rng(5);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        std::vector<InstanceDesc> instances;
+        for (int i = 0; i < 50; ++i) {
+            InstanceDesc d;
+            d.position = {double(u(rng) * 20.0f - 10.0f), 0.0, double(u(rng) * 20.0f)};
+            d.rotationDeg = {u(rng) * 20.0f - 10.0f, u(rng) * 360.0f, u(rng) * 20.0f - 10.0f};
+            d.scale = 0.5f + u(rng);
+            instances.push_back(d);
+        }
+        Scene inst = sceneFor(instances);
+        // The flattened copy: every instance's triangles in world space, one identity instance.
+        TriangleMesh flat;
+        flat.materials = mesh.materials;
+        for (const InstanceDesc& d : instances) {
+            const InstanceRecord r = makeInstance(d, glm::dvec3(0.0));
+            // Invert world->local numerically: local->world = R s, x = p + (s R) l.
+            const glm::mat3 w2l(glm::vec3(r.row[0].x, r.row[1].x, r.row[2].x), glm::vec3(r.row[0].y, r.row[1].y, r.row[2].y),
+                                glm::vec3(r.row[0].z, r.row[1].z, r.row[2].z));
+            const glm::mat3 l2w = glm::inverse(w2l);
+            const uint32_t base = uint32_t(flat.positions.size());
+            for (const glm::vec3& p : mesh.positions) flat.positions.push_back(l2w * p + glm::vec3(d.position));
+            for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+                flat.triangles.push_back(mesh.triangles[t] + glm::uvec3(base));
+                flat.triangleMaterial.push_back(mesh.triangleMaterial[t]);
+            }
+        }
+        Scene one = sceneFor({InstanceDesc{}});
+        std::vector<SpeciesAssets> a1{assetsFor(mesh)}, a2{assetsFor(flat)};
+        const RenderScene r1 = buildRenderScene(inst, a1, glm::vec3(1.0f));
+        const RenderScene r2 = buildRenderScene(one, a2, glm::vec3(1.0f));
+        const RenderView v1 = r1.view(), v2 = r2.view();
+        int hits = 0;
+        for (int y = 0; y < 120; ++y)
+            for (int x = 0; x < 160; ++x) {
+                RenderView big = v1;
+                big.width = 160;
+                big.height = 120;
+                const Ray r = cameraRay(big, float(x) + 0.5f, float(y) + 0.5f);
+                Hit h1{}, h2{};
+                const bool b1 = traceScene<false>(v1, r, h1), b2 = traceScene<false>(v2, r, h2);
+                if (b1 != b2) {
+                    // Only grazing hits at triangle edges may differ after float transforms.
+                    QVERIFY(std::min(b1 ? h1.t : 1e30f, b2 ? h2.t : 1e30f) < 1e30f);
+                    continue;
+                }
+                if (!b1) continue;
+                ++hits;
+                QVERIFY2(std::fabs(h1.t - h2.t) <= 1e-3f * h1.t, qPrintable(QString("t %1 vs %2").arg(h1.t).arg(h2.t)));
+            }
+        QVERIFY(hits > 1000);
+    }
+
+    // A ray through a transparent texel of a leaf hits what is behind it; through an opaque texel, the leaf.
+    void alphaCutoutLetsRaysThrough()
+    {
+        TriangleMesh m;
+        // Leaf quad at z = 0 (x,y in [-1,1]) with uv = (x+1)/2, wall quad at z = 2.
+        const glm::vec3 q[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+        for (int i = 0; i < 4; ++i) {
+            m.positions.push_back(q[i]);
+            m.uvs.emplace_back((q[i].x + 1.0f) / 2.0f, (q[i].y + 1.0f) / 2.0f);
+        }
+        for (int i = 0; i < 4; ++i) {
+            m.positions.push_back(q[i] + glm::vec3(0, 0, 2));
+            m.uvs.emplace_back(0.0f, 0.0f);
+        }
+        m.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+        m.triangleMaterial = {0, 0, 1, 1};
+        m.materials.resize(2);
+        m.materials[0].isLeaf = true;
+        SpeciesAssets a = assetsFor(m);
+        ImageRgba cut(8, 8, glm::vec4(1.0f));
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 4; ++x) cut.at(x, y)[3] = 0.0f;   // left half transparent
+        a.cutout = {cut, ImageRgba()};
+        Scene s = sceneFor({InstanceDesc{}});
+        s.camera.position = {0.0, 0.0, -5.0};
+        s.camera.target = {0.0, 0.0, 0.0};
+        std::vector<SpeciesAssets> assets{a};
+        const RenderScene rs = buildRenderScene(s, assets, glm::vec3(1.0f));
+        const RenderView v = rs.view();
+        auto shoot = [&](float x, float* t) {
+            Ray r{glm::vec3(x, 0.3f, 0.0f), 0.0f, glm::vec3(0, 0, 1), 1e30f};   // camera-relative: eye at z = -5
+            Hit h{};
+            const bool hit = traceScene<false>(v, r, h);
+            *t = h.t;
+            return hit;
+        };
+        float t = 0;
+        QVERIFY(shoot(-0.5f, &t));
+        QVERIFY(std::fabs(t - 7.0f) < 1e-4f);   // through the leaf to the wall
+        QVERIFY(shoot(0.5f, &t));
+        QVERIFY(std::fabs(t - 5.0f) < 1e-4f);   // the leaf
+        // Shadow rays obey the same cut-out: from between leaf and wall towards the camera side.
+        Ray through{glm::vec3(-0.5f, 0.3f, 6.0f), 0.0f, glm::vec3(0, 0, -1), 1e30f};
+        Ray blocked{glm::vec3(0.5f, 0.3f, 6.0f), 0.0f, glm::vec3(0, 0, -1), 1e30f};
+        Hit h{};
+        QVERIFY(!traceScene<true>(v, through, h));
+        QVERIFY(traceScene<true>(v, blocked, h));
+    }
+
+    // full = local + lb (the film's parts add up); ambient matches the mean luminance of full;
+    // local mode solves no lighting grid; a leaf in the open is brighter than one in shadow.
+    void modesAndStages()
+    {
+        Scene s = smallForest();
+        GridCache cache((m_out + "/cache").toStdString());
+        JobLog log;
+        const RenderOutput out = renderScene(s, &cache, nullptr, &log);
+        const auto full = composeMode(out.film, RenderMode::Full, s.sky);
+        const auto local = composeMode(out.film, RenderMode::Local, s.sky);
+        const auto lb = composeMode(out.film, RenderMode::Lb, s.sky);
+        float ambientConst = 0;
+        const auto ambient = composeMode(out.film, RenderMode::Ambient, s.sky, &ambientConst);
+        for (size_t i = 0; i < full.size(); ++i) {
+            const glm::vec3 sum = local[i] + lb[i] - out.film.pixels[i].skyCover * s.sky;
+            QVERIFY(glm::all(glm::lessThanEqual(glm::abs(full[i] - sum), glm::vec3(1e-5f))));
+        }
+        QVERIFY(ambientConst > 0.0f);
+        QVERIFY(std::fabs(luminanceMean(ambient) - luminanceMean(full)) <= 1e-4f * luminanceMean(full));
+        QVERIFY(luminanceMean(local) < luminanceMean(full));
+
+        s.render.mode = RenderMode::Local;
+        JobLog localLog;
+        renderScene(s, &cache, nullptr, &localLog);
+        for (const std::string& st : localLog.stages) QVERIFY2(st.find("light") == std::string::npos, st.c_str());
+    }
+
+    // Moving the whole scene and camera 1e6 m and 1e7 m from the origin changes no pixel noticeably.
+    void precisionFarFromOrigin()
+    {
+        Scene s = smallForest();
+        s.render.mode = RenderMode::Local;
+        s.render.width = 96;
+        s.render.height = 64;
+        GridCache cache((m_out + "/cache").toStdString());
+        const auto ref = composeMode(renderScene(s, &cache).film, RenderMode::Local, s.sky);
+        for (double shift : {1e6, 1e7}) {
+            Scene far = s;
+            const glm::dvec3 d(shift, 0.0, -shift);
+            for (InstanceDesc& i : far.instances) i.position += d;
+            far.camera.position += d;
+            far.camera.target += d;
+            const auto img = composeMode(renderScene(far, &cache).film, RenderMode::Local, far.sky);
+            int differ = 0;
+            for (size_t i = 0; i < img.size(); ++i)
+                if (glm::any(glm::greaterThan(glm::abs(img[i] - ref[i]), glm::vec3(0.02f)))) ++differ;
+            QVERIFY2(differ <= int(img.size()) / 200, qPrintable(QString("%1 pixels differ at %2 m").arg(differ).arg(shift)));
+        }
+    }
+
+    void goldenImages_data()
+    {
+        QTest::addColumn<int>("mode");
+        for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
+            QTest::newRow(renderModeName(m)) << int(m);
+    }
+
+    // Each mode against its baseline (tests/data/golden). A missing baseline is written and fails;
+    // SYLVA_TEST_UPDATE=1 rewrites baselines. On failure the output and a x16 difference image
+    // are written under the build tree.
+    void goldenImages()
+    {
+        QFETCH(int, mode);
+        Scene s = smallForest();
+        s.render.mode = RenderMode(mode);
+        GridCache cache((m_out + "/cache").toStdString());
+        const RenderOutput out = renderScene(s, &cache);
+        const auto linear = composeMode(out.film, s.render.mode, s.sky);
+        const std::string name = std::string("render_") + renderModeName(s.render.mode) + ".png";
+        const std::string outPath = (m_out + "/").toStdString() + name;
+        const std::string golden = std::string(SYLVA_TEST_DATA) + "/golden/" + name;
+        writeRender(outPath, linear, s.render.width, s.render.height, s.render.exposureKey);
+        if (qEnvironmentVariableIsSet("SYLVA_TEST_UPDATE") || !QFile::exists(QString::fromStdString(golden))) {
+            QDir().mkpath(QString(SYLVA_TEST_DATA) + "/golden");
+            writeRender(golden, linear, s.render.width, s.render.height, s.render.exposureKey);
+            if (!qEnvironmentVariableIsSet("SYLVA_TEST_UPDATE")) QFAIL(("baseline was missing; wrote " + golden).c_str());
+            return;
+        }
+        OIIO::ImageBuf a(outPath), b(golden);
+        // A pixel fails above 0.1 in any channel (25 of 255); the image fails when more than 0.5% of
+        // its pixels fail or its mean error exceeds 0.004 (one 8-bit step).
+        const auto cmp = OIIO::ImageBufAlgo::compare(a, b, 0.1f, 0.05f);
+        const double npx = double(s.render.width * s.render.height);
+        if (cmp.nfail > 0.005 * npx || cmp.meanerror > 0.004) {
+            OIIO::ImageBuf diff = OIIO::ImageBufAlgo::absdiff(a, b);
+            diff = OIIO::ImageBufAlgo::mul(diff, 16.0f);
+            diff.write(outPath + ".diff16.png");
+            QFAIL(qPrintable(QString("%1: %2 failing pixels, mean error %3; see %4")
+                                 .arg(name.c_str())
+                                 .arg(cmp.nfail)
+                                 .arg(cmp.meanerror)
+                                 .arg(QString::fromStdString(outPath))));
+        }
+    }
+
+private:
+    // Three grown trees of two species on the ground, a close camera: small enough for CI.
+    static Scene smallForest()
+    {
+        Scene s;
+        s.species.resize(2);
+        s.species[0].name = "broadleaf";
+        s.species[0].grow = GrowSpec{"broadleaf", 3, 6000, 8.0f};
+        s.species[1].name = "birch";
+        s.species[1].grow = GrowSpec{"birch", 4, 5000, 9.0f};
+        for (SpeciesDesc& sp : s.species) {
+            sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+            sp.grid = 24;
+        }
+        InstanceDesc a, b, c;
+        a.position = {-3.0, 0.0, 4.0};
+        b.species = 1;
+        b.position = {3.0, 0.0, 6.0};
+        b.rotationDeg = {0.0f, 40.0f, 0.0f};
+        c.position = {0.0, 0.0, 12.0};
+        c.scale = 1.2f;
+        c.rotationDeg = {0.0f, 200.0f, 0.0f};
+        s.instances = {a, b, c};
+        s.camera.position = {0.0, 3.0, -9.0};
+        s.camera.target = {0.0, 4.0, 6.0};
+        s.sun.direction = sunDirection(40.0, 120.0);
+        s.render.width = 120;
+        s.render.height = 80;
+        s.render.spp = 4;
+        return s;
+    }
+};
+
+QTEST_GUILESS_MAIN(TestRender)
+#include "tst_render.moc"
