@@ -175,7 +175,7 @@ std::vector<Command> commands()
                      {"--stats", "", "print timings and acceleration structure sizes"},
                      kOutput, kCache, kNoCache, kThreads, kQuiet},
                     0, 1});
-    list.push_back({"info", "FILE", "print what a mesh, grid (.npy) or cache file holds", {}, 1, 1});
+    list.push_back({"info", "FILE", "print what a scene (.json), mesh, grid (.npy) or cache file holds", {}, 1, 1});
     return list;
 }
 
@@ -574,9 +574,14 @@ int cmdInfo(const Args& args)
         return kOk;
     }
     const std::string ext = lowerExtension(path);
+    if (ext == ".json" && path.size() > 11 && path.substr(path.size() - 11) != ".npy.json") {
+        const Scene scene = readSceneFile(path);
+        std::printf("%s: scene\n%s", path.c_str(), describeScene(scene).c_str());
+        return kOk;
+    }
     for (const char* notMesh : {".json", ".png", ".jpg", ".jpeg", ".tif", ".tiff", ".exr", ".txt", ".mtl"})
         if (ext == notMesh)
-            throw Error(path + ": not a mesh, .npy grid or cache entry (sylva info reads those; a .npy.json sidecar is "
+            throw Error(path + ": not a scene, mesh, .npy grid or cache entry (sylva info reads those; a .npy.json sidecar is "
                                "shown with its .npy)");
     ImportReport report;
     TriangleMesh mesh;

@@ -64,6 +64,11 @@ private Q_SLOTS:
         QTest::newRow("grid with density") << QStringList{"light", "--density", "x.npy", "--grid", "8", "--sun", "0,1,0", "-o", "y.npy"} << "applies to --mesh";
         QTest::newRow("bad axis") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "-o", "y.npy", "--picture", "p.png", "--axis", "w"} << "expected x, y or z";
         QTest::newRow("picture without extension") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "-o", "y.npy", "--picture", "pic"} << "image extension";
+        QTest::newRow("render bad mode") << QStringList{"render", "--mode", "sketch"} << "expected full, local, ambient or lb";
+        QTest::newRow("render bad accel") << QStringList{"render", "--accel", "octree"} << "expected bvh or kdtree";
+        QTest::newRow("render bad spp") << QStringList{"render", "--spp", "0"} << "outside [1, 4096]";
+        QTest::newRow("render bad extension") << QStringList{"render", "-o", "forest.jpg2"} << "unknown image extension";
+        QTest::newRow("render two scenes") << QStringList{"render", "a.json", "b.json"} << "unexpected argument 'b.json'";
         QTest::newRow("steps and tol") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "--steps", "5", "--tol", "1e-3", "-o", "y"} << "exclude each other";
     }
     void usageErrorsExitTwo()
@@ -77,7 +82,7 @@ private Q_SLOTS:
 
     void helpExitsZero()
     {
-        for (const QString cmd : {"grow", "voxelize", "light", "info"}) {
+        for (const QString cmd : {"grow", "voxelize", "light", "render", "info"}) {
             const Run r = runSylva({cmd, "--help"});
             QCOMPARE(r.code, 0);
             QVERIFY(r.out.contains("usage: sylva " + cmd));
@@ -140,6 +145,49 @@ private Q_SLOTS:
         r = runSylva({"light", "--density", QString::fromStdString(badPath), "--sun", "0,1,0", "--no-cache", "-o", dir + "/l.npy"});
         QCOMPARE(r.code, 1);
         QVERIFY2(r.err.contains(QString::fromStdString(badPath)) && r.err.contains("outside [0, 1]"), qPrintable(r.err));
+    }
+
+    // A small scene file renders to PNG and EXR at the size asked; sylva info reads it; a broken
+    // scene is an error naming the file and the key, with exit code 1 and no output file.
+    void renderSceneFile()
+    {
+        const QString dir = outDir() + "/render";
+        QDir(dir).removeRecursively();
+        QDir().mkpath(dir);
+        const QString scene = dir + "/small.sylva.json";
+        QFile f(scene);
+        QVERIFY(f.open(QIODevice::WriteOnly));
+        f.write(R"({"version": 1,
+          "species": [{"name": "shrub", "grow": {"species": "shrub", "seed": 2, "triangles": 3000},
+                       "lighting": {"grid": 16}}],
+          "instances": [{"species": "shrub", "position": [0, 0, 0]}, {"species": "shrub", "position": [2, 0, 1], "rotation": 90}],
+          "camera": {"position": [0, 1.5, -6], "target": [0, 0.8, 0], "fov": 40}})");
+        f.close();
+        const QString cache = dir + "/cache";
+        Run r = runSylva({"render", scene, "--width", "48", "--height", "32", "-o", dir + "/small.png", "--quiet"}, cache);
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QVERIFY(r.out.contains("rendered 48x32"));
+        QVERIFY(QFileInfo(dir + "/small.png").size() > 100);
+        r = runSylva({"render", scene, "--width", "40", "--height", "20", "--mode", "lb", "-o", dir + "/small.exr", "--quiet"}, cache);
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QVERIFY(QFileInfo(dir + "/small.exr").exists());
+        r = runSylva({"info", scene});
+        QCOMPARE(r.code, 0);
+        QVERIFY2(r.out.contains("shrub"), qPrintable(r.out));
+
+        const QString broken = dir + "/broken.sylva.json";
+        QFile b(broken);
+        QVERIFY(b.open(QIODevice::WriteOnly));
+        b.write(R"({"version": 1, "species": [{"name": "s", "grow": {"species": "shrub"}}],
+                    "instances": [{"species": "s", "position": [0, 0, 0], "scale": -1}]})");
+        b.close();
+        r = runSylva({"render", broken, "-o", dir + "/broken.png", "--quiet"}, cache);
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains("broken.sylva.json") && r.err.contains("scale"), qPrintable(r.err));
+        QVERIFY(!QFileInfo::exists(dir + "/broken.png"));
+        r = runSylva({"render", dir + "/missing.sylva.json", "--quiet"}, cache);
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains("missing.sylva.json"), qPrintable(r.err));
     }
 
     void growVoxelizeLightInfo()
