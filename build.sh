@@ -13,7 +13,7 @@ JOBS="${SYLVA_JOBS:-$(nproc)}"
 PACKAGES=(cmake ninja-build ccache g++ pkg-config
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev
   libassimp-dev libopenmesh-dev libopenimageio-dev openimageio-tools libopencv-core-dev
-  libglm-dev libtbb-dev)
+  libglm-dev libtbb-dev libembree-dev)
 
 install_missing() {
   local missing=()

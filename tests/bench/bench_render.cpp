@@ -1,0 +1,665 @@
+// Renderer benchmark on the default forest: full frame, primary and shadow ray throughput, side by side with Embree 3 on the same geometry.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+
+#include "core/render/render_cpu.h"
+#include "core/render/render_scene.h"
+#include "core/render/shade.h"
+#include "core/render/trace.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/render/render_job.h"
+
+#ifdef SYLVA_HAVE_EMBREE
+#include <embree3/rtcore.h>
+#endif
+
+using namespace sylva;
+
+namespace {
+
+double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+
+// Median and minimum of repeated timings, seconds.
+struct Timing {
+    double median = 0.0, min = 0.0;
+};
+
+template <class F>
+Timing timeReps(int reps, F&& f)
+{
+    std::vector<double> t;
+    for (int r = 0; r < reps; ++r) {
+        const double t0 = now();
+        f();
+        t.push_back(now() - t0);
+    }
+    std::sort(t.begin(), t.end());
+    return {t[t.size() / 2], t.front()};
+}
+
+// The renderer's schedule: oneTBB over 8x8 pixel tiles, 4 tiles per task. f(x0, y0, x1, y1).
+template <class F>
+void forTiles(int width, int height, F&& f)
+{
+    constexpr int kTile = 8;
+    const int tilesX = (width + kTile - 1) / kTile, tilesY = (height + kTile - 1) / kTile;
+    tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 4), [&](const tbb::blocked_range<int>& r) {
+        for (int tile = r.begin(); tile < r.end(); ++tile) {
+            const int x0 = (tile % tilesX) * kTile, y0 = (tile / tilesX) * kTile;
+            f(x0, y0, std::min(x0 + kTile, width), std::min(y0 + kTile, height));
+        }
+    });
+}
+
+// What a primary ray saw, for comparing tracers: instance index (kGroundPrim = ground, kNoHit = sky) and t. 8 bytes.
+struct PrimaryResult {
+    uint32_t inst;
+    float t;
+};
+
+// The shadow ray shadeRay casts for a hit (offset off the face-forwarded normal, toward the sun).
+// Returns false where shadeRay casts none (sky, surface facing away from the sun, shadows off).
+bool shadowRayFor(const RenderView& v, const Ray& ray, const Hit& hit, Ray& out)
+{
+    if (!v.shadows || hit.prim == kNoHit) return false;
+    const glm::vec3 p = ray.org + hit.t * ray.dir;
+    glm::vec3 ng;
+    if (hit.prim == kGroundPrim) {
+        ng = glm::vec3(0.0f, ray.dir.y < 0.0f ? 1.0f : -1.0f, 0.0f);
+    } else {
+        const InstanceRecord& in = v.instances[hit.inst];
+        const glm::uvec3 tv = v.triVerts[hit.prim];
+        const float b0 = 1.0f - hit.u - hit.v;
+        const glm::vec3 ns = b0 * v.normals[tv.x] + hit.u * v.normals[tv.y] + hit.v * v.normals[tv.z];
+        ng = glm::normalize(toWorldNormal(in, ns));
+        if (!(glm::dot(ng, ng) > 0.5f)) ng = glm::vec3(0.0f, 1.0f, 0.0f);
+        if (glm::dot(ng, -ray.dir) < 0.0f) ng = -ng;
+    }
+    if (!(glm::dot(ng, v.sunDir) > 0.0f)) return false;
+    out = Ray{offsetPoint(p, ng), 0.0f, v.sunDir, 1e30f};
+    return true;
+}
+
+Ray pixelRay(const RenderView& v, int x, int y) { return cameraRay(v, float(x) + 0.5f, float(y) + 0.5f); }
+
+// Primary results that differ: other instance (or sky / ground), or t off by more than 1e-3 relative.
+[[maybe_unused]] size_t primaryMismatches(const std::vector<PrimaryResult>& a, const std::vector<PrimaryResult>& b)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < a.size(); ++i) {
+        if (a[i].inst != b[i].inst) ++n;
+        else if (a[i].inst != kNoHit && std::fabs(a[i].t - b[i].t) > 1e-3f * std::max(a[i].t, b[i].t)) ++n;
+    }
+    return n;
+}
+
+[[maybe_unused]] size_t shadowMismatches(const std::vector<uint8_t>& a, const std::vector<uint8_t>& b)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < a.size(); ++i) n += a[i] != b[i];
+    return n;
+}
+
+double mrays(size_t rays, double seconds) { return double(rays) / seconds / 1e6; }
+
+#ifdef SYLVA_HAVE_EMBREE
+
+// Bytes Embree holds, summed through its memory monitor.
+std::atomic<long long> g_embreeBytes{0};
+
+bool embreeMemoryMonitor(void*, ssize_t bytes, bool)
+{
+    g_embreeBytes.fetch_add(bytes, std::memory_order_relaxed);
+    return true;
+}
+
+void embreeError(void*, RTCError code, const char* message)
+{
+    std::fprintf(stderr, "embree error %d: %s\n", int(code), message ? message : "");
+}
+
+// User data of one Embree triangle geometry: its primID -> slot in RenderView::tris.
+struct EmbreeGeomData {
+    const RenderView* view;
+    std::vector<uint32_t> slots;
+};
+
+// Intersection and occlusion filter of the alpha-tested geometries: trace.h's alphaOpaque on the hit's uv.
+void embreeAlphaFilter(const RTCFilterFunctionNArguments* args)
+{
+    const EmbreeGeomData& g = *static_cast<const EmbreeGeomData*>(args->geometryUserPtr);
+    const RenderView& v = *g.view;
+    for (unsigned i = 0; i < args->N; ++i) {
+        if (args->valid[i] != -1) continue;
+        const TriAccel& tri = v.tris[g.slots[RTCHitN_primID(args->hit, args->N, i)]];
+        const glm::vec2 uv = triangleUv(v, tri.tri, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
+        if (!alphaOpaque(v, tri.alpha - 1u, uv)) args->valid[i] = 0;
+    }
+}
+
+// The same instanced geometry in Embree: per species an opaque and an alpha-tested triangle geometry
+// (unshared vertices v0, v0 + e1, v0 + e2 from the TriAccels), per instance an instance of its species'
+// scene with local -> world = the inverse of the InstanceRecord (computed in double), camera-relative.
+struct EmbreePeer {
+    RTCDevice device = nullptr;
+    RTCScene top = nullptr;
+    std::vector<RTCScene> species;
+    std::vector<std::unique_ptr<EmbreeGeomData>> geomData;
+    double speciesBuildSeconds = 0.0, topBuildSeconds = 0.0;
+    long long speciesBytes = 0, topBytes = 0;
+
+    EmbreePeer(const RenderScene& rs, const RenderView& v, int threads, RTCBuildQuality quality)
+    {
+        const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+        device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
+        if (!device) throw std::runtime_error("rtcNewDevice failed");
+        rtcSetDeviceErrorFunction(device, embreeError, nullptr);
+        rtcSetDeviceMemoryMonitorFunction(device, embreeMemoryMonitor, nullptr);
+        const long long base = g_embreeBytes.load();
+
+        double t0 = now();
+        for (size_t s = 0; s < rs.species.size(); ++s) {
+            const uint32_t first = rs.species[s].triOffset;
+            const uint32_t last = s + 1 < rs.species.size() ? rs.species[s + 1].triOffset : uint32_t(rs.tris.size());
+            RTCScene scene = rtcNewScene(device);
+            rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
+            rtcSetSceneBuildQuality(scene, quality);
+            for (int alpha = 0; alpha < 2; ++alpha) {
+                auto data = std::make_unique<EmbreeGeomData>();
+                data->view = &v;
+                for (uint32_t slot = first; slot < last; ++slot)
+                    if ((rs.tris[slot].alpha != 0u) == (alpha == 1)) data->slots.push_back(slot);
+                if (data->slots.empty()) continue;
+                const size_t n = data->slots.size();
+                RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+                rtcSetGeometryBuildQuality(geom, quality);
+                auto* vb = static_cast<float*>(
+                    rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
+                auto* ib = static_cast<uint32_t*>(
+                    rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), n));
+                for (size_t k = 0; k < n; ++k) {
+                    const TriAccel& t = rs.tris[data->slots[k]];
+                    const glm::vec3 p[3] = {t.v0, t.v0 + t.e1, t.v0 + t.e2};
+                    for (int c = 0; c < 3; ++c) {
+                        vb[(3 * k + size_t(c)) * 3 + 0] = p[c].x;
+                        vb[(3 * k + size_t(c)) * 3 + 1] = p[c].y;
+                        vb[(3 * k + size_t(c)) * 3 + 2] = p[c].z;
+                        ib[3 * k + size_t(c)] = uint32_t(3 * k + size_t(c));
+                    }
+                }
+                rtcSetGeometryUserData(geom, data.get());
+                if (alpha) {
+                    rtcSetGeometryIntersectFilterFunction(geom, embreeAlphaFilter);
+                    rtcSetGeometryOccludedFilterFunction(geom, embreeAlphaFilter);
+                }
+                rtcCommitGeometry(geom);
+                rtcAttachGeometryByID(scene, geom, unsigned(alpha));
+                rtcReleaseGeometry(geom);
+                geomData.push_back(std::move(data));
+            }
+            rtcCommitScene(scene);
+            species.push_back(scene);
+        }
+        speciesBuildSeconds = now() - t0;
+        speciesBytes = g_embreeBytes.load() - base;
+
+        t0 = now();
+        top = rtcNewScene(device);
+        rtcSetSceneFlags(top, RTC_SCENE_FLAG_NONE);
+        rtcSetSceneBuildQuality(top, quality);
+        for (size_t i = 0; i < rs.instances.size(); ++i) {
+            const InstanceRecord& in = rs.instances[i];
+            // world -> local is local = A world + b; local -> world is world = A^-1 (local - b).
+            glm::dmat3 a;   // column-major: a[col][row]
+            glm::dvec3 b;
+            for (int r = 0; r < 3; ++r) {
+                for (int c = 0; c < 3; ++c) a[c][r] = double(in.row[r][c]);
+                b[r] = double(in.row[r].w);
+            }
+            const glm::dmat3 ai = glm::inverse(a);
+            const glm::dvec3 ti = -(ai * b);
+            float xfm[12];   // RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR: three linear columns, then the translation
+            for (int c = 0; c < 3; ++c)
+                for (int r = 0; r < 3; ++r) xfm[c * 3 + r] = float(ai[c][r]);
+            for (int r = 0; r < 3; ++r) xfm[9 + r] = float(ti[r]);
+            RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+            rtcSetGeometryInstancedScene(geom, species[in.species]);
+            rtcSetGeometryTimeStepCount(geom, 1);
+            rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+            rtcCommitGeometry(geom);
+            rtcAttachGeometryByID(top, geom, unsigned(i));
+            rtcReleaseGeometry(geom);
+        }
+        rtcCommitScene(top);
+        topBuildSeconds = now() - t0;
+        topBytes = g_embreeBytes.load() - base - speciesBytes;
+    }
+
+    ~EmbreePeer()
+    {
+        if (top) rtcReleaseScene(top);
+        for (RTCScene s : species) rtcReleaseScene(s);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+// Closest hit of one ray, the ground tested analytically outside Embree exactly as traceBvh does.
+SYLVA_INLINE PrimaryResult embreePrimary1(RTCScene scene, const RenderView& v, const Ray& ray)
+{
+    PrimaryResult res{kNoHit, 0.0f};
+    float tmax = ray.tmax;
+    if (v.groundEnabled && ray.dir.y != 0.0f) {
+        const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+        if (tg > ray.tmin && tg < tmax) {
+            tmax = tg;
+            res = {kGroundPrim, tg};
+        }
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRayHit rh;
+    rh.ray.org_x = ray.org.x;
+    rh.ray.org_y = ray.org.y;
+    rh.ray.org_z = ray.org.z;
+    rh.ray.tnear = ray.tmin;
+    rh.ray.dir_x = ray.dir.x;
+    rh.ray.dir_y = ray.dir.y;
+    rh.ray.dir_z = ray.dir.z;
+    rh.ray.time = 0.0f;
+    rh.ray.tfar = tmax;
+    rh.ray.mask = 0xffffffffu;
+    rh.ray.id = 0;
+    rh.ray.flags = 0;
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    rtcIntersect1(scene, &ctx, &rh);
+    if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) res = {rh.hit.instID[0], rh.ray.tfar};
+    return res;
+}
+
+SYLVA_INLINE bool embreeOccluded1(RTCScene scene, const RenderView& v, const Ray& ray)
+{
+    if (v.groundEnabled && ray.dir.y != 0.0f) {
+        const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+        if (tg > ray.tmin && tg < ray.tmax) return true;
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    RTCRay r;
+    r.org_x = ray.org.x;
+    r.org_y = ray.org.y;
+    r.org_z = ray.org.z;
+    r.tnear = ray.tmin;
+    r.dir_x = ray.dir.x;
+    r.dir_y = ray.dir.y;
+    r.dir_z = ray.dir.z;
+    r.time = 0.0f;
+    r.tfar = ray.tmax;
+    r.mask = 0xffffffffu;
+    r.id = 0;
+    r.flags = 0;
+    rtcOccluded1(scene, &ctx, &r);
+    return r.tfar < 0.0f;
+}
+
+// Up to 8 rays of a tile row as one packet (lanes past `count` or with active[k] false are off).
+void embreePrimary8(RTCScene scene, const RenderView& v, const Ray* rays, int count, PrimaryResult* out)
+{
+    alignas(32) int valid[8];
+    alignas(32) RTCRayHit8 rh;
+    PrimaryResult ground[8];
+    for (int k = 0; k < 8; ++k) {
+        valid[k] = k < count ? -1 : 0;
+        const Ray& ray = rays[k < count ? k : 0];
+        float tmax = ray.tmax;
+        ground[k] = {kNoHit, 0.0f};
+        if (v.groundEnabled && ray.dir.y != 0.0f) {
+            const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+            if (tg > ray.tmin && tg < tmax) {
+                tmax = tg;
+                ground[k] = {kGroundPrim, tg};
+            }
+        }
+        rh.ray.org_x[k] = ray.org.x;
+        rh.ray.org_y[k] = ray.org.y;
+        rh.ray.org_z[k] = ray.org.z;
+        rh.ray.tnear[k] = ray.tmin;
+        rh.ray.dir_x[k] = ray.dir.x;
+        rh.ray.dir_y[k] = ray.dir.y;
+        rh.ray.dir_z[k] = ray.dir.z;
+        rh.ray.time[k] = 0.0f;
+        rh.ray.tfar[k] = tmax;
+        rh.ray.mask[k] = 0xffffffffu;
+        rh.ray.id[k] = unsigned(k);
+        rh.ray.flags[k] = 0;
+        rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][k] = RTC_INVALID_GEOMETRY_ID;
+    }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect8(valid, scene, &ctx, &rh);
+    for (int k = 0; k < count; ++k)
+        out[k] = rh.hit.geomID[k] != RTC_INVALID_GEOMETRY_ID ? PrimaryResult{rh.hit.instID[0][k], rh.ray.tfar[k]} : ground[k];
+}
+
+void embreeOccluded8(RTCScene scene, const RenderView& v, const Ray* rays, const uint8_t* active, int count, uint8_t* out)
+{
+    alignas(32) int valid[8];
+    alignas(32) RTCRay8 r;
+    bool any = false;
+    for (int k = 0; k < 8; ++k) {
+        valid[k] = 0;
+        if (k >= count || !active[k]) continue;
+        const Ray& ray = rays[k];
+        out[k] = 0;
+        if (v.groundEnabled && ray.dir.y != 0.0f) {
+            const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+            if (tg > ray.tmin && tg < ray.tmax) {
+                out[k] = 1;
+                continue;
+            }
+        }
+        valid[k] = -1;
+        any = true;
+        r.org_x[k] = ray.org.x;
+        r.org_y[k] = ray.org.y;
+        r.org_z[k] = ray.org.z;
+        r.tnear[k] = ray.tmin;
+        r.dir_x[k] = ray.dir.x;
+        r.dir_y[k] = ray.dir.y;
+        r.dir_z[k] = ray.dir.z;
+        r.time[k] = 0.0f;
+        r.tfar[k] = ray.tmax;
+        r.mask[k] = 0xffffffffu;
+        r.id[k] = unsigned(k);
+        r.flags[k] = 0;
+    }
+    if (!any) return;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    rtcOccluded8(valid, scene, &ctx, &r);
+    for (int k = 0; k < count; ++k)
+        if (valid[k] == -1) out[k] = r.tfar[k] < 0.0f ? 1 : 0;
+}
+
+#endif // SYLVA_HAVE_EMBREE
+
+int usage(int rc)
+{
+    std::printf("usage: bench_render [--reps N] [--threads N] [--width W] [--height H] [--accel bvh|kdtree]\n"
+                "                    [--no-embree] [--embree-quality medium|high]\n");
+    return rc;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    int reps = 5, threads = 0, width = 0, height = 0;
+    AccelKind accel = AccelKind::Bvh;
+    bool useEmbree = true, highQuality = true;
+    for (int a = 1; a < argc; ++a) {
+        const std::string s = argv[a];
+        const bool more = a + 1 < argc;
+        if (s == "--reps" && more) reps = std::max(1, std::atoi(argv[++a]));
+        else if (s == "--threads" && more) threads = std::max(1, std::atoi(argv[++a]));
+        else if (s == "--width" && more) width = std::max(1, std::atoi(argv[++a]));
+        else if (s == "--height" && more) height = std::max(1, std::atoi(argv[++a]));
+        else if (s == "--accel" && more) {
+            if (!parseAccel(argv[++a], &accel)) return usage(2);
+        } else if (s == "--no-embree") useEmbree = false;
+        else if (s == "--embree-quality" && more) {
+            const std::string q = argv[++a];
+            if (q != "medium" && q != "high") return usage(2);
+            highQuality = q == "high";
+        } else return usage(s == "--help" ? 0 : 2);
+    }
+    std::unique_ptr<tbb::global_control> limit;
+    if (threads > 0) limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
+    const int threadsUsed = int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+
+    // The default forest, its assets through the grid cache (reruns load the lighting grids from disk).
+    Scene scene = defaultScene();
+    if (width > 0) scene.render.width = width;
+    if (height > 0) scene.render.height = height;
+    GridCache cache;
+    double t0 = now();
+    const std::vector<SpeciesAssets> assets = loadSpeciesAssets(scene, &cache, true);
+    const double assetSeconds = now() - t0;
+    t0 = now();
+    const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
+    const double buildSeconds = now() - t0;
+    RenderView v = rs.view();
+    v.accel = accel;
+    if (accel == AccelKind::KdTree && v.kdTlas == nullptr) {
+        std::printf("note: the kd-tree is not built by buildRenderScene yet; reporting the BVH\n");
+        v.accel = AccelKind::Bvh;
+    }
+    const int W = v.width, H = v.height;
+    const size_t pixels = size_t(W) * size_t(H);
+    const AccelStats& st = rs.stats();
+    const double ourBytes = double(st.tlasBytes + st.instanceBytes + st.blasBytes + st.triangleBytes);
+    std::printf("render benchmark: default forest, %dx%d, %d spp, shadows %s, accel %s, %d threads, %d reps (median / min)\n",
+                W, H, v.spp, v.shadows ? "on" : "off", accelName(v.accel), threadsUsed, reps);
+    size_t alphaTris = 0;
+    for (const TriAccel& t : rs.tris) alphaTris += t.alpha != 0u;
+    std::printf("scene: %zu species, %zu instances, %zu species triangles (%.1f%% alpha-tested), %.0f instanced triangles; "
+                "assets %.2f s (cache %s)\n",
+                rs.species.size(), st.instances, st.speciesTriangles, 100.0 * double(alphaTris) / double(rs.tris.size()),
+                st.instancedTriangles, assetSeconds, cache.dir().c_str());
+
+    // (a) the full frame, as `sylva render` traces it.
+    const Timing frame = timeReps(reps, [&] { (void)renderFilm(v); });
+    std::printf("\n%-40s %10.4f s  %10.4f s   (target 0.25 s on 2 cores)\n", "full frame (renderFilm)", frame.median, frame.min);
+
+    // Our primary hits (an untimed pass that also warms the caches) and the shadow rays shadeRay would cast from them.
+    std::vector<Hit> hits(pixels);
+    std::vector<PrimaryResult> ours(pixels);
+    auto oursPrimaryPass = [&] {
+        forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+            for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x) {
+                    const size_t i = size_t(y) * size_t(W) + size_t(x);
+                    Hit h{};
+                    traceScene<false>(v, pixelRay(v, x, y), h);
+                    hits[i] = h;
+                    ours[i] = {h.prim == kGroundPrim ? kGroundPrim : (h.prim == kNoHit ? kNoHit : h.inst), h.t};
+                }
+        });
+    };
+    oursPrimaryPass();
+    std::vector<Ray> shadowRays(pixels);
+    std::vector<uint8_t> shadowActive(pixels, 0), oursOccluded(pixels, 0);
+    size_t shadowCount = 0, skyCount = 0, groundCount = 0;
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            const size_t i = size_t(y) * size_t(W) + size_t(x);
+            shadowActive[i] = shadowRayFor(v, pixelRay(v, x, y), hits[i], shadowRays[i]) ? 1 : 0;
+            shadowCount += shadowActive[i];
+            skyCount += ours[i].inst == kNoHit;
+            groundCount += ours[i].inst == kGroundPrim;
+        }
+    auto oursShadowPass = [&] {
+        forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+            for (int y = y0; y < y1; ++y)
+                for (int x = x0; x < x1; ++x) {
+                    const size_t i = size_t(y) * size_t(W) + size_t(x);
+                    if (!shadowActive[i]) continue;
+                    Hit h{};
+                    oursOccluded[i] = traceScene<true>(v, shadowRays[i], h) ? 1 : 0;
+                }
+        });
+    };
+
+    // The passes to time: (b) primary and (c) shadow rays, ours and (d) Embree's, interleaved rep by rep so
+    // that load from other processes on a shared machine falls on every pass alike.
+    struct Pass {
+        std::string name;
+        std::function<void()> run;
+        size_t rays;
+        Timing timing;
+    };
+    std::vector<Pass> passes;
+    passes.push_back({"ours primary (traceScene<false>)", oursPrimaryPass, pixels, {}});
+    passes.push_back({"ours shadow (traceScene<true>)", oursShadowPass, shadowCount, {}});
+
+    double emBuild = 0.0, emTopBuild = 0.0;
+    long long emBytes = 0, emTopBytes = 0;
+    bool ranEmbree = false;
+#ifdef SYLVA_HAVE_EMBREE
+    std::unique_ptr<EmbreePeer> peer;
+    std::vector<PrimaryResult> em(pixels), em8(pixels);
+    std::vector<uint8_t> emOcc(pixels, 0), em8Occ(pixels, 0);
+    if (useEmbree) {
+        peer = std::make_unique<EmbreePeer>(rs, v, threads, highQuality ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
+        emBuild = peer->speciesBuildSeconds;
+        emTopBuild = peer->topBuildSeconds;
+        emBytes = peer->speciesBytes + peer->topBytes;
+        emTopBytes = peer->topBytes;
+        ranEmbree = true;
+        const RTCScene es = peer->top;
+        passes.push_back({"embree primary (rtcIntersect1)", [&, es] {
+                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+                                  for (int y = y0; y < y1; ++y)
+                                      for (int x = x0; x < x1; ++x)
+                                          em[size_t(y) * size_t(W) + size_t(x)] = embreePrimary1(es, v, pixelRay(v, x, y));
+                              });
+                          },
+                          pixels, {}});
+        passes.push_back({"embree shadow (rtcOccluded1)", [&, es] {
+                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+                                  for (int y = y0; y < y1; ++y)
+                                      for (int x = x0; x < x1; ++x) {
+                                          const size_t i = size_t(y) * size_t(W) + size_t(x);
+                                          if (shadowActive[i]) emOcc[i] = embreeOccluded1(es, v, shadowRays[i]) ? 1 : 0;
+                                      }
+                              });
+                          },
+                          shadowCount, {}});
+        passes.push_back({"embree primary (rtcIntersect8, 8x1)", [&, es] {
+                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+                                  Ray rays[8];
+                                  for (int y = y0; y < y1; ++y)
+                                      for (int x = x0; x < x1; x += 8) {
+                                          const int n = std::min(8, x1 - x);
+                                          for (int k = 0; k < n; ++k) rays[k] = pixelRay(v, x + k, y);
+                                          embreePrimary8(es, v, rays, n, &em8[size_t(y) * size_t(W) + size_t(x)]);
+                                      }
+                              });
+                          },
+                          pixels, {}});
+        passes.push_back({"embree shadow (rtcOccluded8, 8x1)", [&, es] {
+                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+                                  for (int y = y0; y < y1; ++y)
+                                      for (int x = x0; x < x1; x += 8) {
+                                          const size_t i = size_t(y) * size_t(W) + size_t(x);
+                                          embreeOccluded8(es, v, &shadowRays[i], &shadowActive[i], std::min(8, x1 - x), &em8Occ[i]);
+                                      }
+                              });
+                          },
+                          shadowCount, {}});
+        passes[2].run();   // warm Embree's structures as ours were warmed
+        passes[3].run();
+    }
+#else
+    (void)highQuality;
+#endif
+
+    std::vector<std::vector<double>> seconds(passes.size());
+    for (int r = 0; r < reps; ++r)
+        for (size_t p = 0; p < passes.size(); ++p) {
+            const double s0 = now();
+            passes[p].run();
+            seconds[p].push_back(now() - s0);
+        }
+    for (size_t p = 0; p < passes.size(); ++p) {
+        std::sort(seconds[p].begin(), seconds[p].end());
+        passes[p].timing = {seconds[p][seconds[p].size() / 2], seconds[p].front()};
+    }
+
+    size_t occluded = 0;
+    for (uint8_t o : oursOccluded) occluded += o;
+    std::printf("primary rays: %zu (%.1f%% sky, %.1f%% ground); shadow rays: %zu (%.1f%% occluded)\n", pixels,
+                100.0 * double(skyCount) / double(pixels), 100.0 * double(groundCount) / double(pixels), shadowCount,
+                100.0 * double(occluded) / double(std::max<size_t>(1, shadowCount)));
+    std::printf("\n%-40s %12s %12s\n", "rays (Mrays/s), passes interleaved", "median", "best");
+    for (const Pass& p : passes)
+        std::printf("%-40s %12.2f %12.2f\n", p.name.c_str(), mrays(p.rays, p.timing.median), mrays(p.rays, p.timing.min));
+    const double ourPrimary = mrays(pixels, passes[0].timing.median), ourShadow = mrays(shadowCount, passes[1].timing.median);
+
+    double emPrimary = 0.0, emShadow = 0.0, emPrimary8 = 0.0, emShadow8 = 0.0;
+    double emPrimaryMismatch = 0.0, emShadowMismatch = 0.0;
+#ifdef SYLVA_HAVE_EMBREE
+    if (ranEmbree) {
+        emPrimary = mrays(pixels, passes[2].timing.median);
+        emShadow = mrays(shadowCount, passes[3].timing.median);
+        emPrimary8 = mrays(pixels, passes[4].timing.median);
+        emShadow8 = mrays(shadowCount, passes[5].timing.median);
+        std::printf("%-40s %12.2f %12.2f\n", "ratio ours / embree primary (single)", ourPrimary / emPrimary,
+                    passes[2].timing.min / passes[0].timing.min);
+        std::printf("%-40s %12.2f %12.2f\n", "ratio ours / embree shadow (single)", ourShadow / emShadow,
+                    passes[3].timing.min / passes[1].timing.min);
+
+        const size_t pm = primaryMismatches(ours, em), pm8 = primaryMismatches(ours, em8);
+        const size_t sm = shadowMismatches(oursOccluded, emOcc), sm8 = shadowMismatches(oursOccluded, em8Occ);
+        const double shadows = double(std::max<size_t>(1, shadowCount));
+        emPrimaryMismatch = double(pm) / double(pixels);
+        emShadowMismatch = double(sm) / shadows;
+        std::printf("\ncorrectness vs ours: primary hits differing (instance, or t > 1e-3 relative): %zu single (%.4f%%), %zu packet "
+                    "(%.4f%%); shadow rays differing: %zu single (%.4f%%), %zu packet (%.4f%%)\n",
+                    pm, 100.0 * emPrimaryMismatch, pm8, 100.0 * double(pm8) / double(pixels), sm, 100.0 * emShadowMismatch, sm8,
+                    100.0 * double(sm8) / shadows);
+        std::printf("embree setup: %s build quality on species and top scenes, RTC_SCENE_FLAG_NONE (robust off), "
+                    "per species an opaque and an alpha-filtered triangle geometry, ground plane analytic outside "
+                    "Embree (as ours), 8-wide packets %s\n",
+                    highQuality ? "HIGH" : "MEDIUM",
+                    rtcGetDeviceProperty(peer->device, RTC_DEVICE_PROPERTY_NATIVE_RAY8_SUPPORTED) ? "native" : "emulated");
+    }
+#else
+    if (useEmbree) std::printf("\nembree: peer missing (built without Embree 3; apt-get install libembree-dev and reconfigure)\n");
+#endif
+
+    std::printf("\n%-40s %12s %14s %14s\n", "build and memory", "build s", "B/inst. tri", "B/instance");
+    std::printf("%-40s %12.3f %14.4f %14.1f\n", "ours (buildRenderScene, all arrays)", buildSeconds,
+                ourBytes / std::max(1.0, st.instancedTriangles),
+                double(st.tlasBytes + st.instanceBytes) / double(std::max<size_t>(1, st.instances)));
+    if (ranEmbree)
+        std::printf("%-40s %12.3f %14.4f %14.1f   (species %.3f s + top %.3f s; %.1f MB by memory monitor)\n",
+                    "embree (species scenes + instances)", emBuild + emTopBuild, double(emBytes) / std::max(1.0, st.instancedTriangles),
+                    double(emTopBytes) / double(std::max<size_t>(1, st.instances)), emBuild, emTopBuild, double(emBytes) / 1e6);
+    std::printf("ours: %.1f MB (tlas %zu B, instances %zu B, blas %zu B, triangles %zu B); depth tlas %d, blas %d\n", ourBytes / 1e6,
+                st.tlasBytes, st.instanceBytes, st.blasBytes, st.triangleBytes, st.tlasDepth, st.maxBlasDepth);
+
+    std::printf("\nwidth=%d\nheight=%d\nthreads=%d\n", W, H, threadsUsed);
+    std::printf("frame_s=%.4f\nframe_min_s=%.4f\n", frame.median, frame.min);
+    std::printf("primary_mrays_s=%.3f\nshadow_mrays_s=%.3f\n", ourPrimary, ourShadow);
+    std::printf("shadow_rays=%zu\n", shadowCount);
+    if (ranEmbree) {
+        std::printf("embree_primary_mrays_s=%.3f\nembree_shadow_mrays_s=%.3f\n", emPrimary, emShadow);
+        std::printf("embree_primary8_mrays_s=%.3f\nembree_shadow8_mrays_s=%.3f\n", emPrimary8, emShadow8);
+        std::printf("ratio_primary=%.3f\nratio_shadow=%.3f\n", ourPrimary / emPrimary, ourShadow / emShadow);
+        std::printf("embree_primary_mismatch_rate=%.6f\nembree_shadow_mismatch_rate=%.6f\n", emPrimaryMismatch, emShadowMismatch);
+        std::printf("embree_build_s=%.4f\n", emBuild + emTopBuild);
+        std::printf("embree_bytes_per_instanced_triangle=%.4f\nembree_bytes_per_instance=%.1f\n",
+                    double(emBytes) / std::max(1.0, st.instancedTriangles),
+                    double(emTopBytes) / double(std::max<size_t>(1, st.instances)));
+    }
+    std::printf("build_s=%.4f\n", buildSeconds);
+    std::printf("accel_bytes_per_instanced_triangle=%.4f\n", ourBytes / std::max(1.0, st.instancedTriangles));
+    std::printf("accel_bytes_per_instance=%.1f\n",
+                double(st.tlasBytes + st.instanceBytes) / double(std::max<size_t>(1, st.instances)));
+    return 0;
+}
