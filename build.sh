@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Sylva on a fresh Debian 12 machine: install what is missing, build, then run the main job or the tests.
-#   ./build.sh run    install + build + grow the default tree, light it, write out/default_tree_light.png
+#   ./build.sh run    install + build + render the default forest to out/default_forest.png
 #   ./build.sh test   install + build + run every test (ctest)
 #   ./build.sh build  install + build only
 set -euo pipefail
@@ -45,12 +45,10 @@ build() {
 run_main_job() {
   local out="$ROOT/out" sylva="$BUILD_DIR/pipeline/sylva"
   mkdir -p "$out"
-  echo "==> growing the default tree (broadleaf, seed 1, 200k triangles)"
-  "$sylva" grow --species broadleaf --seed 1 --triangles 200000 -o "$out/default_tree/default_tree.obj"
-  echo "==> voxelizing and lighting it (128 nodes on the longest axis, leaf preset)"
-  "$sylva" light --mesh "$out/default_tree/default_tree.obj" --grid 128 --preset leaf --sun 0.4,0.85,0.3 \
-    -o "$out/default_tree_light.npy" --picture "$out/default_tree_light.png"
-  echo "==> done: $out/default_tree_light.png (slices: density left, lighting right)"
+  echo "==> rendering the default forest (5 grown species, 962 instances, 273 M instanced triangles, 896x448)"
+  echo "    the first run grows, voxelizes and lights each species; later runs load the grids from the cache"
+  "$sylva" render --stats -o "$out/default_forest.png"
+  echo "==> done: $out/default_forest.png"
 }
 
 case "$MODE" in
