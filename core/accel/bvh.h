@@ -2,6 +2,9 @@
 #pragma once
 
 #include <cstdint>
+#include <tuple>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -67,8 +70,8 @@ SYLVA_INLINE Float4 max4(Float4 a, Float4 b) { return a > b ? a : b; }
 #endif
 
 // Entry distances of the ray into the node's four child boxes; a lane is > tmax when missed.
-SYLVA_HD SYLVA_INLINE void nodeEntry(const BvhNode& n, const glm::vec3& org, const glm::vec3& inv, float tmin, float tmax,
-                                     float tn[4])
+SYLVA_HD SYLVA_INLINE void nodeEntry(const BvhNode& n, const glm::vec3& org, const glm::vec3& inv, unsigned zeroAxes,
+                                     float tmin, float tmax, float tn[4])
 {
 #if !defined(__CUDA_ARCH__)
     using namespace detail;
@@ -78,27 +81,47 @@ SYLVA_HD SYLVA_INLINE void nodeEntry(const BvhNode& n, const glm::vec3& org, con
     const Float4 y0 = (load4(n.loy) - oy) * iy, y1 = (load4(n.hiy) - oy) * iy;
     const Float4 z0 = (load4(n.loz) - oz) * iz, z1 = (load4(n.hiz) - oz) * iz;
     const Float4 lo = {tmin, tmin, tmin, tmin}, hi = {tmax, tmax, tmax, tmax};
-    const Float4 tnear = max4(max4(min4(x0, x1), min4(y0, y1)), max4(min4(z0, z1), lo));
-    const Float4 tfar = min4(min4(max4(x0, x1), max4(y0, y1)), min4(max4(z0, z1), hi));
-    const Float4 miss = {1e38f, 1e38f, 1e38f, 1e38f};
+    Float4 tnear = max4(max4(min4(x0, x1), min4(y0, y1)), max4(min4(z0, z1), lo));
+    Float4 tfar = min4(min4(max4(x0, x1), max4(y0, y1)), min4(max4(z0, z1), hi));
+    if (__builtin_expect(zeroAxes != 0, 0)) {
+        // Rays with a zero direction component (rare; the same branch for the whole traversal):
+        // on such an axis the slab is all of t when the origin lies in [lo, hi], else empty.
+        const Float4 big = {1e30f, 1e30f, 1e30f, 1e30f};
+        const Float4 lox = load4(n.lox), hix = load4(n.hix), loy = load4(n.loy), hiy = load4(n.hiy);
+        const Float4 loz = load4(n.loz), hiz = load4(n.hiz);
+        auto fix = [&](const Float4& l, const Float4& h, const Float4& o) {
+            const auto inside = (l <= o) & (o <= h);
+            const Float4 t0 = inside ? -big : big, t1 = inside ? big : -big;
+            return std::pair<Float4, Float4>(t0, t1);
+        };
+        Float4 ax0 = x0, ax1 = x1, ay0 = y0, ay1 = y1, az0 = z0, az1 = z1;
+        if (zeroAxes & 1) std::tie(ax0, ax1) = fix(lox, hix, ox);
+        if (zeroAxes & 2) std::tie(ay0, ay1) = fix(loy, hiy, oy);
+        if (zeroAxes & 4) std::tie(az0, az1) = fix(loz, hiz, oz);
+        tnear = max4(max4(min4(ax0, ax1), min4(ay0, ay1)), max4(min4(az0, az1), lo));
+        tfar = min4(min4(max4(ax0, ax1), max4(ay0, ay1)), min4(max4(az0, az1), hi));
+    }
+    const Float4 miss = {missDistance(), missDistance(), missDistance(), missDistance()};
     const Float4 r = tnear <= tfar ? tnear : miss;
     __builtin_memcpy(tn, &r, 16);
 #else
+    (void)zeroAxes;
     for (int k = 0; k < 4; ++k)
         tn[k] = rayBoxEntry(glm::vec3(n.lox[k], n.loy[k], n.loz[k]), glm::vec3(n.hix[k], n.hiy[k], n.hiz[k]), org, inv,
                             tmin, tmax);
 #endif
 }
 
-// Visits, in roughly front-to-back order, every leaf primitive whose leaf box the ray
-// [tmin, tmax] enters, calling leaf(slot, tmax) with the primitive's slot in BVH order. The callback
-// shrinks tmax when it records a closer hit and returns true to stop at once (any-hit queries).
-// Returns true when stopped by the callback.
+// Visits, in roughly front-to-back order, every leaf whose box the ray [tmin, tmax] enters. With a
+// callback leaf(slot, tmax) it is called per primitive with the primitive's slot in BVH order; with
+// leaf(first, count, tmax) once per leaf. The callback shrinks tmax when it records a closer hit and
+// returns true to stop at once (any-hit queries). Returns true when stopped by the callback.
 template <class LeafFn>
 SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::vec3& dir, float tmin, float& tmax,
                                  LeafFn&& leaf)
 {
     const glm::vec3 inv = safeReciprocal(dir);
+    const unsigned zeroAxes = (dir.x == 0.0f ? 1u : 0u) | (dir.y == 0.0f ? 2u : 0u) | (dir.z == 0.0f ? 4u : 0u);
     uint32_t stackNode[kBvhStackSize];
     float stackDist[kBvhStackSize];
     int sp = 0;
@@ -106,7 +129,7 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
     for (;;) {
         const BvhNode& n = bvh.nodes[node];
         float tn[4];
-        nodeEntry(n, org, inv, tmin, tmax, tn);
+        nodeEntry(n, org, inv, zeroAxes, tmin, tmax, tn);
         // Leaves are handled at once (they may shrink tmax); inner children are sorted near to far.
         uint32_t innerNode[4];
         float innerDist[4];
@@ -114,8 +137,12 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
         for (int k = 0; k < 4; ++k) {
             if (!(tn[k] <= tmax) || n.child[k] == kNoHit) continue;
             if (n.count[k] > 0) {
-                for (uint32_t p = 0; p < n.count[k]; ++p)
-                    if (leaf(n.child[k] + p, tmax)) return true;
+                if constexpr (std::is_invocable_v<LeafFn, uint32_t, uint32_t, float&>) {
+                    if (leaf(n.child[k], n.count[k], tmax)) return true;
+                } else {
+                    for (uint32_t p = 0; p < n.count[k]; ++p)
+                        if (leaf(n.child[k] + p, tmax)) return true;
+                }
             } else {
                 int j = inner++;
                 while (j > 0 && innerDist[j - 1] < tn[k]) {   // descending: the nearest ends last
@@ -125,6 +152,11 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
                 }
                 innerDist[j] = tn[k];
                 innerNode[j] = n.child[k];
+#if !defined(__CUDA_ARCH__)
+                // Start the fetch of the child's 128-byte node now: traversal is bound by memory latency.
+                __builtin_prefetch(&bvh.nodes[n.child[k]]);
+                __builtin_prefetch(reinterpret_cast<const char*>(&bvh.nodes[n.child[k]]) + 64);
+#endif
             }
         }
         // Push the farther ones, continue with the nearest (re-checked against a shrunken tmax).

@@ -42,16 +42,44 @@ SYLVA_HD SYLVA_INLINE glm::vec3 safeReciprocal(const glm::vec3& d)
                      d.z != 0.0f ? 1.0f / d.z : copysignf(big, d.z));
 }
 
-// Slab test. Returns the entry distance, or a value > tmax when the box is missed.
+// The entry distance of a missed box: NaN, so that `d <= tmax` is false even for tmax = inf.
+SYLVA_HD SYLVA_INLINE float missDistance()
+{
+#if defined(__CUDA_ARCH__)
+    return __int_as_float(0x7fc00000);
+#else
+    return __builtin_nanf("");
+#endif
+}
+
+// Slab test. Returns the entry distance, or NaN (missDistance) when the box is missed. A zero
+// direction component is inside the slab exactly when lo <= org <= hi on that axis (a ray lying in
+// a box face enters the box).
 SYLVA_HD SYLVA_INLINE float rayBoxEntry(const glm::vec3& lo, const glm::vec3& hi, const glm::vec3& org,
                                         const glm::vec3& invDir, float tmin, float tmax)
 {
-    const float tx0 = (lo.x - org.x) * invDir.x, tx1 = (hi.x - org.x) * invDir.x;
-    const float ty0 = (lo.y - org.y) * invDir.y, ty1 = (hi.y - org.y) * invDir.y;
-    const float tz0 = (lo.z - org.z) * invDir.z, tz1 = (hi.z - org.z) * invDir.z;
+    float tx0 = (lo.x - org.x) * invDir.x, tx1 = (hi.x - org.x) * invDir.x;
+    float ty0 = (lo.y - org.y) * invDir.y, ty1 = (hi.y - org.y) * invDir.y;
+    float tz0 = (lo.z - org.z) * invDir.z, tz1 = (hi.z - org.z) * invDir.z;
+    // safeReciprocal gives +-1e30 for a zero component; a zero offset would then give t = 0.
+    if (invDir.x == 1e30f || invDir.x == -1e30f) {
+        const bool in = lo.x <= org.x && org.x <= hi.x;
+        tx0 = in ? -1e30f : 1e30f;
+        tx1 = in ? 1e30f : -1e30f;
+    }
+    if (invDir.y == 1e30f || invDir.y == -1e30f) {
+        const bool in = lo.y <= org.y && org.y <= hi.y;
+        ty0 = in ? -1e30f : 1e30f;
+        ty1 = in ? 1e30f : -1e30f;
+    }
+    if (invDir.z == 1e30f || invDir.z == -1e30f) {
+        const bool in = lo.z <= org.z && org.z <= hi.z;
+        tz0 = in ? -1e30f : 1e30f;
+        tz1 = in ? 1e30f : -1e30f;
+    }
     const float tnear = maxf(maxf(minf(tx0, tx1), minf(ty0, ty1)), maxf(minf(tz0, tz1), tmin));
     const float tfar = minf(minf(maxf(tx0, tx1), maxf(ty0, ty1)), minf(maxf(tz0, tz1), tmax));
-    return tnear <= tfar ? tnear : 1e38f;
+    return tnear <= tfar ? tnear : missDistance();
 }
 
 // Moller-Trumbore with precomputed edges e1 = v1 - v0, e2 = v2 - v0. Two-sided. On a hit with

@@ -91,8 +91,12 @@ RenderView RenderScene::view() const
     v.species = species.data();
     v.blasNodes = blasNodes.data();
     v.tris = tris.data();
-    v.kdTlas = nullptr;
-    v.kdBlas = nullptr;
+    v.blocks = blocks.data();
+    v.kdTlasNodes = kdTlasNodes.empty() ? nullptr : kdTlasNodes.data();
+    v.kdTlasRefs = kdTlasRefs.data();
+    v.kdSpecies = kdSpecies.data();
+    v.kdBlasNodes = kdBlasNodes.data();
+    v.kdBlasRefs = kdBlasRefs.data();
     v.triVerts = triVerts.data();
     v.triMaterial = triMaterial.data();
     v.normals = normals.data();
@@ -192,6 +196,27 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
             rs.tris.push_back(ta);
         }
 
+        // BVH leaves become 4-wide triangle blocks: leaf children then index blocks, not slots.
+        sr.blockOffset = uint32_t(rs.blocks.size());
+        for (size_t ni = sr.nodeOffset; ni < rs.blasNodes.size(); ++ni) {
+            BvhNode& node = rs.blasNodes[ni];
+            for (int k = 0; k < 4; ++k) {
+                if (node.count[k] == 0 || node.child[k] == kNoHit) continue;
+                if (node.count[k] > 4) throw Error("render: a BVH leaf holds more than four triangles");
+                TriBlock blk{};
+                for (uint32_t l = 0; l < node.count[k]; ++l) {
+                    const TriAccel& t = rs.tris[sr.triOffset + node.child[k] + l];
+                    blk.v0x[l] = t.v0.x, blk.v0y[l] = t.v0.y, blk.v0z[l] = t.v0.z;
+                    blk.e1x[l] = t.e1.x, blk.e1y[l] = t.e1.y, blk.e1z[l] = t.e1.z;
+                    blk.e2x[l] = t.e2.x, blk.e2y[l] = t.e2.y, blk.e2z[l] = t.e2.z;
+                    blk.tri[l] = t.tri;
+                    blk.alpha[l] = t.alpha;
+                }
+                node.child[k] = uint32_t(rs.blocks.size() - sr.blockOffset);
+                rs.blocks.push_back(blk);
+            }
+        }
+
         // Lighting grid, normalized by the unobstructed photon density.
         const LightingGrid& g = a.lighting;
         if (!g.rgb.empty()) {
@@ -230,12 +255,51 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         boxes[i].hi += pad;
         rs.m_stats.instancedTriangles += double(assets[d.species].mesh.triangles.size());
     }
+    if (scene.render.accel == AccelKind::KdTree) {
+        // The seed's structure at both levels. Species trees index triangles by BVH slot (the order
+        // of rs.tris) and clip them to the split boxes ("perfect splits").
+        rs.m_stats.maxBlasDepth = 0;
+        std::vector<KdTree> kd(ns);
+        tbb::parallel_for(size_t(0), ns, [&](size_t s) {
+            const TriAccel* tris = rs.tris.data() + rs.species[s].triOffset;
+            const size_t n = assets[s].mesh.triangles.size();
+            std::vector<Bounds3> triBoxes(n);
+            for (size_t t = 0; t < n; ++t) {
+                triBoxes[t].extend(tris[t].v0);
+                triBoxes[t].extend(tris[t].v0 + tris[t].e1);
+                triBoxes[t].extend(tris[t].v0 + tris[t].e2);
+            }
+            KdBuildSettings ks;
+            ks.clip = [tris](uint32_t prim, const Bounds3& box) {
+                const TriAccel& t = tris[prim];
+                return clipTriangleToBox(t.v0, t.v0 + t.e1, t.v0 + t.e2, box);
+            };
+            kd[s] = buildKdTree(triBoxes, ks);
+        });
+        for (size_t s = 0; s < ns; ++s) {
+            KdSpeciesRecord r{};
+            r.lo = kd[s].bounds.lo;
+            r.hi = kd[s].bounds.hi;
+            r.nodeOffset = uint32_t(rs.kdBlasNodes.size());
+            r.refOffset = uint32_t(rs.kdBlasRefs.size());
+            rs.kdBlasNodes.insert(rs.kdBlasNodes.end(), kd[s].nodes.begin(), kd[s].nodes.end());
+            rs.kdBlasRefs.insert(rs.kdBlasRefs.end(), kd[s].primRefs.begin(), kd[s].primRefs.end());
+            rs.kdSpecies.push_back(r);
+            rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, kd[s].stats.depth);
+        }
+        KdTree top = buildKdTree(boxes);
+        rs.kdTlasNodes = std::move(top.nodes);
+        rs.kdTlasRefs = std::move(top.primRefs);
+        rs.base.kdTlasLo = top.bounds.lo;
+        rs.base.kdTlasHi = top.bounds.hi;
+        rs.m_stats.tlasDepth = top.stats.depth;
+    }
     BvhBuildSettings ts;
     ts.maxLeafSize = 2;
     Bvh tlas = buildBvh(boxes, ts);
     rs.tlasNodes = std::move(tlas.nodes);
     rs.tlasOrder = std::move(tlas.primOrder);
-    rs.m_stats.tlasDepth = tlas.depth;
+    if (scene.render.accel != AccelKind::KdTree) rs.m_stats.tlasDepth = tlas.depth;
 
     // Environment, camera, settings.
     RenderView& b = rs.base;
@@ -256,10 +320,17 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
     b.indirectScale = scene.render.indirectScale;
 
     AccelStats& st = rs.m_stats;
-    st.tlasBytes = rs.tlasNodes.size() * sizeof(BvhNode) + rs.tlasOrder.size() * sizeof(uint32_t);
+    if (scene.render.accel == AccelKind::KdTree) {
+        st.tlasBytes = rs.kdTlasNodes.size() * sizeof(KdNode) + rs.kdTlasRefs.size() * sizeof(uint32_t);
+        st.blasBytes = rs.kdBlasNodes.size() * sizeof(KdNode) + rs.kdBlasRefs.size() * sizeof(uint32_t) +
+                       rs.kdSpecies.size() * sizeof(KdSpeciesRecord);
+    } else {
+        st.tlasBytes = rs.tlasNodes.size() * sizeof(BvhNode) + rs.tlasOrder.size() * sizeof(uint32_t);
+        st.blasBytes = rs.blasNodes.size() * sizeof(BvhNode);
+    }
     st.instanceBytes = rs.instances.size() * sizeof(InstanceRecord);
-    st.blasBytes = rs.blasNodes.size() * sizeof(BvhNode);
-    st.triangleBytes = rs.tris.size() * sizeof(TriAccel);
+    st.triangleBytes = scene.render.accel == AccelKind::KdTree ? rs.tris.size() * sizeof(TriAccel)
+                                                               : rs.blocks.size() * sizeof(TriBlock);
     st.instances = rs.instances.size();
     if (progress) progress->report(1.0, "acceleration structures built");
     return rs;

@@ -24,7 +24,7 @@ struct SpeciesAssets {
 
 // Sizes in bytes of what the traversal reads, for the performance notes.
 struct AccelStats {
-    size_t tlasBytes = 0, instanceBytes = 0, blasBytes = 0, triangleBytes = 0;
+    size_t tlasBytes = 0, instanceBytes = 0, blasBytes = 0, triangleBytes = 0;   // the structures the run traverses
     size_t instances = 0, speciesTriangles = 0;
     double instancedTriangles = 0.0;
     int tlasDepth = 0, maxBlasDepth = 0;
@@ -43,6 +43,7 @@ public:
     std::vector<SpeciesRecord> species;
     std::vector<BvhNode> blasNodes;
     std::vector<TriAccel> tris;
+    std::vector<TriBlock> blocks;
     std::vector<glm::uvec3> triVerts;
     std::vector<uint32_t> triMaterial;
     std::vector<glm::vec3> normals;
@@ -53,11 +54,16 @@ public:
     std::vector<AlphaMaskRecord> alphaMasks;
     std::vector<uint32_t> alphaBits;
     std::vector<float> lighting;
+    // kd-tree alternative, built only when the scene asks for accel kdtree
+    std::vector<KdNode> kdTlasNodes, kdBlasNodes;
+    std::vector<uint32_t> kdTlasRefs, kdBlasRefs;
+    std::vector<KdSpeciesRecord> kdSpecies;
     RenderView base{};                  // environment, camera and settings (pointers filled by view())
     AccelStats m_stats;
 };
 
-// Builds the arrays for a scene: one BVH per species (in parallel), one over the instances in the
+// Builds the arrays for a scene: one BVH (or, for accel kdtree, one kd-tree) per species (in
+// parallel), one over the instances in the
 // camera-relative frame (world minus the camera position, computed in double: precision does not
 // depend on the distance from the world origin). assets[i] belongs to scene.species[i].
 // sunRadiance is the sun's linear RGB (colour x intensity). Throws Error on inconsistent input.

@@ -6,6 +6,7 @@
 #include <glm/glm.hpp>
 
 #include "core/accel/bvh.h"
+#include "core/accel/kdtree.h"
 #include "core/base/defines.h"
 #include "core/scene/scene.h"
 
@@ -21,6 +22,18 @@ struct TriAccel {
 };
 static_assert(sizeof(TriAccel) == 48);
 
+// Up to four triangles of one BVH leaf as structure of arrays, tested with one SIMD pass (BVH runs).
+// Lanes past the leaf's count are never read as hits. Same fields as TriAccel. 192 bytes.
+struct alignas(64) TriBlock {
+    float v0x[4], v0y[4], v0z[4];
+    float e1x[4], e1y[4], e1z[4];
+    float e2x[4], e2y[4], e2z[4];
+    uint32_t tri[4];
+    uint32_t alpha[4];
+    uint32_t pad[4];
+};
+static_assert(sizeof(TriBlock) == 192);
+
 // A placed plant: world (camera-relative) -> species frame as a 3x4 row-major affine map
 // (rotation and uniform scale only, so normals map back with the transpose). 64 bytes.
 struct InstanceRecord {
@@ -33,16 +46,25 @@ static_assert(sizeof(InstanceRecord) == 64);
 
 // Per species: where its BVH nodes and triangles start in the flat arrays, its lighting grid. 48 bytes.
 struct SpeciesRecord {
-    uint32_t nodeOffset;     // into RenderView::blasNodes
-    uint32_t triOffset;      // into RenderView::tris (BVH slot order)
-    uint32_t kdNodeOffset;   // into the kd-tree arrays (kd-tree runs)
-    uint32_t kdRefOffset;
+    uint32_t nodeOffset;     // into RenderView::blasNodes (leaves index blocks of RenderView::blocks)
+    uint32_t triOffset;      // into RenderView::tris (BVH slot order; kd-tree runs and tests)
+    uint32_t blockOffset;    // into RenderView::blocks
+    uint32_t pad;
     glm::vec3 gridOrigin;    // species frame, metres, node (0,0,0)
     float gridInvSpacing;    // 1 / node spacing; 0 = no lighting grid
     glm::ivec3 gridDims;
     uint32_t gridOffset;     // into RenderView::lighting (3 floats per node, already normalized)
 };
 static_assert(sizeof(SpeciesRecord) == 48);
+
+// The kd-tree of one species (kd-tree runs): offsets into the flat kd arrays and the box rays are
+// clipped to. Its primitive references are slots of RenderView::tris, like the BVH's. 32 bytes.
+struct KdSpeciesRecord {
+    glm::vec3 lo;
+    uint32_t nodeOffset;     // into RenderView::kdBlasNodes
+    glm::vec3 hi;
+    uint32_t refOffset;      // into RenderView::kdBlasRefs
+};
 
 // A surface material for shading. Texture indices are into RenderView::textures, -1 = none. 48 bytes.
 struct MaterialRecord {
@@ -85,11 +107,16 @@ struct RenderView {
     uint32_t instanceCount;
     const SpeciesRecord* species;
     const BvhNode* blasNodes;
-    const TriAccel* tris;
+    const TriAccel* tris;            // every triangle, BVH slot order (kd-tree traversal, tests)
+    const TriBlock* blocks;          // BVH leaves' triangles
 
-    // kd-tree alternative (same instances and triangles); null when not built
-    const void* kdTlas;              // reserved for the kd-tree layout
-    const void* kdBlas;
+    // kd-tree alternative (same instances and triangles); null unless accel == KdTree
+    const KdNode* kdTlasNodes;
+    const uint32_t* kdTlasRefs;      // instance indices
+    glm::vec3 kdTlasLo, kdTlasHi;
+    const KdSpeciesRecord* kdSpecies;
+    const KdNode* kdBlasNodes;
+    const uint32_t* kdBlasRefs;
 
     // shading data, indexed by TriAccel::tri
     const glm::uvec3* triVerts;      // global vertex indices

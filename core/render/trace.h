@@ -2,6 +2,7 @@
 #pragma once
 
 #include "core/accel/bvh.h"
+#include "core/accel/kdtree.h"
 #include "core/accel/ray.h"
 #include "core/render/render_view.h"
 
@@ -41,6 +42,60 @@ SYLVA_HD SYLVA_INLINE bool hitTriangle(const RenderView& v, const TriAccel& tri,
     return true;
 }
 
+// Tests the first `count` triangles of a block (one SIMD pass on the host); the accepted hit
+// (alpha cut-outs pass the ray through) closest and below tmax wins: tmax, u, w, tri are set.
+// AnyHit returns at the first accepted hit. Returns true when a hit was accepted.
+template <bool AnyHit>
+SYLVA_HD inline bool hitBlock(const RenderView& v, const TriBlock& b, uint32_t count, const glm::vec3& org,
+                              const glm::vec3& dir, float tmin, float& tmax, float& u, float& w, uint32_t& tri)
+{
+    float tt[4], uu[4], vv[4];
+    bool ok[4];
+#if !defined(__CUDA_ARCH__)
+    using F = detail::Float4;
+    const F dx = {dir.x, dir.x, dir.x, dir.x}, dy = {dir.y, dir.y, dir.y, dir.y}, dz = {dir.z, dir.z, dir.z, dir.z};
+    const F e1x = detail::load4(b.e1x), e1y = detail::load4(b.e1y), e1z = detail::load4(b.e1z);
+    const F e2x = detail::load4(b.e2x), e2y = detail::load4(b.e2y), e2z = detail::load4(b.e2z);
+    const F px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
+    const F det = e1x * px + e1y * py + e1z * pz;
+    const F one = {1.0f, 1.0f, 1.0f, 1.0f}, zero = {0.0f, 0.0f, 0.0f, 0.0f};
+    const F inv = one / det;
+    const F sx = F{org.x, org.x, org.x, org.x} - detail::load4(b.v0x);
+    const F sy = F{org.y, org.y, org.y, org.y} - detail::load4(b.v0y);
+    const F sz = F{org.z, org.z, org.z, org.z} - detail::load4(b.v0z);
+    const F U = (sx * px + sy * py + sz * pz) * inv;
+    const F qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
+    const F V = (dx * qx + dy * qy + dz * qz) * inv;
+    const F T = (e2x * qx + e2y * qy + e2z * qz) * inv;
+    const auto mask = (det != zero) & (U >= zero) & (V >= zero) & (U + V <= one) & (T > F{tmin, tmin, tmin, tmin}) &
+                      (T < F{tmax, tmax, tmax, tmax});
+    for (int k = 0; k < 4; ++k) {
+        ok[k] = mask[k] != 0 && uint32_t(k) < count;
+        tt[k] = T[k];
+        uu[k] = U[k];
+        vv[k] = V[k];
+    }
+#else
+    for (int k = 0; k < 4; ++k) {
+        ok[k] = uint32_t(k) < count &&
+                intersectTriangle(org, dir, glm::vec3(b.v0x[k], b.v0y[k], b.v0z[k]), glm::vec3(b.e1x[k], b.e1y[k], b.e1z[k]),
+                                  glm::vec3(b.e2x[k], b.e2y[k], b.e2z[k]), tmin, tmax, tt[k], uu[k], vv[k]);
+    }
+#endif
+    bool found = false;
+    for (int k = 0; k < 4; ++k) {
+        if (!ok[k] || !(tt[k] < tmax)) continue;
+        if (b.alpha[k] != 0u && !alphaOpaque(v, b.alpha[k] - 1u, triangleUv(v, b.tri[k], uu[k], vv[k]))) continue;
+        tmax = tt[k];
+        u = uu[k];
+        w = vv[k];
+        tri = b.tri[k];
+        found = true;
+        if (AnyHit) return true;
+    }
+    return found;
+}
+
 SYLVA_HD SYLVA_INLINE glm::vec3 toLocalPoint(const InstanceRecord& in, const glm::vec3& p)
 {
     return glm::vec3(glm::dot(glm::vec3(in.row[0]), p) + in.row[0].w, glm::dot(glm::vec3(in.row[1]), p) + in.row[1].w,
@@ -58,10 +113,11 @@ SYLVA_HD SYLVA_INLINE glm::vec3 toWorldNormal(const InstanceRecord& in, const gl
     return glm::vec3(in.row[0]) * n.x + glm::vec3(in.row[1]) * n.y + glm::vec3(in.row[2]) * n.z;
 }
 
-// Closest hit along the ray (camera-relative world frame) over instances and the ground.
-// anyHit = true stops at the first accepted hit (shadow rays). Returns true on a hit.
-template <bool AnyHit>
-SYLVA_HD inline bool traceBvh(const RenderView& v, const Ray& ray, Hit& hit)
+// Closest hit along the ray (camera-relative world frame) over instances and the ground, through
+// the BVHs (Kd = false) or the kd-trees (Kd = true) at both levels. AnyHit stops at the first
+// accepted hit (shadow rays). Returns true on a hit.
+template <bool AnyHit, bool Kd>
+SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hit)
 {
     hit.prim = kNoHit;
     hit.inst = kNoHit;
@@ -76,31 +132,54 @@ SYLVA_HD inline bool traceBvh(const RenderView& v, const Ray& ray, Hit& hit)
             hit.u = hit.v = 0.0f;
         }
     }
-    const BvhView tlas{v.tlasNodes};
-    const bool stopped = traverseBvh(tlas, ray.org, ray.dir, ray.tmin, tmax, [&](uint32_t slot, float& tlasMax) {
-        const uint32_t inst = v.tlasOrder[slot];
+    auto instanceFn = [&](uint32_t inst, float& tlasMax) {
         const InstanceRecord& in = v.instances[inst];
-        const SpeciesRecord& sp = v.species[in.species];
         const glm::vec3 o = toLocalPoint(in, ray.org), d = toLocalDir(in, ray.dir);
-        const TriAccel* tris = v.tris + sp.triOffset;
-        bool found = false;
-        const bool stop = traverseBvh(BvhView{v.blasNodes + sp.nodeOffset}, o, d, ray.tmin, tlasMax,
-                                      [&](uint32_t s, float& blasMax) {
-                                          float u, w;
-                                          if (!hitTriangle(v, tris[s], o, d, ray.tmin, blasMax, u, w)) return false;
-                                          found = true;
-                                          if (!AnyHit) {
-                                              hit.t = blasMax;
-                                              hit.u = u;
-                                              hit.v = w;
-                                              hit.prim = tris[s].tri;
-                                              hit.inst = inst;
-                                          }
-                                          return AnyHit;
-                                      });
-        (void)found;
-        return stop;
-    });
+        const TriAccel* tris = v.tris + v.species[in.species].triOffset;
+        auto triFn = [&](uint32_t s, float& blasMax) {
+            float u, w;
+            if (!hitTriangle(v, tris[s], o, d, ray.tmin, blasMax, u, w)) return false;
+            if (!AnyHit) {
+                hit.t = blasMax;
+                hit.u = u;
+                hit.v = w;
+                hit.prim = tris[s].tri;
+                hit.inst = inst;
+            }
+            return AnyHit;
+        };
+        if constexpr (Kd) {
+            const KdSpeciesRecord& k = v.kdSpecies[in.species];
+            const KdView view{v.kdBlasNodes + k.nodeOffset, v.kdBlasRefs + k.refOffset, k.lo, k.hi};
+            return traverseKd(view, o, d, ray.tmin, tlasMax, triFn);
+        } else {
+            const SpeciesRecord& sp = v.species[in.species];
+            const TriBlock* blocks = v.blocks + sp.blockOffset;
+            return traverseBvh(BvhView{v.blasNodes + sp.nodeOffset}, o, d, ray.tmin, tlasMax,
+                               [&](uint32_t block, uint32_t count, float& blasMax) {
+                                   float u, w;
+                                   uint32_t tri;
+                                   if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, ray.tmin, blasMax, u, w, tri))
+                                       return false;
+                                   if (!AnyHit) {
+                                       hit.t = blasMax;
+                                       hit.u = u;
+                                       hit.v = w;
+                                       hit.prim = tri;
+                                       hit.inst = inst;
+                                   }
+                                   return AnyHit;
+                               });
+        }
+    };
+    bool stopped;
+    if constexpr (Kd) {
+        const KdView tlas{v.kdTlasNodes, v.kdTlasRefs, v.kdTlasLo, v.kdTlasHi};
+        stopped = traverseKd(tlas, ray.org, ray.dir, ray.tmin, tmax, instanceFn);
+    } else {
+        stopped = traverseBvh(BvhView{v.tlasNodes}, ray.org, ray.dir, ray.tmin, tmax,
+                              [&](uint32_t slot, float& tlasMax) { return instanceFn(v.tlasOrder[slot], tlasMax); });
+    }
     if (AnyHit) return stopped;
     return hit.prim != kNoHit;
 }
@@ -109,7 +188,8 @@ SYLVA_HD inline bool traceBvh(const RenderView& v, const Ray& ray, Hit& hit)
 template <bool AnyHit>
 SYLVA_HD SYLVA_INLINE bool traceScene(const RenderView& v, const Ray& ray, Hit& hit)
 {
-    return traceBvh<AnyHit>(v, ray, hit);
+    if (v.accel == AccelKind::KdTree) return traceInstances<AnyHit, true>(v, ray, hit);
+    return traceInstances<AnyHit, false>(v, ray, hit);
 }
 
 } // namespace sylva

@@ -435,6 +435,7 @@ int main(int argc, char** argv)
     Scene scene = defaultScene();
     if (width > 0) scene.render.width = width;
     if (height > 0) scene.render.height = height;
+    scene.render.accel = accel;
     GridCache cache;
     double t0 = now();
     const std::vector<SpeciesAssets> assets = loadSpeciesAssets(scene, &cache, true);
@@ -443,11 +444,6 @@ int main(int argc, char** argv)
     const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
     const double buildSeconds = now() - t0;
     RenderView v = rs.view();
-    v.accel = accel;
-    if (accel == AccelKind::KdTree && v.kdTlas == nullptr) {
-        std::printf("note: the kd-tree is not built by buildRenderScene yet; reporting the BVH\n");
-        v.accel = AccelKind::Bvh;
-    }
     const int W = v.width, H = v.height;
     const size_t pixels = size_t(W) * size_t(H);
     const AccelStats& st = rs.stats();

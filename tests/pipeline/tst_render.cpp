@@ -115,19 +115,24 @@ private Q_SLOTS:
         QDir().mkpath(m_out);
     }
 
-    void bvhMatchesBruteForce_data()
+    void accelMatchesBruteForce_data()
     {
         QTest::addColumn<QString>("what");
-        QTest::newRow("Tree_1.obj") << "Tree_1";
-        QTest::newRow("Birch_1.obj") << "Birch_1";
-        QTest::newRow("grown birch") << "grown";
-        QTest::newRow("random soup") << "soup";
+        QTest::addColumn<int>("accel");
+        for (AccelKind a : {AccelKind::Bvh, AccelKind::KdTree}) {
+            const std::string n = accelName(a);
+            QTest::newRow((n + " Tree_1.obj").c_str()) << "Tree_1" << int(a);
+            QTest::newRow((n + " Birch_1.obj").c_str()) << "Birch_1" << int(a);
+            QTest::newRow((n + " grown birch").c_str()) << "grown" << int(a);
+            QTest::newRow((n + " random soup").c_str()) << "soup" << int(a);
+        }
     }
 
-    // 100k random rays per mesh: same closest hit (t and triangle) and the same any-hit answer.
-    void bvhMatchesBruteForce()
+    // 100k random rays per mesh and structure: same closest hit (t and triangle) and the same any-hit answer.
+    void accelMatchesBruteForce()
     {
         QFETCH(QString, what);
+        QFETCH(int, accel);
         TriangleMesh mesh;
         if (what == "grown") {
             GrowOptions g;
@@ -143,7 +148,8 @@ private Q_SLOTS:
         }
         const size_t triCount = mesh.triangles.size();
         const Bounds3 bounds = meshBounds(mesh);
-        const Scene scene = sceneFor({InstanceDesc{}});
+        Scene scene = sceneFor({InstanceDesc{}});
+        scene.render.accel = AccelKind(accel);
         std::vector<SpeciesAssets> assets{assetsFor(std::move(mesh))};
         const RenderScene rs = buildRenderScene(scene, assets, glm::vec3(1.0f));
         const RenderView v = rs.view();
@@ -171,9 +177,17 @@ private Q_SLOTS:
         QVERIFY2(primMismatch <= hits / 1000, qPrintable(QString("%1 triangle mismatches").arg(primMismatch)));
     }
 
+    void instancesMatchFlattenedCopy_data()
+    {
+        QTest::addColumn<int>("accel");
+        QTest::newRow("bvh") << int(AccelKind::Bvh);
+        QTest::newRow("kdtree") << int(AccelKind::KdTree);
+    }
+
     // Fifty rotated, scaled, translated instances trace exactly like one flattened copy of their triangles.
     void instancesMatchFlattenedCopy()
     {
+        QFETCH(int, accel);
         GrowOptions g;
         g.species = TreeSpecies::Shrub;
         g.targetTriangles = 2000;
@@ -189,6 +203,7 @@ private Q_SLOTS:
             instances.push_back(d);
         }
         Scene inst = sceneFor(instances);
+        inst.render.accel = AccelKind(accel);
         // The flattened copy: every instance's triangles in world space, one identity instance.
         TriangleMesh flat;
         flat.materials = mesh.materials;
@@ -305,6 +320,21 @@ private Q_SLOTS:
         JobLog localLog;
         renderScene(s, &cache, nullptr, &localLog);
         for (const std::string& st : localLog.stages) QVERIFY2(st.find("light") == std::string::npos, st.c_str());
+    }
+
+    // The kd-tree run draws the same picture as the BVH run.
+    void kdTreeRendersTheSamePicture()
+    {
+        Scene s = smallForest();
+        s.render.spp = 1;
+        GridCache cache((m_out + "/cache").toStdString());
+        const auto bvh = composeMode(renderScene(s, &cache).film, RenderMode::Full, s.sky);
+        s.render.accel = AccelKind::KdTree;
+        const auto kd = composeMode(renderScene(s, &cache).film, RenderMode::Full, s.sky);
+        int differ = 0;
+        for (size_t i = 0; i < bvh.size(); ++i)
+            if (glm::any(glm::greaterThan(glm::abs(bvh[i] - kd[i]), glm::vec3(1e-3f)))) ++differ;
+        QVERIFY2(differ <= int(bvh.size()) / 1000, qPrintable(QString("%1 pixels differ").arg(differ)));
     }
 
     // Moving the whole scene and camera 1e6 m and 1e7 m from the origin changes no pixel noticeably.
