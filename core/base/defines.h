@@ -12,8 +12,10 @@
 #endif
 
 // Fully unroll a short loop with a constant trip count (keeps per-node values in registers).
-#if defined(__CUDACC__)
+#if defined(__CUDA_ARCH__)
 #define SYLVA_UNROLL _Pragma("unroll")
+#elif defined(__CUDACC__)
+#define SYLVA_UNROLL   // the host pass of a .cu file: no per-node loops run there
 #elif defined(__GNUC__) && !defined(__clang__)
 #define SYLVA_UNROLL _Pragma("GCC unroll 32")
 #elif defined(__clang__)

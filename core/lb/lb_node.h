@@ -20,7 +20,7 @@ SYLVA_HD SYLVA_INLINE void collideNode(T (&f)[kDirections], T rho, const Om& om,
     T moving = T{};
     SYLVA_UNROLL
     for (int q = 0; q < kPairs; ++q) {
-        s[q] = f[kPairPos[q]] + f[kPairNeg[q]];
+        s[q] = f[pairPos(q)] + f[pairNeg(q)];
         moving = moving + s[q];
     }
     SYLVA_UNROLL
@@ -31,7 +31,7 @@ SYLVA_HD SYLVA_INLINE void collideNode(T (&f)[kDirections], T rho, const Om& om,
         for (int p = 0; p < kPairs; ++p) a[p] = a[p] + s[q] * om.even[p][q];
     }
     SYLVA_UNROLL
-    for (int q = 0; q < kPairs; ++q) s[q] = f[kPairPos[q]] - f[kPairNeg[q]];   // s now holds the differences d
+    for (int q = 0; q < kPairs; ++q) s[q] = f[pairPos(q)] - f[pairNeg(q)];   // s now holds the differences d
     SYLVA_UNROLL
     for (int p = 0; p < kPairs; ++p) b[p] = s[0] * om.odd[p][0];
     SYLVA_UNROLL
@@ -44,7 +44,7 @@ SYLVA_HD SYLVA_INLINE void collideNode(T (&f)[kDirections], T rho, const Om& om,
     for (int p = 0; p < kPairs; ++p) {
         const float w = p < 3 ? 1.0f / 12.0f : 1.0f / 24.0f;
         const T common = a[p] + f0 * w;
-        const int ip = kPairPos[p], in = kPairNeg[p];
+        const int ip = pairPos(p), in = pairNeg(p);
         f[ip] = f[ip] + rho * (common + b[p] - f[ip] * om.sigmaT);
         f[in] = f[in] + rho * (common - b[p] - f[in] * om.sigmaT);
     }

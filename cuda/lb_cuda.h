@@ -1,0 +1,16 @@
+// The LB lighting solve on the GPU (LB_MODEL.md): the same per-node collision as the CPU, z-fastest layout.
+#pragma once
+
+#include "core/base/progress.h"
+#include "core/grid/grid.h"
+#include "core/lb/lb_params.h"
+#include "core/lb/lb_solver.h"
+
+namespace sylva::cuda {
+
+// Solves all three channels on the current device (channels with equal optics share one solve).
+// Throws Error on bad input, BackendError on device trouble, Cancelled when cancelled.
+LightingGrid solveLightingCuda(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
+                               lb::SolveStats* stats);
+
+} // namespace sylva::cuda

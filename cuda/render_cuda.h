@@ -1,0 +1,40 @@
+// The frame on the GPU: the scene's flat arrays uploaded as they are, the shared per-pixel kernel in 8x8 tiles,
+// and tone mapping on the device.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+
+#include "core/base/progress.h"
+#include "core/render/render_cpu.h"
+#include "core/render/render_scene.h"
+
+namespace sylva::cuda {
+
+// A RenderScene on the device. Upload once per scene change; render many frames.
+class DeviceScene {
+public:
+    explicit DeviceScene(const RenderScene& scene);   // throws BackendError
+    ~DeviceScene();
+    DeviceScene(const DeviceScene&) = delete;
+    DeviceScene& operator=(const DeviceScene&) = delete;
+
+    // The device-side view (pointers into device memory) with the host view's settings.
+    const RenderView& view() const { return m_view; }
+    size_t deviceBytes() const { return m_bytes; }
+
+private:
+    struct Buffers;
+    std::unique_ptr<Buffers> m_buffers;
+    RenderView m_view{};
+    size_t m_bytes = 0;
+};
+
+// Traces every pixel on the device and returns the film on the host. Throws BackendError.
+Film renderCuda(const DeviceScene& scene, Progress* progress = nullptr);
+
+// Traces and tone-maps on the device into an RGBA8 buffer in device memory (width x height, top row
+// first), e.g. a GL pixel buffer mapped by the interop module. key: Reinhard key value.
+void renderToRgba8(const DeviceScene& scene, RenderMode mode, float key, uint32_t* deviceRgba8);
+
+} // namespace sylva::cuda
