@@ -12,6 +12,17 @@ namespace {
 
 constexpr int kTile = 8;
 
+template <bool AnyHit>
+__global__ void raysKernel(RenderView v, const Ray* rays, size_t n, Hit* hits)
+{
+    const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i >= n) return;
+    Hit h{};
+    const bool got = traceScene<AnyHit>(v, rays[i], h);
+    if (AnyHit) h.prim = got ? 0u : kNoHit;
+    hits[i] = h;
+}
+
 __global__ void shadeKernel(RenderView v, SampleParts* film)
 {
     const int x = int(blockIdx.x) * kTile + int(threadIdx.x), y = int(blockIdx.y) * kTile + int(threadIdx.y);
@@ -135,6 +146,21 @@ Film renderCuda(const DeviceScene& scene, Progress* progress)
     d.download(film.pixels.data(), film.pixels.size(), "film");
     if (progress) progress->report(1.0, "tracing on the GPU");
     return film;
+}
+
+std::vector<Hit> traceRaysCuda(const DeviceScene& scene, const std::vector<Ray>& rays, bool anyHit)
+{
+    DeviceBuffer<Ray> d;
+    d.upload(rays.data(), rays.size(), "rays");
+    DeviceBuffer<Hit> h(rays.size(), "hits");
+    const unsigned blocks = unsigned((rays.size() + 127) / 128);
+    if (anyHit) raysKernel<true><<<blocks, 128>>>(scene.view(), d.get(), rays.size(), h.get());
+    else raysKernel<false><<<blocks, 128>>>(scene.view(), d.get(), rays.size(), h.get());
+    check(cudaGetLastError(), "ray kernel launch");
+    check(cudaDeviceSynchronize(), "ray kernel");
+    std::vector<Hit> out(rays.size());
+    h.download(out.data(), out.size(), "hits");
+    return out;
 }
 
 void renderToRgba8(const DeviceScene& scene, RenderMode mode, float key, uint32_t* deviceRgba8)

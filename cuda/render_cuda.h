@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "core/base/progress.h"
 #include "core/render/render_cpu.h"
@@ -32,6 +33,9 @@ private:
 
 // Traces every pixel on the device and returns the film on the host. Throws BackendError.
 Film renderCuda(const DeviceScene& scene, Progress* progress = nullptr);
+
+// Closest hits of the given rays (camera-relative frame) on the device, for tests against the CPU.
+std::vector<Hit> traceRaysCuda(const DeviceScene& scene, const std::vector<Ray>& rays, bool anyHit);
 
 // Traces and tone-maps on the device into an RGBA8 buffer in device memory (width x height, top row
 // first), e.g. a GL pixel buffer mapped by the interop module. key: Reinhard key value.

@@ -1,6 +1,8 @@
 // Lighting pipeline for one species, with cache keys that cover everything that determines the result.
 #include "pipeline/lighting_job.h"
 
+#include "core/backend/backend.h"
+
 #include <span>
 
 #include "core/lb/lb_solver.h"
@@ -117,7 +119,7 @@ DensityGrid densityForTriangles(const TriangleMesh& mesh, const VoxelizeSettings
 }
 
 LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache, Progress* progress,
-                         JobLog* log)
+                         JobLog* log, Backend* backend)
 {
     lb::validate(params);
     const CacheKey key = cache ? lightKey(density, params) : CacheKey{};   // hashing the grid costs time
@@ -130,7 +132,8 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
         }
         if (log && why.find("no cache entry") == std::string::npos) log->warnings.push_back(why);
     }
-    LightingGrid grid = lb::solveLighting(density, params, progress);
+    LightingGrid grid = backend ? backend->solveLighting(density, params, progress, nullptr)
+                                : lb::solveLighting(density, params, progress);
     if (log) log->stages.push_back("light");
     if (cache) {
         try {

@@ -12,6 +12,7 @@
 
 namespace sylva {
 
+class Backend;
 class GridCache;
 
 // What ran, in order: "import", "voxelize", "voxelize (cache hit)", "light", "light (cache hit)", and
@@ -40,7 +41,9 @@ std::string densityHash(const DensityGrid& density);
 
 // Solves (or loads from the cache) the lighting of a density grid. The key covers the density content,
 // every LB parameter that changes the answer, the sun, steps/tolerance, storage and the format version.
+// backend: where the solve runs (null = the CPU); backends agree to float rounding, so the cache
+// key does not name the backend.
 LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache,
-                         Progress* progress = nullptr, JobLog* log = nullptr);
+                         Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
 
 } // namespace sylva

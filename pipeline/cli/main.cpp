@@ -16,6 +16,7 @@
 #include "core/lb/lb_solver.h"
 #include "core/voxel/voxelize.h"
 #include "pipeline/backend_info.h"
+#include "pipeline/backend_select.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/cli/cli_util.h"
 #include "pipeline/grow/obj_writer.h"
@@ -406,7 +407,7 @@ int cmdLight(const Args& args)
     const std::string backend = args.get("--backend", "auto");
     if (backend != "auto" && backend != "cpu" && backend != "cuda")
         throw UsageError("option --backend: expected auto, cpu or cuda, got '" + backend + "'");
-    if (backend == "cuda") std::fprintf(stderr, "note: the CUDA LB solver is not in this build yet; solving on the CPU\n");
+    auto compute = selectBackend(backend, [](const std::string& note) { std::fprintf(stderr, "note: %s\n", note.c_str()); });
     const lb::LbParams params = lightParams(args);
     auto cache = openCache(args);
     JobLog log;
@@ -434,7 +435,7 @@ int cmdLight(const Args& args)
     }
     printDensitySummary(density);
     ProgressPrinter bar("light", args.has("--quiet"));
-    const LightingGrid light = lightingFor(density, params, cache.get(), &bar.progress(), &log);
+    const LightingGrid light = lightingFor(density, params, cache.get(), &bar.progress(), &log, compute.get());
     bar.finish(log.stages.back());
     for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     // The sidecar records what produced the grid: the optics actually used (after any overrides).
@@ -512,20 +513,20 @@ int cmdRender(const Args& args)
     if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff")
         throw UsageError("output " + out + ": unknown image extension (use .png, .exr, .tif or .tiff)");
     requireReplaceableFile(out);
-    if (backend == "cuda") std::fprintf(stderr, "note: the CUDA renderer is not in this build yet; rendering on the CPU\n");
+    auto compute = selectBackend(backend, [](const std::string& note) { std::fprintf(stderr, "note: %s\n", note.c_str()); });
     auto cache = openCache(args);
     JobLog log;
     ProgressPrinter bar("render", args.has("--quiet"));
-    const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log);
+    const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get());
     bar.finish();
     for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     float ambient = 0.0f;
     const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, scene.sky, &ambient);
     writeRender(out, linear, r.width, r.height, r.exposureKey);
     const AccelStats& st = result.stats;
-    std::printf("rendered %dx%d, %d spp, mode %s, %zu instances of %zu species (%.0f instanced triangles)\nwrote %s\n",
+    std::printf("rendered %dx%d, %d spp, mode %s, %zu instances of %zu species (%.0f instanced triangles) on %s\nwrote %s\n",
                 r.width, r.height, r.spp, renderModeName(r.mode), st.instances, scene.species.size(), st.instancedTriangles,
-                out.c_str());
+                compute->name().c_str(), out.c_str());
     if (args.has("--stats")) {
         std::printf("time: assets %.3f s, build %.3f s, trace %.3f s\n", result.timings.assets, result.timings.build,
                     result.timings.trace);

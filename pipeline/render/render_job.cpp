@@ -7,6 +7,7 @@
 
 #include <QFile>
 
+#include "core/backend/backend.h"
 #include "core/base/error.h"
 #include "core/lb/lb_solver.h"
 #include "core/render/tonemap.h"
@@ -104,7 +105,7 @@ Scene defaultScene() { return parseScene(readResource("default_forest.sylva.json
 bool modeNeedsLighting(RenderMode mode) { return mode != RenderMode::Local; }
 
 std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cache, bool needLighting, Progress* progress,
-                                             JobLog* log)
+                                             JobLog* log, Backend* backend)
 {
     const size_t n = scene.species.size();
     std::vector<SpeciesAssets> out(n);
@@ -125,7 +126,7 @@ std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cach
         params.sun = scene.sun.direction;
         SubProgress lightPart(&sub, 0.2, 1.0);
         Progress lightProgress([&](double f, const std::string& msg) { lightPart.report(f, msg); });
-        out[s].lighting = lightingFor(density, params, cache, &lightProgress, log);
+        out[s].lighting = lightingFor(density, params, cache, &lightProgress, log, backend);
         const std::vector<float> f = lb::boundaryDistribution(params.sun);
         const float free = std::accumulate(f.begin(), f.end(), 0.0f);
         out[s].lightingNorm = params.intensity * free;
@@ -133,7 +134,7 @@ std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cach
     return out;
 }
 
-RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log)
+RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend)
 {
     RenderOutput out;
     auto t0 = std::chrono::steady_clock::now();
@@ -141,7 +142,7 @@ RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progres
     Progress assetsProgress([&](double f, const std::string& m) { assetsPart.report(f, m); });
     if (progress && progress->isCancelled()) assetsProgress.cancel();
     const std::vector<SpeciesAssets> assets =
-        loadSpeciesAssets(scene, cache, modeNeedsLighting(scene.render.mode), &assetsProgress, log);
+        loadSpeciesAssets(scene, cache, modeNeedsLighting(scene.render.mode), &assetsProgress, log, backend);
     out.timings.assets = secondsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
@@ -156,7 +157,7 @@ RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progres
     SubProgress tracePart(progress, 0.7, 1.0);
     Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
     if (progress && progress->isCancelled()) traceProgress.cancel();
-    out.film = renderFilm(rs.view(), &traceProgress);
+    out.film = backend ? backend->render(rs, &traceProgress) : renderFilm(rs.view(), &traceProgress);
     if (log) log->stages.push_back("trace");
     out.timings.trace = secondsSince(t0);
     return out;

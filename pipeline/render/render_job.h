@@ -13,6 +13,7 @@
 
 namespace sylva {
 
+class Backend;
 class GridCache;
 
 // The CIE 1931 table bundled with the program (resources/color).
@@ -32,7 +33,8 @@ bool modeNeedsLighting(RenderMode mode);
 // grids through the cache. Stages go to log as "SPECIES: grow|import", then the lighting job's stages.
 // The LB solve uses the scene's sun in the species frame (instances share their species' grid).
 std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cache, bool needLighting,
-                                             Progress* progress = nullptr, JobLog* log = nullptr);
+                                             Progress* progress = nullptr, JobLog* log = nullptr,
+                                             Backend* backend = nullptr);
 
 // Timings of one render, seconds.
 struct RenderTimings {
@@ -45,7 +47,9 @@ struct RenderOutput {
     AccelStats stats;
     RenderTimings timings;
 };
-RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr);
+// backend: where the LB solves and the frame run (null = the CPU).
+RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr,
+                         Backend* backend = nullptr);
 
 // Tone-mapped (Reinhard, log-average key) sRGB picture of linear RGB pixels, alpha 1.
 ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key);

@@ -1,0 +1,55 @@
+// Backend choice: CUDA when asked for or available, CPU otherwise; device trouble falls back to the CPU.
+#include "pipeline/backend_select.h"
+
+#include "cuda/cuda_backend.h"
+
+namespace sylva {
+
+FallbackBackend::FallbackBackend(std::unique_ptr<Backend> primary, std::function<void(const std::string&)> onFallback)
+    : m_primary(std::move(primary)), m_onFallback(std::move(onFallback))
+{
+}
+
+std::string FallbackBackend::name() const { return m_primary ? m_primary->name() : m_cpu.name(); }
+
+LightingGrid FallbackBackend::solveLighting(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
+                                            lb::SolveStats* stats)
+{
+    if (m_primary) {
+        try {
+            return m_primary->solveLighting(density, params, progress, stats);
+        } catch (const BackendError& e) {
+            if (m_onFallback) m_onFallback(std::string(e.what()) + "; solving on the CPU");
+            m_primary.reset();
+        }
+    }
+    return m_cpu.solveLighting(density, params, progress, stats);
+}
+
+Film FallbackBackend::render(const RenderScene& scene, Progress* progress)
+{
+    if (m_primary) {
+        try {
+            return m_primary->render(scene, progress);
+        } catch (const BackendError& e) {
+            if (m_onFallback) m_onFallback(std::string(e.what()) + "; rendering on the CPU");
+            m_primary.reset();
+        }
+    }
+    return m_cpu.render(scene, progress);
+}
+
+std::unique_ptr<Backend> selectBackend(const std::string& request, const std::function<void(const std::string&)>& onNote)
+{
+    if (request == "cpu") return std::make_unique<CpuBackend>();
+    if (request != "auto" && request != "cuda") throw Error("backend: expected auto, cpu or cuda, got '" + request + "'");
+    std::string why;
+    std::unique_ptr<Backend> cuda = cuda::makeCudaBackend(&why);
+    if (!cuda) {
+        if (request == "cuda" && onNote) onNote("CUDA requested but " + why + "; using the CPU");
+        return std::make_unique<CpuBackend>();
+    }
+    return std::make_unique<FallbackBackend>(std::move(cuda), onNote);
+}
+
+} // namespace sylva

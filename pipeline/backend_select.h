@@ -1,0 +1,34 @@
+// Picks the compute backend for a run (auto, cpu, cuda) and falls back to the CPU on device trouble.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "core/backend/backend.h"
+
+namespace sylva {
+
+// A backend that runs on `primary` (CUDA) and, when it throws BackendError (driver error, out of
+// device memory), reports the message through `onFallback` once and reruns the job on the CPU;
+// every later job goes straight to the CPU. Never a crash, never a half-done result.
+class FallbackBackend final : public Backend {
+public:
+    FallbackBackend(std::unique_ptr<Backend> primary, std::function<void(const std::string&)> onFallback);
+    std::string name() const override;
+    LightingGrid solveLighting(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
+                               lb::SolveStats* stats) override;
+    Film render(const RenderScene& scene, Progress* progress) override;
+
+private:
+    std::unique_ptr<Backend> m_primary;
+    CpuBackend m_cpu;
+    std::function<void(const std::string&)> m_onFallback;
+};
+
+// request: "auto" (CUDA when a device is present, else CPU), "cpu", or "cuda" (CPU with a note when
+// there is no device). Notes (one line each, e.g. "CUDA requested but no CUDA device: ...; using the
+// CPU") go to onNote; the returned backend is never null. Throws Error on another request.
+std::unique_ptr<Backend> selectBackend(const std::string& request, const std::function<void(const std::string&)>& onNote);
+
+} // namespace sylva

@@ -1,0 +1,202 @@
+// The CUDA backend against the CPU path: LB solves, ray hits, pictures; and the CPU fallback.
+// Tests that need a device skip with a message when there is none (CI machines have no GPU).
+#include <QProcess>
+#include <QTemporaryDir>
+#include <QTest>
+
+#include <cmath>
+#include <random>
+
+#include "core/grid/grid_compare.h"
+#include "core/lb/lb_solver.h"
+#include "core/render/render_cpu.h"
+#include "core/render/shade.h"
+#include "cuda/device_query.h"
+#include "pipeline/backend_select.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/render/render_job.h"
+#if SYLVA_HAVE_CUDA
+#include "cuda/lb_cuda.h"
+#include "cuda/render_cuda.h"
+#endif
+
+using namespace sylva;
+
+namespace {
+
+DensityGrid randomDensity(glm::ivec3 dims, uint32_t seed, bool withWood)
+{
+    DensityGrid d;
+    d.geometry.dims = dims;
+    d.geometry.spacing = 0.1;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    d.density.resize(d.geometry.nodeCount());
+    d.woodFraction.assign(d.geometry.nodeCount(), 0.0f);
+    for (int i = 0; i < dims.x; ++i)
+        for (int j = 0; j < dims.y; ++j)
+            for (int k = 0; k < dims.z; ++k) {
+                const size_t n = d.geometry.index(i, j, k);
+                const bool boundary = i == 0 || j == 0 || k == 0 || i == dims.x - 1 || j == dims.y - 1 || k == dims.z - 1;
+                d.density[n] = boundary || u(rng) < 0.4f ? 0.0f : u(rng);
+                if (withWood && u(rng) < 0.1f) d.woodFraction[n] = 1.0f;
+            }
+    return d;
+}
+
+// Two grown shrubs on the ground, small enough to trace quickly on the CPU.
+Scene smallScene()
+{
+    Scene s;
+    s.species.resize(1);
+    s.species[0].name = "shrub";
+    s.species[0].grow = GrowSpec{"shrub", 2, 4000, 2.0f};
+    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    s.species[0].grid = 16;
+    InstanceDesc a, b;
+    b.position = {1.5, 0.0, 1.0};
+    b.rotationDeg = {0.0f, 70.0f, 0.0f};
+    s.instances = {a, b};
+    s.camera.position = {0.0, 1.5, -5.0};
+    s.camera.target = {0.5, 0.8, 0.5};
+    s.render.width = 96;
+    s.render.height = 64;
+    return s;
+}
+
+} // namespace
+
+class TestGpu : public QObject {
+    Q_OBJECT
+
+    QString m_noDevice;   // non-empty: why the device tests skip
+
+private Q_SLOTS:
+    void initTestCase()
+    {
+        const cuda::DeviceQuery q = cuda::queryDevices();
+        if (!q.built) m_noDevice = "this build has no CUDA backend";
+        else if (q.devices.empty()) m_noDevice = QString::fromStdString(q.message);
+        else qInfo("device: %s (sm_%d%d)", q.devices[0].name.c_str(), q.devices[0].computeMajor, q.devices[0].computeMinor);
+    }
+
+    void lbMatchesCpu_data()
+    {
+        QTest::addColumn<QString>("preset");
+        QTest::addColumn<bool>("fp16");
+        QTest::addColumn<bool>("tolerance");
+        for (const char* p : {"leaf", "cloud", "pmma"})
+            for (bool h : {false, true}) QTest::newRow((std::string(p) + (h ? " fp16" : " fp32")).c_str()) << p << h << false;
+        QTest::newRow("leaf fp32 tolerance") << "leaf" << false << true;
+    }
+
+    // Random grids with brown nodes: the GPU equals the CPU to float rounding (fp32) or within the
+    // fp16 bound measured on the CPU (GPU fp16 vs CPU fp16).
+    void lbMatchesCpu()
+    {
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
+        QFETCH(QString, preset);
+        QFETCH(bool, fp16);
+        QFETCH(bool, tolerance);
+        const DensityGrid d = randomDensity({21, 17, 26}, 3, true);
+        lb::LbParams p = lb::paramsFromPreset(*lb::findPreset(preset.toStdString()));
+        p.sun = {0.3f, 1.0f, -0.2f};
+        p.storage = fp16 ? lb::Storage::Fp16 : lb::Storage::Fp32;
+        if (tolerance) p.tolerance = 1e-4;
+        lb::SolveStats cs, gs;
+        const LightingGrid cpu = lb::solveLighting(d, p, nullptr, &cs);
+        const LightingGrid gpu = cuda::solveLightingCuda(d, p, nullptr, &gs);
+        const double err = relativeL2(gpu, cpu);
+        qInfo("%s: relative L2 GPU vs CPU %.3g (steps CPU %d, GPU %d)", qPrintable(preset), err, cs.steps, gs.steps);
+        QVERIFY(std::isfinite(err));
+        if (!tolerance) QCOMPARE(gs.steps, cs.steps);
+        QVERIFY2(err < (fp16 ? 2e-3 : 1e-5), qPrintable(QString("error %1").arg(err)));
+#endif
+    }
+
+    // 100k random rays: the GPU finds the same closest hits and any-hit answers as the CPU.
+    void raysMatchCpu()
+    {
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
+        const Scene s = smallScene();
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, nullptr, false);
+        const RenderScene rs = buildRenderScene(s, assets, glm::vec3(1.0f));
+        const RenderView v = rs.view();
+        std::mt19937 rng(9);
+        std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+        std::vector<Ray> rays(100000);
+        for (Ray& r : rays) {
+            r.org = glm::vec3(u(rng) * 3.0f, 1.0f + u(rng), 5.0f + u(rng) * 2.0f);
+            r.dir = glm::normalize(glm::vec3(u(rng), u(rng) * 0.5f, u(rng)) + glm::vec3(0.0f, 0.0f, 0.0001f));
+            r.tmin = 0.0f;
+            r.tmax = 1e30f;
+        }
+        const cuda::DeviceScene ds(rs);
+        for (bool any : {false, true}) {
+            const std::vector<Hit> gpu = cuda::traceRaysCuda(ds, rays, any);
+            int differ = 0, hits = 0;
+            for (size_t i = 0; i < rays.size(); ++i) {
+                Hit h{};
+                const bool got = any ? traceScene<true>(v, rays[i], h) : traceScene<false>(v, rays[i], h);
+                const bool ggot = gpu[i].prim != kNoHit;
+                hits += got;
+                if (got != ggot || (!any && got && (h.prim != gpu[i].prim || std::fabs(h.t - gpu[i].t) > 1e-4f * h.t))) ++differ;
+            }
+            qInfo("%s: %d of %zu rays differ (%d hits)", any ? "any-hit" : "closest", differ, rays.size(), hits);
+            QVERIFY(hits > 1000);
+            QVERIFY2(differ <= int(rays.size()) / 10000, qPrintable(QString("%1 rays differ").arg(differ)));
+        }
+#endif
+    }
+
+    // The GPU film composes and tone-maps to the CPU picture in every mode.
+    void imagesMatchCpu()
+    {
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
+        Scene s = smallScene();
+        QTemporaryDir dir;
+        GridCache cache(dir.path().toStdString());
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
+        const RenderScene rs = buildRenderScene(s, assets, sunRadiance(s.sun));
+        const Film cpu = renderFilm(rs.view());
+        const Film gpu = cuda::renderCuda(cuda::DeviceScene(rs));
+        for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb}) {
+            const ImageRgba a = toneMapped(composeMode(cpu, m, s.sky), s.render.width, s.render.height, 0.18f);
+            const ImageRgba b = toneMapped(composeMode(gpu, m, s.sky), s.render.width, s.render.height, 0.18f);
+            int bad = 0;
+            for (size_t i = 0; i < a.pixels.size(); ++i) bad += std::fabs(a.pixels[i] - b.pixels[i]) > 0.1f;
+            qInfo("%s: %d of %zu values differ by more than 0.1", renderModeName(m), bad, a.pixels.size());
+            QVERIFY(bad <= int(a.pixels.size()) / 200);
+        }
+#endif
+    }
+
+    // With no visible device, --backend cuda says so on stderr and renders on the CPU (runs everywhere).
+    void fallsBackToCpu()
+    {
+        QTemporaryDir dir;
+        QProcess p;
+        QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+        env.insert("CUDA_VISIBLE_DEVICES", "");
+        env.insert("XDG_CACHE_HOME", dir.path());
+        p.setProcessEnvironment(env);
+        const QString out = dir.path() + "/fallback.png";
+        p.start(SYLVA_CLI_PATH, {"render", "--backend", "cuda", "--width", "32", "--height", "16", "--mode", "local",
+                                 "--quiet", "-o", out});
+        QVERIFY(p.waitForFinished(600000));
+        const QString err = QString::fromUtf8(p.readAllStandardError()), so = QString::fromUtf8(p.readAllStandardOutput());
+        QVERIFY2(p.exitCode() == 0, qPrintable(err));
+        QVERIFY2(err.contains("using the CPU"), qPrintable(err));
+        QVERIFY2(so.contains("on cpu"), qPrintable(so));
+        QVERIFY(QFile::exists(out));
+        // The backend choice itself: cpu is always cpu; an unknown request is an error.
+        QCOMPARE(QString::fromStdString(selectBackend("cpu", {})->name()), QString("cpu"));
+        QVERIFY_THROWS_EXCEPTION(Error, selectBackend("opencl", {}));
+    }
+};
+
+QTEST_GUILESS_MAIN(TestGpu)
+#include "tst_gpu.moc"
