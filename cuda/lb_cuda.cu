@@ -2,6 +2,7 @@
 // ping-pong buffers, fp32 or fp16 storage; the convergence check runs on the device.
 #include "cuda/lb_cuda.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <vector>
@@ -231,6 +232,30 @@ LightingGrid solveTyped(const DensityGrid& density, const lb::LbParams& params, 
 }
 
 } // namespace
+
+double deviceCopyBandwidth(size_t bytes, int reps)
+{
+    DeviceBuffer<char> a(bytes, "bandwidth buffer"), b(bytes, "bandwidth buffer");
+    check(cudaMemset(a.get(), 1, bytes), "bandwidth buffer");
+    cudaEvent_t e0, e1;
+    check(cudaEventCreate(&e0), "event");
+    check(cudaEventCreate(&e1), "event");
+    std::vector<float> ms;
+    for (int r = 0; r < reps + 1; ++r) {
+        cudaEventRecord(e0);
+        cudaMemcpy(b.get(), a.get(), bytes, cudaMemcpyDeviceToDevice);
+        cudaEventRecord(e1);
+        cudaEventSynchronize(e1);
+        float t = 0.0f;
+        cudaEventElapsedTime(&t, e0, e1);
+        if (r > 0) ms.push_back(t);   // the first copy warms up
+    }
+    cudaEventDestroy(e0);
+    cudaEventDestroy(e1);
+    check(cudaGetLastError(), "bandwidth copies");
+    std::sort(ms.begin(), ms.end());
+    return 2.0 * double(bytes) / (double(ms[ms.size() / 2]) * 1e-3);
+}
 
 LightingGrid solveLightingCuda(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
                                lb::SolveStats* stats)

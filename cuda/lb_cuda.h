@@ -13,4 +13,8 @@ namespace sylva::cuda {
 LightingGrid solveLightingCuda(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
                                lb::SolveStats* stats);
 
+// Device-to-device copy bandwidth in bytes per second (bytes read + written), median of reps copies
+// of `bytes`: the memory floor the LB kernel is compared against.
+double deviceCopyBandwidth(size_t bytes, int reps);
+
 } // namespace sylva::cuda
