@@ -1,4 +1,5 @@
 // sylva: the command line (grow, voxelize, light, info). Exit codes: 0 ok, 1 bad input or failure, 2 bad usage.
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -14,6 +15,7 @@
 #include "core/base/version.h"
 #include "core/lb/lb_params.h"
 #include "core/lb/lb_solver.h"
+#include "core/reference/mc_reference.h"
 #include "core/voxel/voxelize.h"
 #include "pipeline/backend_info.h"
 #include "pipeline/backend_select.h"
@@ -163,6 +165,26 @@ std::vector<Command> commands()
                      {"--warm-start", "", "start from the unobstructed light field: same steady state, fewer steps"},
                      {"--backend", "auto|cpu|cuda", "compute backend (default auto)"},
                      kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
+                    0, 0});
+    list.push_back({"reference", "(--density DENSITY.npy | --mesh MESH) --sun X,Y,Z -o REF.npy",
+                    "Monte Carlo reference lighting (slow; measures the LB model): mean and standard error",
+                    {{"--density", "FILE", "density grid (.npy from sylva voxelize)"},
+                     {"--mesh", "FILE", "mesh to voxelize first (with --grid)"},
+                     kGrid, kSubcells, kLeafMaterials,
+                     {"--preset", "NAME", "leaf (default), dogrose, cloud or pmma (the optics of sylva light)"},
+                     {"--sigma-a", "R,G,B", "absorption per lattice step (one number: all channels)"},
+                     {"--sigma-s", "R,G,B", "scattering per lattice step; sigma_a + sigma_s <= 1"},
+                     {"--g", "R,G,B", "Henyey-Greenstein asymmetry in [-1, 1]"},
+                     {"--keep-f0", "", "absorbed light is re-emitted isotropically (clouds, plastics)"},
+                     {"--zero-f0", "", "absorbed light is removed (plants)"},
+                     {"--sun", "X,Y,Z", "direction toward the sun (any length)"},
+                     {"--intensity", "R,G,B", "sun intensity per channel (default 1)"},
+                     {"--paths", "N", "paths per channel (default 1000000); the error falls as 1/sqrt(N)"},
+                     {"--seed", "S", "random seed (default 1); the same seed gives the same bits"},
+                     {"--max-bounces", "K", "scattering events per path (default unlimited; 0: direct light only)"},
+                     {"--collimated", "", "one beam along the sun instead of the LB's 18 lattice beams"},
+                     {"--compare", "LIGHT.npy", "print the normalized error of this LB grid against the reference"},
+                     kOutput, kCache, kNoCache, kThreads, kQuiet},
                     0, 0});
     list.push_back({"render", "[SCENE.sylva.json] [-o OUT.png|.exr|.tif]",
                     "render a scene (the bundled default forest when none is given)",
@@ -475,6 +497,119 @@ int cmdLight(const Args& args)
     return kOk;
 }
 
+// "REF.npy" -> "REF.stderr.npy" (PATH + ".stderr.npy" when PATH does not end in ".npy").
+std::string standardErrorPath(const std::string& meanPath)
+{
+    const std::string ext = ".npy";
+    if (meanPath.size() > ext.size() && meanPath.compare(meanPath.size() - ext.size(), ext.size(), ext) == 0)
+        return meanPath.substr(0, meanPath.size() - ext.size()) + ".stderr.npy";
+    return meanPath + ".stderr.npy";
+}
+
+int cmdReference(const Args& args)
+{
+    auto threads = threadLimit(args);
+    if (args.has("--density") == args.has("--mesh"))
+        throw UsageError("'sylva reference' needs exactly one of --density FILE or --mesh FILE");
+    const std::string out = args.require("--output");
+    const lb::LbParams params = lightParams(args);
+    ReferenceSettings settings;
+    if (args.has("--paths"))
+        settings.paths = uint64_t(parseInteger("--paths", args.get("--paths"), 2, (long long)kMaxReferencePaths));
+    if (args.has("--seed")) settings.seed = uint64_t(parseInteger("--seed", args.get("--seed"), 0, (1LL << 62)));
+    if (args.has("--max-bounces")) settings.maxBounces = int(parseInteger("--max-bounces", args.get("--max-bounces"), 0, 1000000000));
+    if (args.has("--collimated")) settings.incidence = Incidence::Collimated;
+    const VoxelizeSettings voxel = voxelSettings(args);
+    if (args.has("--density"))
+        for (const char* meshOnly : {"--grid", "--subcells", "--leaf-materials"})
+            if (args.has(meshOnly)) throw UsageError(std::string(meshOnly) + " applies to --mesh, not to --density");
+    const std::string errPath = standardErrorPath(out);
+    for (const std::string& target : {out, gridSidecarPath(out), errPath, gridSidecarPath(errPath)}) requireReplaceableFile(target);
+    std::optional<LightingGrid> compare;
+    if (args.has("--compare")) {
+        requireReadable(args.get("--compare"), "lighting grid");
+        compare = readLightingGrid(args.get("--compare"));
+    }
+    auto cache = openCache(args);
+    JobLog log;
+    DensityGrid density;
+    if (args.has("--density")) {
+        const std::string path = args.get("--density");
+        requireReadable(path, "density grid");
+        density = readDensityGrid(path);
+        try {
+            lb::validateDensity(density);
+        } catch (const Error& e) {
+            throw Error(path + ": " + e.what());
+        }
+    } else {
+        requireReadable(args.get("--mesh"), "mesh file");
+        ProgressPrinter vbar("voxelize", args.has("--quiet"));
+        density = densityForMesh({args.get("--mesh"), importOptions(args), voxel}, cache.get(), &vbar.progress(), &log);
+        vbar.finish(log.stages.back());
+    }
+    if (compare && compare->geometry.dims != density.geometry.dims)
+        throw Error(args.get("--compare") + ": grid " + dimsText(compare->geometry) + " differs from the density grid " +
+                    dimsText(density.geometry));
+    printDensitySummary(density);
+    ProgressPrinter bar("reference", args.has("--quiet"));
+    const ReferenceResult ref = solveReference(density, params, settings, &bar.progress());
+    bar.finish();
+    for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    // The sidecars record what produced the grids.
+    std::ostringstream extra;
+    extra.precision(9);
+    auto triple = [&](auto get) { extra << "[" << get(0) << "," << get(1) << "," << get(2) << "]"; };
+    extra << "{\"solver\":\"reference\",\"preset\":\"" << args.get("--preset", "leaf") << "\",\"sigma_a\":";
+    triple([&](int c) { return params.channels[size_t(c)].sigmaA; });
+    extra << ",\"sigma_s\":";
+    triple([&](int c) { return params.channels[size_t(c)].sigmaS; });
+    extra << ",\"g\":";
+    triple([&](int c) { return params.channels[size_t(c)].g; });
+    extra << ",\"sun\":";
+    triple([&](int c) { return params.sun[c]; });
+    extra << ",\"intensity\":";
+    triple([&](int c) { return params.intensity[c]; });
+    extra << ",\"zero_f0\":" << (params.zeroF0 ? "true" : "false") << ",\"paths\":" << settings.paths
+          << ",\"seed\":" << settings.seed << ",\"max_bounces\":" << settings.maxBounces << ",\"incidence\":\""
+          << (settings.incidence == Incidence::Collimated ? "collimated" : "lattice") << "\"";
+    const std::string common = extra.str();
+    writeLightingGrid(out, ref.mean, common + ",\"quantity\":\"mean fluence\"}");
+    const LightingGrid seGrid{ref.mean.geometry, ref.standardError};
+    writeLightingGrid(errPath, seGrid, common + ",\"quantity\":\"standard error of the mean\"}");
+
+    LightingGrid norm = ref.mean;
+    std::vector<float> normErr = ref.standardError;
+    normalizeToUnobstructed(norm, params, &normErr);
+    double mean[3] = {0, 0, 0};
+    for (size_t n = 0; n < norm.rgb.size() / 3; ++n)
+        for (int c = 0; c < 3; ++c) mean[c] += norm.rgb[n * 3 + size_t(c)];
+    const double nodes = double(norm.rgb.size() / 3);
+    std::printf("reference %s: %llu paths x %d channel solves in %.1f s, %.2f collisions per path; mean RGB / unobstructed "
+                "(%.4f, %.4f, %.4f), relative noise %.4f (interior nodes)\nwrote %s (+ %s)\n",
+                dimsText(norm.geometry).c_str(), (unsigned long long)ref.paths, ref.channelSolves, ref.seconds,
+                ref.collisionsPerPath, mean[0] / nodes, mean[1] / nodes, mean[2] / nodes, relativeNoiseInterior(norm, normErr),
+                out.c_str(), errPath.c_str());
+    if (compare) {
+        normalizeToUnobstructed(*compare, params);
+        double sumLb = 0.0, sumRef = 0.0;
+        for (int i = 1; i < norm.geometry.dims.x - 1; ++i)
+            for (int j = 1; j < norm.geometry.dims.y - 1; ++j)
+                for (int k = 1; k < norm.geometry.dims.z - 1; ++k)
+                    for (int c = 0; c < 3; ++c) {
+                        sumLb += compare->at(i, j, k, c);
+                        sumRef += norm.at(i, j, k, c);
+                    }
+        const double err = relativeL2Interior(*compare, norm), noise = relativeNoiseInterior(norm, normErr);
+        std::printf("%s against the reference (both / unobstructed value, interior nodes): relative L2 error %.4f "
+                    "(R %.4f, G %.4f, B %.4f), reference noise %.4f, without the noise ~%.4f; mean LB / mean reference %.4f\n",
+                    args.get("--compare").c_str(), err, relativeL2Interior(*compare, norm, 0), relativeL2Interior(*compare, norm, 1),
+                    relativeL2Interior(*compare, norm, 2), noise, std::sqrt(std::max(0.0, err * err - noise * noise)),
+                    sumRef > 0.0 ? sumLb / sumRef : 0.0);
+    }
+    return kOk;
+}
+
 std::string lowerExtension(const std::string& path)
 {
     std::string ext = fs::path(path).extension().string();
@@ -626,6 +761,7 @@ int main(int argc, char** argv)
         if (cmd->name == "grow") return cmdGrow(args);
         if (cmd->name == "voxelize") return cmdVoxelize(args);
         if (cmd->name == "light") return cmdLight(args);
+        if (cmd->name == "reference") return cmdReference(args);
         if (cmd->name == "render") return cmdRender(args);
         if (cmd->name == "info") return cmdInfo(args);
     } catch (const UsageError& e) {
