@@ -51,6 +51,14 @@ struct BvhView {
     const BvhNode* nodes;
 };
 
+// Optional traversal counters for profiling tools (compiled in only with SYLVA_TRAVERSAL_STATS).
+#if defined(SYLVA_TRAVERSAL_STATS) && !defined(__CUDA_ARCH__)
+inline thread_local uint64_t g_bvhNodeVisits = 0, g_bvhLeafVisits = 0;
+#define SYLVA_COUNT(counter) (++(counter))
+#else
+#define SYLVA_COUNT(counter) ((void)0)
+#endif
+
 // Every visit pushes at most three children; build depth is capped below 64.
 inline constexpr int kBvhStackSize = 192;
 
@@ -69,46 +77,72 @@ SYLVA_INLINE Float4 max4(Float4 a, Float4 b) { return a > b ? a : b; }
 } // namespace detail
 #endif
 
-// Entry distances of the ray into the node's four child boxes; a lane is > tmax when missed.
-SYLVA_HD SYLVA_INLINE void nodeEntry(const BvhNode& n, const glm::vec3& org, const glm::vec3& inv, unsigned zeroAxes,
-                                     float tmin, float tmax, float tn[4])
+// Entry distances of the ray into the node's four child boxes and the mask of children entered
+// within [tmin, tmax] (bit k = child k; unused children are never entered).
+SYLVA_HD SYLVA_INLINE unsigned nodeEntry(const BvhNode& n, const glm::vec3& org, const glm::vec3& inv, unsigned zeroAxes,
+                                         float tmin, float tmax, float tn[4])
 {
 #if !defined(__CUDA_ARCH__)
     using namespace detail;
     const Float4 ox = {org.x, org.x, org.x, org.x}, oy = {org.y, org.y, org.y, org.y}, oz = {org.z, org.z, org.z, org.z};
     const Float4 ix = {inv.x, inv.x, inv.x, inv.x}, iy = {inv.y, inv.y, inv.y, inv.y}, iz = {inv.z, inv.z, inv.z, inv.z};
-    const Float4 x0 = (load4(n.lox) - ox) * ix, x1 = (load4(n.hix) - ox) * ix;
-    const Float4 y0 = (load4(n.loy) - oy) * iy, y1 = (load4(n.hiy) - oy) * iy;
-    const Float4 z0 = (load4(n.loz) - oz) * iz, z1 = (load4(n.hiz) - oz) * iz;
     const Float4 lo = {tmin, tmin, tmin, tmin}, hi = {tmax, tmax, tmax, tmax};
-    Float4 tnear = max4(max4(min4(x0, x1), min4(y0, y1)), max4(min4(z0, z1), lo));
-    Float4 tfar = min4(min4(max4(x0, x1), max4(y0, y1)), min4(max4(z0, z1), hi));
-    if (__builtin_expect(zeroAxes != 0, 0)) {
-        // Rays with a zero direction component (rare; the same branch for the whole traversal):
-        // on such an axis the slab is all of t when the origin lies in [lo, hi], else empty.
+    Float4 tnear, tfar;
+    if (__builtin_expect(zeroAxes == 0, 1)) {
+        // Near and far planes chosen by the direction's signs: no min/max per axis, and an inverted
+        // (unused) box gives near > far on every axis, so it is never entered.
+        const Float4 nx = (load4(inv.x >= 0.0f ? n.lox : n.hix) - ox) * ix, fx = (load4(inv.x >= 0.0f ? n.hix : n.lox) - ox) * ix;
+        const Float4 ny = (load4(inv.y >= 0.0f ? n.loy : n.hiy) - oy) * iy, fy = (load4(inv.y >= 0.0f ? n.hiy : n.loy) - oy) * iy;
+        const Float4 nz = (load4(inv.z >= 0.0f ? n.loz : n.hiz) - oz) * iz, fz = (load4(inv.z >= 0.0f ? n.hiz : n.loz) - oz) * iz;
+        tnear = max4(max4(nx, ny), max4(nz, lo));
+        tfar = min4(min4(fx, fy), min4(fz, hi));
+    } else {
+        // A zero direction component (rare; the same branch for the whole traversal): on that axis
+        // the slab is all of t when the origin lies in [lo, hi] (a ray in a box face enters it), else empty.
         const Float4 big = {1e30f, 1e30f, 1e30f, 1e30f};
-        const Float4 lox = load4(n.lox), hix = load4(n.hix), loy = load4(n.loy), hiy = load4(n.hiy);
-        const Float4 loz = load4(n.loz), hiz = load4(n.hiz);
-        auto fix = [&](const Float4& l, const Float4& h, const Float4& o) {
-            const auto inside = (l <= o) & (o <= h);
-            const Float4 t0 = inside ? -big : big, t1 = inside ? big : -big;
-            return std::pair<Float4, Float4>(t0, t1);
+        auto axis = [&](const float* l, const float* h, const Float4& o, const Float4& i, bool zero, Float4& t0, Float4& t1) {
+            const Float4 L = load4(l), H = load4(h);
+            if (zero) {
+                const auto inside = (L <= o) & (o <= H);
+                t0 = inside ? -big : big;
+                t1 = inside ? big : -big;
+            } else {
+                const Float4 a = (L - o) * i, b = (H - o) * i;
+                t0 = min4(a, b);
+                t1 = max4(a, b);
+                const auto inverted = L > H;   // unused child
+                t0 = inverted ? big : t0;
+                t1 = inverted ? -big : t1;
+            }
         };
-        Float4 ax0 = x0, ax1 = x1, ay0 = y0, ay1 = y1, az0 = z0, az1 = z1;
-        if (zeroAxes & 1) std::tie(ax0, ax1) = fix(lox, hix, ox);
-        if (zeroAxes & 2) std::tie(ay0, ay1) = fix(loy, hiy, oy);
-        if (zeroAxes & 4) std::tie(az0, az1) = fix(loz, hiz, oz);
-        tnear = max4(max4(min4(ax0, ax1), min4(ay0, ay1)), max4(min4(az0, az1), lo));
-        tfar = min4(min4(max4(ax0, ax1), max4(ay0, ay1)), min4(max4(az0, az1), hi));
+        Float4 x0, x1, y0, y1, z0, z1;
+        axis(n.lox, n.hix, ox, ix, zeroAxes & 1u, x0, x1);
+        axis(n.loy, n.hiy, oy, iy, zeroAxes & 2u, y0, y1);
+        axis(n.loz, n.hiz, oz, iz, zeroAxes & 4u, z0, z1);
+        tnear = max4(max4(x0, y0), max4(z0, lo));
+        tfar = min4(min4(x1, y1), min4(z1, hi));
     }
-    const Float4 miss = {missDistance(), missDistance(), missDistance(), missDistance()};
-    const Float4 r = tnear <= tfar ? tnear : miss;
-    __builtin_memcpy(tn, &r, 16);
+    const auto entered = tnear <= tfar;
+    __builtin_memcpy(tn, &tnear, 16);
+    return (entered[0] ? 1u : 0u) | (entered[1] ? 2u : 0u) | (entered[2] ? 4u : 0u) | (entered[3] ? 8u : 0u);
 #else
     (void)zeroAxes;
-    for (int k = 0; k < 4; ++k)
+    unsigned mask = 0;
+    for (int k = 0; k < 4; ++k) {
         tn[k] = rayBoxEntry(glm::vec3(n.lox[k], n.loy[k], n.loz[k]), glm::vec3(n.hix[k], n.hiy[k], n.hiz[k]), org, inv,
                             tmin, tmax);
+        if (tn[k] <= tmax && n.child[k] != kNoHit) mask |= 1u << k;
+    }
+    return mask;
+#endif
+}
+
+SYLVA_HD SYLVA_INLINE int lowestBit(unsigned mask)
+{
+#if defined(__CUDA_ARCH__)
+    return __ffs(int(mask)) - 1;
+#else
+    return __builtin_ctz(mask);
 #endif
 }
 
@@ -128,15 +162,19 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
     uint32_t node = 0;
     for (;;) {
         const BvhNode& n = bvh.nodes[node];
+        SYLVA_COUNT(g_bvhNodeVisits);
         float tn[4];
-        nodeEntry(n, org, inv, zeroAxes, tmin, tmax, tn);
+        unsigned mask = nodeEntry(n, org, inv, zeroAxes, tmin, tmax, tn);
         // Leaves are handled at once (they may shrink tmax); inner children are sorted near to far.
         uint32_t innerNode[4];
         float innerDist[4];
         int inner = 0;
-        for (int k = 0; k < 4; ++k) {
-            if (!(tn[k] <= tmax) || n.child[k] == kNoHit) continue;
+        while (mask) {
+            const int k = lowestBit(mask);
+            mask &= mask - 1u;
+            if (!(tn[k] <= tmax)) continue;   // a leaf of this node recorded a closer hit
             if (n.count[k] > 0) {
+                SYLVA_COUNT(g_bvhLeafVisits);
                 if constexpr (std::is_invocable_v<LeafFn, uint32_t, uint32_t, float&>) {
                     if (leaf(n.child[k], n.count[k], tmax)) return true;
                 } else {
