@@ -1,0 +1,68 @@
+// Orbit, pan and zoom on CameraDesc in doubles.
+#include "studio/camera_nav.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace sylva {
+namespace {
+
+constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+
+} // namespace
+
+CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg)
+{
+    CameraDesc c = camera;
+    const glm::dvec3 offset = c.position - c.target;
+    const double dist = glm::length(offset);
+    if (!(dist > 0.0)) return c;
+    double yaw = std::atan2(offset.x, offset.z);
+    double pitch = std::asin(std::clamp(offset.y / dist, -1.0, 1.0));
+    yaw += yawDeg * kDegToRad;
+    pitch = std::clamp(pitch + pitchDeg * kDegToRad, -89.0 * kDegToRad, 89.0 * kDegToRad);
+    const glm::dvec3 dir(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+    c.position = c.target + dist * dir;
+    c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    return c;
+}
+
+CameraDesc panCamera(const CameraDesc& camera, double dx, double dy, double viewHeight)
+{
+    CameraDesc c = camera;
+    const glm::dvec3 fwd = c.target - c.position;
+    const double dist = glm::length(fwd);
+    if (!(dist > 0.0) || !(viewHeight > 0.0)) return c;
+    const glm::dvec3 f = fwd / dist;
+    glm::dvec3 right = glm::cross(f, glm::dvec3(c.up));
+    if (!(glm::length(right) > 1e-9)) return c;
+    right = glm::normalize(right);
+    const glm::dvec3 up = glm::cross(right, f);
+    const double metresPerPixel = 2.0 * dist * std::tan(double(c.fovY) * 0.5 * kDegToRad) / viewHeight;
+    const glm::dvec3 move = (-dx * right + dy * up) * metresPerPixel;
+    c.position += move;
+    c.target += move;
+    return c;
+}
+
+CameraDesc zoomCamera(const CameraDesc& camera, double steps, double factor)
+{
+    CameraDesc c = camera;
+    const glm::dvec3 offset = c.position - c.target;
+    const double dist = glm::length(offset);
+    if (!(dist > 0.0)) return c;
+    const double next = std::max(0.01, dist * std::pow(factor, steps));
+    c.position = c.target + offset * (next / dist);
+    return c;
+}
+
+void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg)
+{
+    const glm::dvec3 d = glm::normalize(glm::dvec3(direction));
+    *elevationDeg = std::asin(std::clamp(d.y, -1.0, 1.0)) / kDegToRad;
+    double az = std::atan2(d.x, d.z) / kDegToRad;
+    if (az < 0.0) az += 360.0;
+    *azimuthDeg = az;
+}
+
+} // namespace sylva

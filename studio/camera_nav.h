@@ -1,0 +1,23 @@
+// Viewport navigation on a scene camera: orbit about the target, pan in the image plane, dolly zoom.
+#pragma once
+
+#include "core/scene/scene.h"
+
+namespace sylva {
+
+// Rotates the eye about the target: yaw about world +Y, pitch about the camera's right axis (degrees),
+// pitch kept within 1 degree of the poles. The target stays put.
+CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg);
+
+// Moves eye and target together by (dx, dy) pixels of an image `viewHeight` pixels tall, so the point
+// under the cursor at the target's distance follows the cursor.
+CameraDesc panCamera(const CameraDesc& camera, double dx, double dy, double viewHeight);
+
+// Moves the eye toward the target by factor^steps of the distance (steps > 0: closer); the distance
+// stays above 1 cm.
+CameraDesc zoomCamera(const CameraDesc& camera, double steps, double factor = 0.85);
+
+// Elevation and azimuth (degrees, scene.h's convention) of a direction toward the sun.
+void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg);
+
+} // namespace sylva

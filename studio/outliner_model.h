@@ -1,0 +1,45 @@
+// The scene outliner: a two-level tree model over the document (groups: Species, Instances, Ground,
+// Sun, Camera; rows under Species and Instances), columns Name and Details.
+#pragma once
+
+#include <QAbstractItemModel>
+
+#include "studio/scene_document.h"
+
+namespace sylva {
+
+// What an outliner row stands for.
+struct OutlinerItem {
+    enum class Kind { None, SpeciesGroup, InstancesGroup, Ground, Sun, Camera, Species, Instance };
+    Kind kind = Kind::None;
+    int row = -1;   // index into Scene::species / Scene::instances for Species / Instance
+    bool operator==(const OutlinerItem&) const = default;
+};
+
+class OutlinerModel : public QAbstractItemModel {
+    Q_OBJECT
+
+public:
+    enum Group { SpeciesGroup, InstancesGroup, GroundGroup, SunGroup, CameraGroup, GroupCount };
+
+    explicit OutlinerModel(SceneDocument* doc, QObject* parent = nullptr);
+
+    QModelIndex index(int row, int column, const QModelIndex& parent = {}) const override;
+    QModelIndex parent(const QModelIndex& child) const override;
+    int rowCount(const QModelIndex& parent = {}) const override;
+    int columnCount(const QModelIndex& parent = {}) const override;
+    QVariant data(const QModelIndex& index, int role = Qt::DisplayRole) const override;
+    QVariant headerData(int section, Qt::Orientation orientation, int role = Qt::DisplayRole) const override;
+    Qt::ItemFlags flags(const QModelIndex& index) const override;
+
+    OutlinerItem itemAt(const QModelIndex& index) const;
+    QModelIndex indexOf(const OutlinerItem& item, int column = 0) const;
+
+private:
+    void onChanged(ScenePart parts);
+
+    SceneDocument* m_doc;
+    int m_species = 0, m_instances = 0;   // row counts the views know about
+};
+
+} // namespace sylva

@@ -1,0 +1,88 @@
+// Properties of the outliner's current item: numeric edits that become undoable scene edits.
+#pragma once
+
+#include <array>
+#include <functional>
+#include <map>
+
+#include <QWidget>
+
+#include "studio/outliner_model.h"
+#include "studio/scene_document.h"
+
+class QCheckBox;
+class QComboBox;
+class QDial;
+class QDoubleSpinBox;
+class QLabel;
+class QLineEdit;
+class QSpinBox;
+class QStackedWidget;
+
+namespace sylva {
+
+class PropertyPanel : public QWidget {
+    Q_OBJECT
+
+public:
+    explicit PropertyPanel(SceneDocument* doc, QWidget* parent = nullptr);
+
+    void showItem(const OutlinerItem& item);
+    OutlinerItem item() const { return m_item; }
+
+    // The editors, for tests and keyboard users (named: objectName is "instance.position.x" etc.).
+    QDoubleSpinBox* instancePosition(int axis) const { return m_instPos[size_t(axis)]; }
+    QDoubleSpinBox* instanceRotation(int axis) const { return m_instRot[size_t(axis)]; }
+    QDoubleSpinBox* instanceScale() const { return m_instScale; }
+    QDial* sunAzimuthDial() const { return m_sunDial; }
+    QDoubleSpinBox* sunElevation() const { return m_sunElevation; }
+    QDoubleSpinBox* sunTemperature() const { return m_sunTemperature; }
+    QSpinBox* speciesGrid() const { return m_speciesGrid; }
+
+private:
+    QWidget* buildEmptyPage();
+    QWidget* buildInstancePage();
+    QWidget* buildSpeciesPage();
+    QWidget* buildSunPage();
+    QWidget* buildCameraPage();
+    QWidget* buildGroundPage();
+    void refresh();
+    // Applies `change` to a copy of the scene and pushes it; edits of one editor in a row merge.
+    void apply(QObject* editor, const QString& text, const std::function<void(Scene&)>& change);
+    QDoubleSpinBox* spin(const QString& name, double lo, double hi, int decimals, double step);
+
+    SceneDocument* m_doc;
+    OutlinerItem m_item;
+    QStackedWidget* m_stack;
+    QWidget *m_emptyPage, *m_instancePage, *m_speciesPage, *m_sunPage, *m_cameraPage, *m_groundPage;
+
+    QComboBox* m_instSpecies;
+    std::array<QDoubleSpinBox*, 3> m_instPos{}, m_instRot{};
+    QDoubleSpinBox* m_instScale;
+
+    QLabel* m_speciesTitle;
+    QLabel* m_speciesSource;
+    QLineEdit* m_speciesName;
+    QComboBox* m_speciesPreset;
+    QSpinBox* m_speciesGrid;
+
+    QDoubleSpinBox* m_sunElevation;
+    QDial* m_sunDial;
+    QDoubleSpinBox* m_sunAzimuth;
+    QDoubleSpinBox* m_sunTemperature;
+    QDoubleSpinBox* m_sunIntensity;
+
+    std::array<QDoubleSpinBox*, 3> m_camPos{}, m_camTarget{};
+    QDoubleSpinBox* m_camFov;
+
+    QCheckBox* m_groundEnabled;
+    QDoubleSpinBox* m_groundHeight;
+
+    struct MergeState {
+        int key = 0;
+        qint64 lastMs = 0;
+    };
+    std::map<QObject*, MergeState> m_mergeKeys;
+};
+
+} // namespace sylva

@@ -1,0 +1,234 @@
+// The studio's document and outliner without GL: undo/redo and merging, modified state, save and
+// reopen, the outliner model under QAbstractItemModelTester, the property panel's edits, navigation math.
+#include <QAbstractItemModelTester>
+#include <QDial>
+#include <QDoubleSpinBox>
+#include <QSignalSpy>
+#include <QSpinBox>
+#include <QStandardPaths>
+#include <QTemporaryDir>
+#include <QTest>
+
+#include <cmath>
+
+#include "core/base/error.h"
+#include "core/lb/lb_params.h"
+#include "pipeline/scene/scene_file.h"
+#include "studio/camera_nav.h"
+#include "studio/outliner_model.h"
+#include "studio/property_panel.h"
+#include "studio/scene_document.h"
+
+using namespace sylva;
+
+namespace {
+
+QString sharedTree() { return QStringLiteral(SYLVA_SHARED_DATA "/trees/quaternius/OBJ/Tree_1.obj"); }
+
+Scene treeScene(int instances)
+{
+    Scene s;
+    SpeciesDesc sp;
+    sp.name = "Tree_1";
+    sp.meshPath = sharedTree().toStdString();
+    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    s.species.push_back(sp);
+    for (int i = 0; i < instances; ++i) {
+        InstanceDesc in;
+        in.position = {2.0 * i, 0.0, 0.0};
+        s.instances.push_back(in);
+    }
+    return s;
+}
+
+} // namespace
+
+class TstSceneDocument : public QObject {
+    Q_OBJECT
+
+private Q_SLOTS:
+    void initTestCase() { QStandardPaths::setTestModeEnabled(true); }
+
+    void editUndoRedo()
+    {
+        SceneDocument doc;
+        QSignalSpy changed(&doc, &SceneDocument::changed);
+        QVERIFY(!doc.isModified());
+        Scene s = treeScene(1);
+        doc.edit(s, "add");
+        QVERIFY(doc.isModified());
+        QCOMPARE(changed.count(), 1);
+        QVERIFY(hasPart(changed.last().at(0).value<ScenePart>(), ScenePart::Species));
+        s.instances[0].position.x = 3.0;
+        doc.edit(s, "move");
+        QCOMPARE(changed.last().at(0).value<ScenePart>(), ScenePart::Instances);
+        QCOMPARE(doc.undoStack()->count(), 2);
+        doc.undoStack()->undo();
+        QCOMPARE(doc.scene().instances[0].position.x, 0.0);
+        doc.undoStack()->redo();
+        QCOMPARE(doc.scene().instances[0].position.x, 3.0);
+        // An edit that changes nothing is not a step.
+        doc.edit(doc.scene(), "nothing");
+        QCOMPARE(doc.undoStack()->count(), 2);
+        doc.undoStack()->undo();
+        doc.undoStack()->undo();
+        QVERIFY(!doc.isModified());
+        QVERIFY(doc.scene().species.empty());
+    }
+
+    void mergeKeysCollapseGestures()
+    {
+        SceneDocument doc;
+        doc.reset(treeScene(1), QString());
+        const int drag = SceneDocument::newMergeKey();
+        for (int i = 1; i <= 5; ++i) {
+            Scene s = doc.scene();
+            s.camera.position.x = i;
+            doc.edit(s, "navigate", drag);
+        }
+        QCOMPARE(doc.undoStack()->count(), 1);
+        const int other = SceneDocument::newMergeKey();
+        Scene s = doc.scene();
+        s.camera.position.y = 9.0;
+        doc.edit(s, "navigate", other);
+        QCOMPARE(doc.undoStack()->count(), 2);
+        doc.undoStack()->undo();
+        QCOMPARE(doc.scene().camera.position.x, 5.0);
+        doc.undoStack()->undo();
+        QCOMPARE(doc.scene().camera.position.x, 0.0);
+        // After undo, an edit with an old key starts a new step instead of folding into history.
+        doc.undoStack()->redo();
+        s = doc.scene();
+        s.camera.position.z = 1.0;
+        doc.edit(s, "navigate", drag);
+        QCOMPARE(doc.undoStack()->count(), 2);
+        doc.undoStack()->undo();
+        QCOMPARE(doc.scene().camera.position.x, 5.0);
+        QCOMPARE(doc.scene().camera.position.z, -10.0);
+    }
+
+    void saveAndReopen()
+    {
+        QTemporaryDir dir;
+        SceneDocument doc;
+        doc.reset(treeScene(3), QString());
+        Scene s = doc.scene();
+        s.sun.direction = sunDirection(30.0, 120.0);
+        s.sun.temperature = 4500.0;
+        s.instances[1].rotationDeg = {0.0f, 45.0f, 0.0f};
+        s.instances[2].scale = 1.5f;
+        s.species[0].grid = 16;
+        doc.edit(s, "tweak");
+        QVERIFY(doc.isModified());
+        const QString path = dir.filePath("sub/forest.sylva.json");
+        doc.saveAs(path);
+        QVERIFY(!doc.isModified());
+        QCOMPARE(doc.filePath(), path);
+        SceneDocument reopened;
+        reopened.open(path);
+        const std::string base = dir.path().toStdString();
+        QCOMPARE(QString::fromStdString(sceneToJson(reopened.scene(), base)), QString::fromStdString(sceneToJson(doc.scene(), base)));
+        QCOMPARE(changedParts(reopened.scene(), doc.scene()), ScenePart::None);
+    }
+
+    void saveRefusesWhatCannotBeRead()
+    {
+        QTemporaryDir dir;
+        SceneDocument doc;
+        QVERIFY_THROWS_EXCEPTION(Error, doc.saveAs(dir.filePath("empty.sylva.json")));
+        QVERIFY(!QFile::exists(dir.filePath("empty.sylva.json")));
+        QVERIFY_THROWS_EXCEPTION(Error, doc.open(dir.filePath("missing.sylva.json")));
+        QVERIFY(doc.filePath().isEmpty());
+    }
+
+    void outlinerModel()
+    {
+        SceneDocument doc;
+        OutlinerModel model(&doc);
+        QAbstractItemModelTester tester(&model, QAbstractItemModelTester::FailureReportingMode::QtTest);
+        QCOMPARE(model.rowCount(), int(OutlinerModel::GroupCount));
+        QCOMPARE(model.rowCount(model.index(OutlinerModel::SpeciesGroup, 0)), 0);
+        doc.edit(treeScene(4), "add");
+        QCOMPARE(model.rowCount(model.index(OutlinerModel::SpeciesGroup, 0)), 1);
+        QCOMPARE(model.rowCount(model.index(OutlinerModel::InstancesGroup, 0)), 4);
+        const QModelIndex inst = model.indexOf({OutlinerItem::Kind::Instance, 2});
+        QCOMPARE(model.data(inst).toString(), QStringLiteral("Tree_1 #3"));
+        QCOMPARE(model.itemAt(inst), (OutlinerItem{OutlinerItem::Kind::Instance, 2}));
+        QCOMPARE(model.parent(inst), model.index(OutlinerModel::InstancesGroup, 0));
+        QCOMPARE(model.itemAt(model.index(OutlinerModel::SunGroup, 0)).kind, OutlinerItem::Kind::Sun);
+        QCOMPARE(model.data(model.indexOf({OutlinerItem::Kind::Species, 0})).toString(), QStringLiteral("Tree_1"));
+        // Same shape: dataChanged; new shape: reset. The tester checks both.
+        QSignalSpy dataChanged(&model, &QAbstractItemModel::dataChanged);
+        Scene s = doc.scene();
+        s.instances[2].position.x = 7.0;
+        doc.edit(s, "move");
+        QVERIFY(dataChanged.count() > 0);
+        QVERIFY(model.data(model.indexOf({OutlinerItem::Kind::Instance, 2}, 1)).toString().contains("7"));
+        s.instances.pop_back();
+        doc.edit(s, "delete");
+        QCOMPARE(model.rowCount(model.index(OutlinerModel::InstancesGroup, 0)), 3);
+        doc.undoStack()->undo();
+        QCOMPARE(model.rowCount(model.index(OutlinerModel::InstancesGroup, 0)), 4);
+        doc.reset(Scene{}, QString());
+        QCOMPARE(model.rowCount(model.index(OutlinerModel::InstancesGroup, 0)), 0);
+    }
+
+    void propertyPanelEdits()
+    {
+        SceneDocument doc;
+        doc.reset(treeScene(2), QString());
+        PropertyPanel panel(&doc);
+        panel.showItem({OutlinerItem::Kind::Instance, 1});
+        QCOMPARE(panel.instancePosition(0)->value(), 2.0);
+        panel.instancePosition(0)->setValue(4.5);
+        panel.instancePosition(0)->setValue(5.5);   // one editor in a row: one undo step
+        panel.instanceScale()->setValue(2.0);
+        QCOMPARE(doc.scene().instances[1].position.x, 5.5);
+        QCOMPARE(doc.scene().instances[1].scale, 2.0f);
+        QCOMPARE(doc.undoStack()->count(), 2);
+        doc.undoStack()->undo();
+        QCOMPARE(panel.instanceScale()->value(), 1.0);   // the panel follows undo
+        doc.undoStack()->undo();
+        QCOMPARE(panel.instancePosition(0)->value(), 2.0);
+
+        panel.showItem({OutlinerItem::Kind::Sun, -1});
+        panel.sunElevation()->setValue(20.0);
+        panel.sunAzimuthDial()->setValue(90);
+        double el = 0.0, az = 0.0;
+        sunAngles(doc.scene().sun.direction, &el, &az);
+        QVERIFY(std::abs(el - 20.0) < 1e-3);
+        QVERIFY(std::abs(az - 90.0) < 1e-3);
+        panel.sunTemperature()->setValue(3200.0);
+        QCOMPARE(doc.scene().sun.temperature, 3200.0);
+
+        panel.showItem({OutlinerItem::Kind::Species, 0});
+        panel.speciesGrid()->setValue(16);
+        QCOMPARE(doc.scene().species[0].grid, 16);
+    }
+
+    void navigation()
+    {
+        CameraDesc c;
+        c.position = {0.0, 2.0, -10.0};
+        c.target = {0.0, 2.0, 0.0};
+        const double d0 = glm::length(c.position - c.target);
+        const CameraDesc o = orbitCamera(c, 90.0, 0.0);
+        QVERIFY(std::abs(glm::length(o.position - o.target) - d0) < 1e-9);
+        QVERIFY(std::abs(o.position.x - -10.0) < 1e-9 || std::abs(o.position.x - 10.0) < 1e-9);
+        const CameraDesc up = orbitCamera(c, 0.0, 200.0);   // clamped short of the pole
+        QVERIFY(up.position.y - up.target.y < d0);
+        QVERIFY(up.position.y > up.target.y);
+        const CameraDesc p = panCamera(c, 100.0, 0.0, 500.0);
+        QCOMPARE(p.position - c.position, p.target - c.target);
+        QVERIFY(p.target.x != 0.0);
+        const CameraDesc z = zoomCamera(c, 1.0);
+        QVERIFY(std::abs(glm::length(z.position - z.target) - 0.85 * d0) < 1e-9);
+        QCOMPARE(z.target, c.target);
+        double el = 0.0, az = 0.0;
+        sunAngles(sunDirection(35.0, 250.0), &el, &az);
+        QVERIFY(std::abs(el - 35.0) < 1e-4 && std::abs(az - 250.0) < 1e-4);
+    }
+};
+
+QTEST_MAIN(TstSceneDocument)
+#include "tst_scene_document.moc"
