@@ -34,6 +34,13 @@ struct Builder {
         return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
     }
 
+    // Cost of testing n primitives: per started block of leafBlock (a 4-wide test costs one).
+    float blocks(uint32_t n) const
+    {
+        const uint32_t b = uint32_t(std::max(1, s.leafBlock));
+        return float((n + b - 1) / b);
+    }
+
     static Bounds3 merge(Bounds3 a, const Bounds3& b)
     {
         a.lo = glm::min(a.lo, b.lo);
@@ -98,7 +105,7 @@ struct Builder {
                     acc = merge(acc, binBox[b]);
                     cnt += binCount[b];
                     if (cnt == 0 || rightCount[b + 1] == 0) continue;
-                    const float cost = area(acc) * float(cnt) + rightArea[b + 1] * float(rightCount[b + 1]);
+                    const float cost = area(acc) * blocks(cnt) + rightArea[b + 1] * blocks(rightCount[b + 1]);
                     if (cost < bestCost) {
                         bestCost = cost;
                         bestAxis = a;
@@ -106,7 +113,7 @@ struct Builder {
                     }
                 }
             }
-            const float leafCost = area(node->bounds) * float(n);
+            const float leafCost = area(node->bounds) * blocks(n);
             const float splitCost = area(node->bounds) * s.traversalCost + bestCost;
             if (bestAxis < 0 || (n <= uint32_t(s.maxLeafSize) && leafCost <= splitCost)) {
                 if (n <= uint32_t(s.maxLeafSize)) return node;

@@ -30,6 +30,7 @@ static_assert(sizeof(BvhNode) == 128);
 struct BvhBuildSettings {
     int maxLeafSize = 8;          // primitives per leaf at most
     float traversalCost = 1.0f;   // SAH cost of a node visit, relative to one primitive test
+    int leafBlock = 1;            // primitives tested together (SIMD leaf blocks): leaves cost per started block
     int bins = 16;                // SAH bins per axis
 };
 

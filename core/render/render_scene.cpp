@@ -127,6 +127,7 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
             for (int c = 0; c < 3; ++c) boxes[t].extend(m.positions[m.triangles[t][c]]);
         BvhBuildSettings bs;
         bs.maxLeafSize = 4;
+        bs.leafBlock = 4;   // leaves are tested as one 4-wide block
         blas[s] = buildBvh(boxes, bs);
     });
     if (progress) progress->report(0.7, "species BVHs built");
