@@ -1,0 +1,54 @@
+// Species assets (mesh, textures, lighting grid) kept in memory across edits, keyed by what produced them.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "core/base/progress.h"
+#include "core/render/render_scene.h"
+#include "core/scene/scene.h"
+#include "pipeline/lighting_job.h"
+
+namespace sylva {
+
+class GridCache;
+
+using AssetsPtr = std::shared_ptr<const SpeciesAssets>;
+
+// The key of a species' assets: its scene-file entry (name left out), and with lighting the sun
+// direction its grid was solved for. Equal keys give equal assets.
+std::string assetKey(const SpeciesDesc& species, const SunDesc& sun, bool lit);
+
+// Thread-safe map key -> assets. Jobs fill it; the viewport and exports read it. The disk grid cache
+// sits below it (a key missing here may still be a cache hit on disk).
+class AssetStore {
+public:
+    AssetsPtr find(const std::string& key) const;
+    void insert(const std::string& key, AssetsPtr assets);
+    // Assets for every species of the scene (lit ones also serve unlit requests), or an empty vector
+    // when any is missing.
+    std::vector<AssetsPtr> forScene(const Scene& scene, bool lit) const;
+    // Keys of the scene's species that are missing.
+    std::vector<size_t> missingSpecies(const Scene& scene, bool lit) const;
+    // Drops every entry whose key is not in keep.
+    void retainOnly(const std::vector<std::string>& keep);
+    void clear();
+    size_t size() const;
+
+private:
+    AssetsPtr findLocked(const SpeciesDesc& sp, const SunDesc& sun, bool lit) const;
+    mutable std::mutex m_mutex;
+    std::map<std::string, AssetsPtr> m_assets;
+};
+
+// Makes sure the store holds assets for every species of the scene (lit: with lighting grids):
+// missing ones are loaded with loadSpeciesAssets (grow or import, then voxelize and light through the
+// grid cache). Reports progress over the whole scene; log receives "SPECIES: STAGE" lines as they
+// happen (from the calling thread). Returns the scene's assets in species order. Throws Error or Cancelled.
+std::vector<AssetsPtr> ensureAssets(const Scene& scene, bool lit, AssetStore& store, GridCache* cache,
+                                    Progress* progress, const std::function<void(const std::string&)>& log);
+
+} // namespace sylva

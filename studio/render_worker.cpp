@@ -1,0 +1,152 @@
+// RenderWorker: progressive passes with restart, the species part of the frame kept across camera moves.
+#include "studio/render_worker.h"
+
+#include <QMutexLocker>
+
+#include "core/base/error.h"
+#include "pipeline/render/render_job.h"
+#include "studio/background_priority.h"
+#include "studio/scene_document.h"
+
+namespace sylva {
+
+QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float exposureKey)
+{
+    if (film.width <= 0 || film.height <= 0) return {};
+    const std::vector<glm::vec3> linear = composeMode(film, mode, sky);
+    const ImageRgba img = toneMapped(linear, film.width, film.height, exposureKey);
+    QImage out(film.width, film.height, QImage::Format_RGBX8888);
+    for (int y = 0; y < film.height; ++y) {
+        uchar* line = out.scanLine(y);
+        for (int x = 0; x < film.width; ++x) {
+            const float* px = &img.pixels[(size_t(y) * size_t(film.width) + size_t(x)) * 4];
+            for (int c = 0; c < 3; ++c) line[x * 4 + c] = uchar(std::clamp(px[c], 0.0f, 1.0f) * 255.0f + 0.5f);
+            line[x * 4 + 3] = 255;
+        }
+    }
+    return out;
+}
+
+RenderWorker::RenderWorker(QObject* parent) : QThread(parent), m_passes(defaultPasses()) {}
+
+RenderWorker::~RenderWorker()
+{
+    {
+        QMutexLocker lock(&m_mutex);
+        m_abort = true;
+        m_condition.wakeOne();
+    }
+    wait();
+}
+
+std::vector<RenderPass> RenderWorker::defaultPasses() { return {{4, 1}, {1, 1}, {1, 4}}; }
+
+void RenderWorker::setPasses(std::vector<RenderPass> passes)
+{
+    QMutexLocker lock(&m_mutex);
+    m_passes = std::move(passes);
+}
+
+void RenderWorker::request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size)
+{
+    QMutexLocker lock(&m_mutex);
+    m_request.scene = scene;
+    m_request.assets = std::move(assets);
+    m_request.size = size;
+    ++m_request.serial;
+    m_hasRequest = true;
+    m_sinceRequest.start();
+    m_restart = true;
+    if (!isRunning()) start(QThread::LowPriority);
+    else m_condition.wakeOne();
+}
+
+void RenderWorker::clear()
+{
+    QMutexLocker lock(&m_mutex);
+    m_hasRequest = false;
+    m_restart = true;
+}
+
+void RenderWorker::run()
+{
+    lowerCurrentThreadPriority();
+    quint64 done = 0;
+    for (;;) {
+        Request req;
+        {
+            QMutexLocker lock(&m_mutex);
+            while (!m_abort && !(m_hasRequest && m_request.serial != done)) m_condition.wait(&m_mutex);
+            if (m_abort) return;
+            req = m_request;
+            done = req.serial;
+            m_restart = false;
+        }
+        Progress progress;
+        progress.setCallback([this, &progress](double, const std::string&) {
+            if (interrupted()) progress.cancel();
+        });
+        try {
+            process(req, progress);
+        } catch (const Cancelled&) {
+        } catch (const std::exception& e) {
+            m_frame.reset();
+            m_frameAssets.clear();
+            Q_EMIT failed(QString::fromStdString(e.what()));
+        }
+    }
+}
+
+void RenderWorker::process(const Request& req, Progress& progress)
+{
+    const Scene& scene = req.scene;
+    if (scene.instances.empty() || req.assets.size() != scene.species.size()) throw Error("the scene has no instances");
+    const int w = std::max(1, req.size.width()), h = std::max(1, req.size.height());
+    std::vector<RenderPass> passes;
+    {
+        QMutexLocker lock(&m_mutex);
+        passes = m_passes;
+    }
+    auto elapsed = [this] {
+        QMutexLocker lock(&m_mutex);
+        return double(m_sinceRequest.nsecsElapsed()) * 1e-9;
+    };
+
+    // A change of mode or exposure alone: the film already holds every mode's parts.
+    if (m_lastScene && m_frameAssets == req.assets && m_lastSize == req.size && m_lastPass == int(passes.size()) - 1) {
+        Scene a = *m_lastScene, b = scene;
+        a.render.mode = b.render.mode;
+        a.render.exposureKey = b.render.exposureKey;
+        if (changedParts(a, b) == ScenePart::None) {
+            const QImage img = filmImage(m_lastFilm, scene.render.mode, scene.sky, scene.render.exposureKey);
+            m_lastScene = scene;
+            Q_EMIT imageReady(img, m_lastPass, true, elapsed());
+            return;
+        }
+    }
+
+    if (!m_frame || m_frameAssets != req.assets) {
+        m_frame.reset();
+        std::vector<SpeciesAssets> copies;
+        copies.reserve(req.assets.size());
+        for (const AssetsPtr& a : req.assets) copies.push_back(*a);
+        m_frame = buildViewFrame(scene, copies, sunRadiance(scene.sun));
+        m_frameAssets = req.assets;
+        if (interrupted()) throw Cancelled();
+    }
+    const glm::vec3 sun = sunRadiance(scene.sun);
+    for (size_t p = 0; p < passes.size(); ++p) {
+        const int pw = std::max(1, w / passes[p].divisor), ph = std::max(1, h / passes[p].divisor);
+        placeViewFrame(*m_frame, scene, sun, pw, ph, passes[p].spp);
+        Film film = renderFilm(m_frame->rs.view(), &progress);
+        if (interrupted()) throw Cancelled();
+        const QImage img = filmImage(film, scene.render.mode, scene.sky, scene.render.exposureKey);
+        m_lastFilm = std::move(film);
+        m_lastScene = scene;
+        m_lastSize = req.size;
+        m_lastPass = int(p);
+        Q_EMIT imageReady(img, int(p), p + 1 == passes.size(), elapsed());
+    }
+}
+
+} // namespace sylva

@@ -1,0 +1,86 @@
+// The viewport's progressive CPU renderer on its own thread: restarts on every request, emits images
+// from a quarter-resolution preview up to a refined frame (Qt's mandelbrot RenderThread pattern).
+#pragma once
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <QElapsedTimer>
+#include <QImage>
+#include <QMutex>
+#include <QSize>
+#include <QThread>
+#include <QWaitCondition>
+
+#include "core/render/render_cpu.h"
+#include "core/scene/scene.h"
+#include "studio/asset_store.h"
+#include "studio/view_frame.h"
+
+namespace sylva {
+
+// One pass of the progressive schedule: image size divisor and samples per pixel.
+struct RenderPass {
+    int divisor;
+    int spp;
+};
+
+// Tone-mapped sRGB picture of a film in a render mode (composeMode + toneMapped), as a QImage.
+QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float exposureKey);
+
+class RenderWorker : public QThread {
+    Q_OBJECT
+
+public:
+    explicit RenderWorker(QObject* parent = nullptr);
+    ~RenderWorker() override;
+
+    // The default schedule: 1/4 size at 1 spp, full size at 1 spp, full size at 4 spp.
+    static std::vector<RenderPass> defaultPasses();
+    void setPasses(std::vector<RenderPass> passes);
+
+    // Renders `scene` with `assets` (one per species, in order) at `size` pixels. Cancels the frame in
+    // progress. Same assets as the last request: only the top level is re-placed (fast); a change of
+    // the render mode alone recomposes the last film without tracing.
+    void request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size);
+    // Stops the frame in progress and forgets the request (e.g. assets are being recomputed).
+    void clear();
+
+Q_SIGNALS:
+    // pass: index into the schedule; last: the schedule is done; seconds: since the request.
+    void imageReady(const QImage& image, int pass, bool last, double seconds);
+    void failed(const QString& message);
+
+protected:
+    void run() override;
+
+private:
+    struct Request {
+        Scene scene;
+        std::vector<AssetsPtr> assets;
+        QSize size;
+        quint64 serial = 0;
+    };
+    void process(const Request& req, Progress& progress);
+    bool interrupted() const { return m_restart.load() || m_abort.load(); }
+
+    QMutex m_mutex;
+    QWaitCondition m_condition;
+    Request m_request;
+    std::vector<RenderPass> m_passes;
+    QElapsedTimer m_sinceRequest;
+    std::atomic<bool> m_restart{false}, m_abort{false};
+    bool m_hasRequest = false;
+
+    // Worker-thread state.
+    std::optional<ViewFrame> m_frame;
+    std::vector<AssetsPtr> m_frameAssets;
+    std::optional<Scene> m_lastScene;     // what m_lastFilm shows
+    QSize m_lastSize;
+    Film m_lastFilm;
+    int m_lastPass = -1;
+};
+
+} // namespace sylva

@@ -1,0 +1,143 @@
+// The viewport's fast path: a frame built once and re-placed for a new camera, instances and
+// environment renders what a fresh buildRenderScene renders; the render worker's passes and restarts.
+#include <QSignalSpy>
+#include <QTemporaryDir>
+#include <QTest>
+
+#include <cmath>
+
+#include "core/lb/lb_params.h"
+#include "core/render/render_cpu.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/render/render_job.h"
+#include "studio/asset_store.h"
+#include "studio/render_worker.h"
+#include "studio/view_frame.h"
+
+using namespace sylva;
+
+namespace {
+
+Scene treeScene()
+{
+    Scene s;
+    SpeciesDesc sp;
+    sp.name = "Tree_1";
+    sp.meshPath = SYLVA_SHARED_DATA "/trees/quaternius/OBJ/Tree_1.obj";
+    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    sp.grid = 16;
+    s.species.push_back(sp);
+    for (int i = 0; i < 3; ++i) {
+        InstanceDesc in;
+        in.position = {3.0 * i - 3.0, 0.0, 2.0 * i};
+        in.rotationDeg = {0.0f, 40.0f * float(i), 0.0f};
+        s.instances.push_back(in);
+    }
+    s.camera.position = {1.0, 3.0, -14.0};
+    s.camera.target = {0.0, 2.5, 0.0};
+    return s;
+}
+
+// Pixels whose parts differ by more than a rounding error.
+int differingPixels(const Film& a, const Film& b)
+{
+    int n = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) {
+        const SampleParts &p = a.pixels[i], &q = b.pixels[i];
+        const float d = glm::length(p.local - q.local) + glm::length(p.indirect - q.indirect) + std::abs(p.skyCover - q.skyCover);
+        if (d > 1e-4f) ++n;
+    }
+    return n;
+}
+
+} // namespace
+
+class TstViewFrame : public QObject {
+    Q_OBJECT
+
+    QTemporaryDir m_dir;
+    std::vector<SpeciesAssets> m_assets;
+
+private Q_SLOTS:
+    void initTestCase()
+    {
+        GridCache cache(m_dir.filePath("cache").toStdString());
+        m_assets = loadSpeciesAssets(treeScene(), &cache, true);
+        QCOMPARE(m_assets.size(), size_t(1));
+        QVERIFY(!m_assets[0].lighting.rgb.empty());
+    }
+
+    void replacedFrameMatchesFreshBuild()
+    {
+        const Scene a = treeScene();
+        ViewFrame frame = buildViewFrame(a, m_assets, sunRadiance(a.sun));
+        Scene b = a;
+        b.camera.position = {-6.0, 5.0, -9.0};
+        b.camera.target = {0.5, 2.0, 1.0};
+        b.camera.fovY = 50.0f;
+        b.instances[1].position = {1.0, 0.5, 3.0};
+        b.instances[2].rotationDeg = {5.0f, 200.0f, -3.0f};
+        b.instances[2].scale = 1.3f;
+        b.instances.push_back(b.instances[0]);
+        b.instances.back().position.x += 6.0;
+        b.ground.height = 0.2;
+        b.sun.temperature = 4000.0;
+        b.sun.intensity = 1.5f;
+        b.render.width = 96;
+        b.render.height = 64;
+        placeViewFrame(frame, b, sunRadiance(b.sun), b.render.width, b.render.height, 1);
+        const RenderScene fresh = buildRenderScene(b, m_assets, sunRadiance(b.sun));
+        const Film got = renderFilm(frame.rs.view()), want = renderFilm(fresh.view());
+        QCOMPARE(got.width, 96);
+        QCOMPARE(got.pixels.size(), want.pixels.size());
+        int hits = 0;
+        for (const SampleParts& p : want.pixels) hits += p.skyCover < 0.5f ? 1 : 0;
+        QVERIFY2(hits > 500, "the trees and ground should fill part of the frame");
+        QCOMPARE(differingPixels(got, want), 0);
+    }
+
+    void workerRunsPassesAndRecomposes()
+    {
+        Scene s = treeScene();
+        std::vector<AssetsPtr> assets{std::make_shared<const SpeciesAssets>(m_assets[0])};
+        RenderWorker worker;
+        worker.setPasses({{4, 1}, {1, 1}});
+        QSignalSpy images(&worker, &RenderWorker::imageReady);
+        worker.request(s, assets, QSize(128, 72));
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 2, 20000);
+        QCOMPARE(images.at(0).at(0).value<QImage>().size(), QSize(32, 18));
+        QCOMPARE(images.at(1).at(0).value<QImage>().size(), QSize(128, 72));
+        QVERIFY(images.at(1).at(2).toBool());
+        const QImage full = images.at(1).at(0).value<QImage>();
+
+        // Mode alone: one recomposed image, no new passes.
+        images.clear();
+        s.render.mode = RenderMode::Lb;
+        worker.request(s, assets, QSize(128, 72));
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 1, 20000);
+        QTest::qWait(50);
+        QCOMPARE(images.count(), 1);
+        QVERIFY(images.at(0).at(0).value<QImage>() != full);
+
+        // Camera moves in a burst: only the last one needs to finish.
+        images.clear();
+        for (int i = 0; i < 5; ++i) {
+            s.camera.position.x += 0.5;
+            worker.request(s, assets, QSize(128, 72));
+        }
+        QTRY_VERIFY_WITH_TIMEOUT(!images.isEmpty() && images.last().at(2).toBool(), 20000);
+
+        // Errors come back as a signal, and the next good request renders again.
+        QSignalSpy failed(&worker, &RenderWorker::failed);
+        Scene bad = s;
+        bad.camera.target = bad.camera.position;
+        worker.request(bad, assets, QSize(64, 36));
+        QTRY_COMPARE_WITH_TIMEOUT(failed.count(), 1, 20000);
+        images.clear();
+        worker.request(s, assets, QSize(64, 36));
+        QTRY_VERIFY_WITH_TIMEOUT(!images.isEmpty() && images.last().at(2).toBool(), 20000);
+    }
+};
+
+QTEST_MAIN(TstViewFrame)
+#include "tst_view_frame.moc"
