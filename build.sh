@@ -13,7 +13,9 @@ JOBS="${SYLVA_JOBS:-$(nproc)}"
 PACKAGES=(cmake ninja-build ccache g++ pkg-config
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev
   libassimp-dev libopenmesh-dev libopenimageio-dev openimageio-tools libopencv-core-dev
-  libglm-dev libtbb-dev libembree-dev)
+  libglm-dev libtbb-dev libembree-dev
+  # sylva-studio's GL tests run under Xvfb with Mesa's software OpenGL
+  qt6-qpa-plugins xvfb xauth libgl1-mesa-dri)
 
 install_missing() {
   local missing=()

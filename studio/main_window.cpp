@@ -1,0 +1,691 @@
+// MainWindow: menus and docks, document <-> viewport wiring, import/lighting/export jobs.
+#include "studio/main_window.h"
+
+#include <cmath>
+
+#include <QAction>
+#include <QApplication>
+#include <QCloseEvent>
+#include <QComboBox>
+#include <QDateTime>
+#include <QDockWidget>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QMenuBar>
+#include <QMimeData>
+#include <QPlainTextEdit>
+#include <QSettings>
+#include <QStatusBar>
+#include <QToolBar>
+#include <QTreeView>
+#include <QVBoxLayout>
+
+#include "core/base/error.h"
+#include "core/lb/lb_params.h"
+#include "core/render/render_cpu.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/grow/tree_grower.h"
+#include "pipeline/import/mesh_import.h"
+#include "pipeline/render/render_job.h"
+#include "studio/background_priority.h"
+#include "studio/job_manager.h"
+#include "studio/job_panel.h"
+#include "studio/outliner_model.h"
+#include "studio/property_panel.h"
+#include "studio/viewport.h"
+
+namespace sylva {
+namespace {
+
+constexpr int kMaxRecentFiles = 8;
+const char* kSceneFilter = "Sylva scenes (*.sylva.json)";
+
+QString meshFilter()
+{
+    return QObject::tr("Meshes (*.obj *.fbx *.gltf *.glb *.ply *.dae *.3ds *.stl);;All files (*)");
+}
+
+// A unique species name from a wish ("Tree_1", then "Tree_1 (2)", ...).
+std::string uniqueSpeciesName(const Scene& s, const std::string& wish)
+{
+    auto taken = [&](const std::string& n) {
+        for (const SpeciesDesc& sp : s.species)
+            if (sp.name == n) return true;
+        return false;
+    };
+    const std::string base = wish.empty() ? std::string("species") : wish;
+    if (!taken(base)) return base;
+    for (int i = 2;; ++i) {
+        const std::string n = base + " (" + std::to_string(i) + ")";
+        if (!taken(n)) return n;
+    }
+}
+
+// A camera that shows world box b whole, from the front-left and a little above.
+CameraDesc framingCamera(const CameraDesc& current, const Bounds3& b)
+{
+    CameraDesc c = current;
+    const glm::dvec3 centre = glm::dvec3(b.center());
+    const double radius = std::max(0.1, 0.5 * double(glm::length(b.extent())));
+    const double dist = 1.15 * radius / std::sin(double(c.fovY) * 0.5 * 3.14159265358979323846 / 180.0);
+    c.target = centre;
+    c.position = centre + dist * glm::normalize(glm::dvec3(-0.35, 0.2, -1.0));
+    c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    return c;
+}
+
+SpeciesDesc newSpeciesDesc()
+{
+    SpeciesDesc sp;
+    sp.preset = "leaf";
+    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    sp.grid = QSettings().value("import/grid", 64).toInt();
+    return sp;
+}
+
+} // namespace
+
+MainWindow::MainWindow(QWidget* parent)
+    : QMainWindow(parent), m_doc(new SceneDocument(this)), m_jobs(new JobManager(this)), m_cache(std::make_unique<GridCache>())
+{
+    setObjectName("MainWindow");
+    setAcceptDrops(true);
+    lowerTbbWorkerPriority();
+    m_reportError = [this](const QString& title, const QString& message) { QMessageBox::critical(this, title, message); };
+    m_askSave = [this](const QString& name) {
+        return QMessageBox::warning(this, tr("Unsaved changes"), tr("Save the changes to %1?").arg(name),
+                                    QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
+    };
+
+    // Centre: render mode bar over the viewport.
+    auto* centre = new QWidget;
+    auto* cl = new QVBoxLayout(centre);
+    cl->setContentsMargins(0, 0, 0, 0);
+    cl->setSpacing(0);
+    auto* bar = new QToolBar;
+    bar->addWidget(new QLabel(tr(" Mode ")));
+    m_modeBox = new QComboBox;
+    m_modeBox->setObjectName("renderMode");
+    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
+        m_modeBox->addItem(QString::fromLatin1(renderModeName(m)), int(m));
+    m_modeBox->setToolTip(tr("full = sun + LB indirect; local = sun only; ambient = sun + constant; lb = indirect only"));
+    bar->addWidget(m_modeBox);
+    cl->addWidget(bar);
+    m_viewport = new Viewport;
+    cl->addWidget(m_viewport, 1);
+    setCentralWidget(centre);
+    connect(m_modeBox, &QComboBox::activated, this, [this](int index) {
+        Scene s = m_doc->scene();
+        s.render.mode = RenderMode(m_modeBox->itemData(index).toInt());
+        m_doc->edit(s, tr("Render mode %1").arg(m_modeBox->itemText(index)));
+    });
+    connect(m_viewport, &Viewport::cameraEdited, this, [this](const CameraDesc& camera, int key) {
+        Scene s = m_doc->scene();
+        s.camera = camera;
+        m_doc->edit(s, tr("Navigate"), key);
+    });
+    connect(m_viewport, &Viewport::imageShown, this, [this](int pass, bool last, double seconds) {
+        statusBar()->showMessage(tr("Viewport: pass %1%2, %3 s after the change")
+                                     .arg(pass + 1)
+                                     .arg(last ? tr(" (final)") : QString())
+                                     .arg(seconds, 0, 'f', 3));
+    });
+    connect(m_viewport, &Viewport::renderFailed, this, [this](const QString& m) { appendLog(tr("viewport: %1").arg(m)); });
+
+    buildDocks();
+    buildActions();
+
+    m_lightingTimer.setSingleShot(true);
+    m_lightingTimer.setInterval(250);
+    connect(&m_lightingTimer, &QTimer::timeout, this, [this] { computeLighting(); });
+    connect(m_doc, &SceneDocument::changed, this, &MainWindow::onDocumentChanged);
+    connect(m_doc, &SceneDocument::modifiedChanged, this, [this] { updateTitle(); });
+    connect(m_doc, &SceneDocument::filePathChanged, this, [this] { updateTitle(); });
+    connect(m_jobs, &JobManager::logLine, this, &MainWindow::appendLog);
+    updateTitle();
+    updateViewport();
+    statusBar()->showMessage(tr("Ready"));
+}
+
+MainWindow::~MainWindow()
+{
+    m_jobs->cancelAll();
+    m_jobs->waitForAll();
+}
+
+void MainWindow::buildDocks()
+{
+    m_model = new OutlinerModel(m_doc, this);
+    m_outliner = new QTreeView;
+    m_outliner->setObjectName("outliner");
+    m_outliner->setModel(m_model);
+    m_outliner->setSelectionMode(QAbstractItemView::SingleSelection);
+    m_outliner->header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
+    m_outliner->expandAll();
+    connect(m_model, &QAbstractItemModel::modelReset, m_outliner, &QTreeView::expandAll);
+    connect(m_outliner->selectionModel(), &QItemSelectionModel::currentChanged, this, &MainWindow::onSelectionChanged);
+    auto* outlinerDock = new QDockWidget(tr("Outliner"), this);
+    outlinerDock->setObjectName("outlinerDock");
+    outlinerDock->setWidget(m_outliner);
+
+    m_properties = new PropertyPanel(m_doc);
+    auto* propDock = new QDockWidget(tr("Properties"), this);
+    propDock->setObjectName("propertiesDock");
+    propDock->setWidget(m_properties);
+
+    m_jobPanel = new JobPanel(m_jobs);
+    auto* jobDock = new QDockWidget(tr("Jobs"), this);
+    jobDock->setObjectName("jobsDock");
+    jobDock->setWidget(m_jobPanel);
+
+    m_log = new QPlainTextEdit;
+    m_log->setObjectName("log");
+    m_log->setReadOnly(true);
+    m_log->setMaximumBlockCount(5000);
+    auto* logDock = new QDockWidget(tr("Log"), this);
+    logDock->setObjectName("logDock");
+    logDock->setWidget(m_log);
+
+    // Outliner over properties on the right, full height; jobs beside the log under the viewport.
+    setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
+    addDockWidget(Qt::RightDockWidgetArea, outlinerDock);
+    splitDockWidget(outlinerDock, propDock, Qt::Vertical);
+    addDockWidget(Qt::BottomDockWidgetArea, jobDock);
+    splitDockWidget(jobDock, logDock, Qt::Horizontal);
+}
+
+void MainWindow::showEvent(QShowEvent* event)
+{
+    QMainWindow::showEvent(event);
+    if (m_docksSized) return;
+    m_docksSized = true;
+    // Dock sizes only hold once the window has its size: the viewport gets what the docks leave.
+    auto dock = [this](const char* name) { return findChild<QDockWidget*>(QString::fromLatin1(name)); };
+    resizeDocks({dock("outlinerDock")}, {320}, Qt::Horizontal);
+    resizeDocks({dock("outlinerDock"), dock("propertiesDock")}, {2, 3}, Qt::Vertical);
+    resizeDocks({dock("jobsDock"), dock("logDock")}, {1, 2}, Qt::Horizontal);
+    resizeDocks({dock("jobsDock")}, {130}, Qt::Vertical);
+}
+
+void MainWindow::buildActions()
+{
+    QMenu* file = menuBar()->addMenu(tr("&File"));
+    auto add = [this](QMenu* menu, const QString& text, const char* name, const QKeySequence& key, auto slot) {
+        QAction* a = menu->addAction(text);
+        a->setObjectName(QString::fromLatin1(name));
+        if (!key.isEmpty()) a->setShortcut(key);
+        connect(a, &QAction::triggered, this, slot);
+        return a;
+    };
+    add(file, tr("&New"), "actionNew", QKeySequence::New, [this] { newScene(); });
+    add(file, tr("&Open..."), "actionOpen", QKeySequence::Open, [this] { openDialog(); });
+    m_recentMenu = file->addMenu(tr("Open &Recent"));
+    add(file, tr("Open &Example Forest"), "actionExample", QKeySequence(), [this] { loadExampleForest(); });
+    file->addSeparator();
+    add(file, tr("&Save"), "actionSave", QKeySequence::Save, [this] { save(); });
+    add(file, tr("Save &As..."), "actionSaveAs", QKeySequence::SaveAs, [this] { saveAsDialog(); });
+    file->addSeparator();
+    add(file, tr("&Import Mesh..."), "actionImport", QKeySequence(Qt::CTRL | Qt::Key_I), [this] { importDialog(); });
+    add(file, tr("&Grow Species..."), "actionGrow", QKeySequence(Qt::CTRL | Qt::Key_G), [this] { growDialog(); });
+    add(file, tr("&Export Render..."), "actionExport", QKeySequence(Qt::CTRL | Qt::Key_E), [this] { exportDialog(); });
+    file->addSeparator();
+    add(file, tr("&Quit"), "actionQuit", QKeySequence::Quit, [this] { close(); });
+    updateRecentMenu();
+
+    QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+    QAction* undo = m_doc->undoStack()->createUndoAction(this, tr("&Undo"));
+    undo->setObjectName("actionUndo");
+    undo->setShortcut(QKeySequence::Undo);
+    QAction* redo = m_doc->undoStack()->createRedoAction(this, tr("&Redo"));
+    redo->setObjectName("actionRedo");
+    redo->setShortcut(QKeySequence::Redo);
+    edit->addAction(undo);
+    edit->addAction(redo);
+    edit->addSeparator();
+    add(edit, tr("&Delete"), "actionDelete", QKeySequence::Delete, [this] { deleteSelection(); });
+
+    QMenu* render = menuBar()->addMenu(tr("&Render"));
+    add(render, tr("Compute &Lighting"), "actionLight", QKeySequence(Qt::CTRL | Qt::Key_L), [this] { computeLighting(); });
+    add(render, tr("&Reload Lighting"), "actionReload", QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_L),
+        [this] { computeLighting(true); });
+    QAction* autoLight = render->addAction(tr("&Automatic Lighting"));
+    autoLight->setObjectName("actionAutoLighting");
+    autoLight->setCheckable(true);
+    autoLight->setChecked(m_autoLighting);
+    connect(autoLight, &QAction::toggled, this, &MainWindow::setAutoLighting);
+    render->addSeparator();
+    add(render, tr("&Cancel All Jobs"), "actionCancelJobs", QKeySequence(Qt::Key_Escape), [this] { m_jobs->cancelAll(); });
+
+    m_viewMenu = menuBar()->addMenu(tr("&View"));
+    for (QDockWidget* d : findChildren<QDockWidget*>()) m_viewMenu->addAction(d->toggleViewAction());
+
+    QMenu* help = menuBar()->addMenu(tr("&Help"));
+    add(help, tr("&About Sylva Studio"), "actionAbout", QKeySequence(), [this] {
+        QMessageBox::about(this, tr("About Sylva Studio"),
+                           tr("<b>Sylva Studio</b> %1<br>Forests lit with the lattice-Boltzmann lighting model.")
+                               .arg(QString::fromLatin1(SYLVA_VERSION)));
+    });
+}
+
+QString MainWindow::logText() const { return m_log->toPlainText(); }
+
+void MainWindow::clearLog() { m_log->clear(); }
+
+void MainWindow::appendLog(const QString& line)
+{
+    m_log->appendPlainText(QDateTime::currentDateTime().toString(QStringLiteral("HH:mm:ss  ")) + line);
+    Q_EMIT logLineAdded(line);
+}
+
+void MainWindow::reportError(const QString& title, const QString& message)
+{
+    appendLog(tr("error: %1").arg(message));
+    Q_EMIT errorReported(title, message);
+    if (m_reportError) m_reportError(title, message);
+}
+
+void MainWindow::setAutoLighting(bool on)
+{
+    m_autoLighting = on;
+    if (auto* a = findChild<QAction*>("actionAutoLighting")) {
+        const QSignalBlocker block(a);
+        a->setChecked(on);
+    }
+    if (on) updateViewport();
+    else m_lightingTimer.stop();
+}
+
+// ---- document and title ----
+
+void MainWindow::updateTitle()
+{
+    setWindowTitle(tr("%1[*] - Sylva Studio").arg(m_doc->displayName()));
+    setWindowModified(m_doc->isModified());
+}
+
+bool MainWindow::maybeSave()
+{
+    if (!m_doc->isModified()) return true;
+    switch (m_askSave ? m_askSave(m_doc->displayName()) : QMessageBox::Discard) {
+    case QMessageBox::Save: return save();
+    case QMessageBox::Discard: return true;
+    default: return false;
+    }
+}
+
+bool MainWindow::newScene()
+{
+    if (!maybeSave()) return false;
+    m_jobs->cancelAll();
+    m_doc->reset(Scene{}, QString());
+    appendLog(tr("new scene"));
+    return true;
+}
+
+bool MainWindow::openFile(const QString& path)
+{
+    if (!maybeSave()) return false;
+    try {
+        m_doc->open(path);
+    } catch (const std::exception& e) {
+        reportError(tr("Open failed"), QString::fromStdString(e.what()));
+        return false;
+    }
+    addRecentFile(m_doc->filePath());
+    appendLog(tr("opened %1").arg(m_doc->filePath()));
+    return true;
+}
+
+bool MainWindow::saveFile(const QString& path)
+{
+    QString p = path;
+    if (!p.endsWith(QLatin1String(".sylva.json"))) p += QLatin1String(".sylva.json");
+    try {
+        m_doc->saveAs(p);
+    } catch (const std::exception& e) {
+        reportError(tr("Save failed"), QString::fromStdString(e.what()));
+        return false;
+    }
+    addRecentFile(m_doc->filePath());
+    appendLog(tr("saved %1").arg(m_doc->filePath()));
+    statusBar()->showMessage(tr("Saved %1").arg(m_doc->filePath()), 3000);
+    return true;
+}
+
+bool MainWindow::save() { return m_doc->filePath().isEmpty() ? saveAsDialog() : saveFile(m_doc->filePath()); }
+
+QStringList MainWindow::recentFiles() const { return QSettings().value("recentFiles").toStringList(); }
+
+void MainWindow::addRecentFile(const QString& path)
+{
+    QStringList files = recentFiles();
+    files.removeAll(path);
+    files.prepend(path);
+    while (files.size() > kMaxRecentFiles) files.removeLast();
+    QSettings().setValue("recentFiles", files);
+    updateRecentMenu();
+}
+
+void MainWindow::updateRecentMenu()
+{
+    if (!m_recentMenu) return;
+    m_recentMenu->clear();
+    const QStringList files = recentFiles();
+    for (int i = 0; i < files.size(); ++i) {
+        const QString f = files[i];
+        QAction* a = m_recentMenu->addAction(QStringLiteral("&%1 %2").arg(i + 1).arg(QFileInfo(f).fileName()));
+        a->setToolTip(f);
+        connect(a, &QAction::triggered, this, [this, f] { openFile(f); });
+    }
+    m_recentMenu->setEnabled(!files.isEmpty());
+}
+
+void MainWindow::onDocumentChanged(ScenePart parts)
+{
+    const Scene& s = m_doc->scene();
+    {
+        const QSignalBlocker block(m_modeBox);
+        m_modeBox->setCurrentIndex(m_modeBox->findData(int(s.render.mode)));
+    }
+    if (parts == ScenePart::All) m_properties->showItem(m_properties->item());
+    updateViewport();
+}
+
+bool MainWindow::viewNeedsLighting() const { return modeNeedsLighting(m_doc->scene().render.mode); }
+
+void MainWindow::updateViewport()
+{
+    const Scene& s = m_doc->scene();
+    const bool lit = viewNeedsLighting();
+    std::vector<AssetsPtr> assets = m_assets.forScene(s, lit);
+    if (s.instances.empty() || !assets.empty()) {
+        m_viewport->setScene(s, std::move(assets));
+        return;
+    }
+    m_viewport->setScene(s, {});
+    if (m_autoLighting) {
+        m_viewport->setStatus(lit ? tr("Lighting the species...") : tr("Loading the species..."));
+        m_lightingTimer.start();
+    } else {
+        m_viewport->setStatus(tr("Lighting not computed: Render > Compute Lighting (%1)")
+                                  .arg(QKeySequence(Qt::CTRL | Qt::Key_L).toString(QKeySequence::NativeText)));
+    }
+}
+
+void MainWindow::onSelectionChanged() { m_properties->showItem(m_model->itemAt(m_outliner->currentIndex())); }
+
+// ---- import, grow, lighting, export ----
+
+void MainWindow::addSpecies(SpeciesDesc species, const Bounds3& bounds, const QString& undoText)
+{
+    Scene s = m_doc->scene();
+    species.name = uniqueSpeciesName(s, species.name);
+    const bool first = s.instances.empty();
+    s.species.push_back(species);
+    InstanceDesc inst;
+    inst.species = uint32_t(s.species.size() - 1);
+    s.instances.push_back(inst);
+    if (first && bounds.valid()) s.camera = framingCamera(s.camera, bounds);
+    m_doc->edit(s, undoText);
+    m_outliner->setCurrentIndex(m_model->indexOf({OutlinerItem::Kind::Instance, int(s.instances.size() - 1)}));
+}
+
+Job* MainWindow::importMesh(const QString& path)
+{
+    struct Result {
+        Bounds3 bounds;
+        size_t triangles = 0;
+        std::vector<std::string> warnings;
+    };
+    auto result = std::make_shared<Result>();
+    const QString abs = QFileInfo(path).absoluteFilePath();
+    const std::string file = abs.toStdString();
+    appendLog(tr("importing %1").arg(abs));
+    return m_jobs->start(tr("Import %1").arg(QFileInfo(path).fileName()),
+                         [file, result](Job&, Progress& progress) {
+                             progress.report(0.0, "reading");
+                             ImportReport report;
+                             const TriangleMesh mesh = sylva::importMesh(file, ImportOptions{}, &report);
+                             result->bounds = meshBounds(mesh);
+                             result->triangles = mesh.triangleCount();
+                             result->warnings = report.warnings;
+                             progress.report(1.0, "read");
+                         },
+                         [this, abs, result](Job* job) {
+                             if (job->state() == Job::State::Failed) {
+                                 reportError(tr("Import failed"), job->error());
+                                 return;
+                             }
+                             if (job->state() != Job::State::Succeeded) {
+                                 appendLog(tr("import of %1 cancelled").arg(abs));
+                                 return;
+                             }
+                             for (const std::string& w : result->warnings)
+                                 appendLog(tr("warning: %1").arg(QString::fromStdString(w)));
+                             SpeciesDesc sp = newSpeciesDesc();
+                             sp.name = QFileInfo(abs).completeBaseName().toStdString();
+                             sp.meshPath = abs.toStdString();
+                             appendLog(tr("imported %1: %2 triangles").arg(abs).arg(result->triangles));
+                             addSpecies(sp, result->bounds, tr("Import %1").arg(QFileInfo(abs).fileName()));
+                         });
+}
+
+void MainWindow::growSpecies(const GrowSpec& spec)
+{
+    SpeciesDesc sp = newSpeciesDesc();
+    sp.name = spec.species + " " + std::to_string(spec.seed);
+    sp.grow = spec;
+    // The grower's box is known only after growing: frame a trunk of the expected height.
+    const float h = spec.height > 0.0f ? spec.height : defaultTreeHeight(speciesFromName(spec.species));
+    Bounds3 b;
+    b.extend({-0.35f * h, 0.0f, -0.35f * h});
+    b.extend({0.35f * h, h, 0.35f * h});
+    addSpecies(sp, b, tr("Grow %1").arg(QString::fromStdString(sp.name)));
+}
+
+void MainWindow::loadExampleForest()
+{
+    if (!maybeSave()) return;
+    m_doc->reset(defaultScene(), QString());
+    appendLog(tr("example forest: %1 species, %2 instances")
+                  .arg(m_doc->scene().species.size())
+                  .arg(m_doc->scene().instances.size()));
+}
+
+Job* MainWindow::computeLighting(bool reload)
+{
+    m_lightingTimer.stop();
+    const Scene scene = m_doc->scene();
+    const bool lit = viewNeedsLighting();
+    if (m_lightingJob) {
+        // One lighting job at a time: stop it and run again for the scene as it is now.
+        m_lightingJob->cancel();
+        m_lightingAgain = true;
+        return nullptr;
+    }
+    if (reload) {
+        std::vector<std::string> keep;
+        m_assets.retainOnly(keep);
+    } else {
+        // Keep what the scene uses (and what undo may bring back soon: everything of this sun).
+        std::vector<std::string> keep;
+        for (const SpeciesDesc& sp : scene.species) {
+            keep.push_back(assetKey(sp, scene.sun, true));
+            keep.push_back(assetKey(sp, scene.sun, false));
+        }
+        if (m_assets.size() > 4 * keep.size() + 8) m_assets.retainOnly(keep);
+    }
+    if (m_assets.missingSpecies(scene, lit).empty()) {
+        updateViewport();
+        return nullptr;
+    }
+    GridCache* cache = m_cache.get();
+    AssetStore* store = &m_assets;
+    appendLog(lit ? tr("lighting %n species", nullptr, int(m_assets.missingSpecies(scene, lit).size()))
+                  : tr("loading %n species", nullptr, int(m_assets.missingSpecies(scene, lit).size())));
+    m_lightingJob = m_jobs->start(lit ? tr("Lighting") : tr("Loading"),
+                                  [scene, lit, store, cache](Job& job, Progress& progress) {
+                                      ensureAssets(scene, lit, *store, cache, &progress, [&job](const std::string& line) {
+                                          job.log(QString::fromStdString(line));
+                                      });
+                                  },
+                                  [this](Job* job) {
+                                      m_lightingJob = nullptr;
+                                      const bool ok = job->state() == Job::State::Succeeded;
+                                      if (ok) appendLog(tr("lighting done in %1 s").arg(job->seconds(), 0, 'f', 2));
+                                      else if (job->state() == Job::State::Cancelled) appendLog(tr("lighting cancelled"));
+                                      else reportError(tr("Lighting failed"), job->error());
+                                      if (m_lightingAgain) {
+                                          m_lightingAgain = false;
+                                          computeLighting();
+                                      } else {
+                                          updateViewport();
+                                      }
+                                      Q_EMIT lightingFinished(ok);
+                                  });
+    return m_lightingJob;
+}
+
+Job* MainWindow::exportRender(const ExportSettings& settings)
+{
+    Scene scene = m_doc->scene();
+    if (scene.instances.empty()) {
+        reportError(tr("Export failed"), tr("The scene is empty."));
+        return nullptr;
+    }
+    scene.render.width = settings.width;
+    scene.render.height = settings.height;
+    scene.render.spp = settings.spp;
+    m_lastExport = settings;
+    const std::string path = settings.path.toStdString();
+    GridCache* cache = m_cache.get();
+    AssetStore* store = &m_assets;
+    appendLog(tr("exporting %1 (%2 x %3, %4 spp)").arg(settings.path).arg(settings.width).arg(settings.height).arg(settings.spp));
+    return m_jobs->start(tr("Export %1").arg(QFileInfo(settings.path).fileName()),
+                         [scene, path, store, cache](Job& job, Progress& progress) {
+                             const bool lit = modeNeedsLighting(scene.render.mode);
+                             SubProgress assetsPart(&progress, 0.0, 0.4);
+                             Progress assetsProgress([&](double f, const std::string& m) { assetsPart.report(f, m); });
+                             const std::vector<AssetsPtr> shared = ensureAssets(
+                                 scene, lit, *store, cache, &assetsProgress,
+                                 [&job](const std::string& line) { job.log(QString::fromStdString(line)); });
+                             std::vector<SpeciesAssets> assets;
+                             for (const AssetsPtr& a : shared) assets.push_back(*a);
+                             progress.report(0.45, "building");
+                             const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
+                             SubProgress tracePart(&progress, 0.5, 0.98);
+                             Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
+                             const Film film = renderFilm(rs.view(), &traceProgress);
+                             const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, scene.sky);
+                             writeRender(path, linear, film.width, film.height, scene.render.exposureKey);
+                             progress.report(1.0, "written");
+                         },
+                         [this, settings](Job* job) {
+                             if (job->state() == Job::State::Succeeded)
+                                 appendLog(tr("exported %1 in %2 s").arg(settings.path).arg(job->seconds(), 0, 'f', 2));
+                             else if (job->state() == Job::State::Failed) reportError(tr("Export failed"), job->error());
+                             else appendLog(tr("export cancelled"));
+                         });
+}
+
+void MainWindow::deleteSelection()
+{
+    const OutlinerItem it = m_model->itemAt(m_outliner->currentIndex());
+    Scene s = m_doc->scene();
+    if (it.kind == OutlinerItem::Kind::Instance && it.row >= 0 && size_t(it.row) < s.instances.size()) {
+        s.instances.erase(s.instances.begin() + it.row);
+        m_doc->edit(s, tr("Delete instance"));
+    } else if (it.kind == OutlinerItem::Kind::Species && it.row >= 0 && size_t(it.row) < s.species.size()) {
+        // The species and its instances; later species move down one index.
+        const uint32_t gone = uint32_t(it.row);
+        const std::string name = s.species[gone].name;
+        s.species.erase(s.species.begin() + it.row);
+        std::vector<InstanceDesc> kept;
+        for (InstanceDesc in : s.instances) {
+            if (in.species == gone) continue;
+            if (in.species > gone) --in.species;
+            kept.push_back(in);
+        }
+        s.instances = std::move(kept);
+        m_doc->edit(s, tr("Delete species %1").arg(QString::fromStdString(name)));
+    }
+}
+
+// ---- dialogs ----
+
+void MainWindow::openDialog()
+{
+    const QString path = QFileDialog::getOpenFileName(this, tr("Open Scene"), QString(), tr(kSceneFilter));
+    if (!path.isEmpty()) openFile(path);
+}
+
+bool MainWindow::saveAsDialog()
+{
+    QString path = QFileDialog::getSaveFileName(this, tr("Save Scene As"),
+                                                m_doc->filePath().isEmpty() ? tr("forest.sylva.json") : m_doc->filePath(),
+                                                tr(kSceneFilter));
+    return !path.isEmpty() && saveFile(path);
+}
+
+void MainWindow::importDialog()
+{
+    const QString path = QFileDialog::getOpenFileName(this, tr("Import Mesh"), QString(), meshFilter());
+    if (!path.isEmpty()) importMesh(path);
+}
+
+void MainWindow::growDialog()
+{
+    GrowDialog d(this);
+    if (d.exec() == QDialog::Accepted) growSpecies(d.spec());
+}
+
+void MainWindow::exportDialog()
+{
+    ExportSettings initial = m_lastExport;
+    if (initial.path.isEmpty()) {
+        const Scene& s = m_doc->scene();
+        initial.path = QFileInfo(m_doc->filePath().isEmpty() ? tr("render") : m_doc->filePath()).absolutePath() +
+                       QStringLiteral("/render.png");
+        initial.width = s.render.width;
+        initial.height = s.render.height;
+        initial.spp = std::max(1, s.render.spp);
+    }
+    ExportDialog d(initial, this);
+    if (d.exec() == QDialog::Accepted) exportRender(d.settings());
+}
+
+// ---- window events ----
+
+void MainWindow::closeEvent(QCloseEvent* event)
+{
+    if (!maybeSave()) {
+        event->ignore();
+        return;
+    }
+    m_jobs->cancelAll();
+    m_jobs->waitForAll();
+    event->accept();
+}
+
+void MainWindow::dragEnterEvent(QDragEnterEvent* event)
+{
+    if (event->mimeData()->hasUrls()) event->acceptProposedAction();
+}
+
+void MainWindow::dropEvent(QDropEvent* event)
+{
+    for (const QUrl& url : event->mimeData()->urls()) {
+        if (!url.isLocalFile()) continue;
+        const QString path = url.toLocalFile();
+        if (path.endsWith(QLatin1String(".sylva.json"))) openFile(path);
+        else importMesh(path);
+    }
+    event->acceptProposedAction();
+}
+
+} // namespace sylva

@@ -1,0 +1,136 @@
+// The studio's main window: outliner, properties, viewport, jobs and log around one SceneDocument.
+// Every menu action has a method here that tests (and scripts) call without the file dialogs.
+#pragma once
+
+#include <functional>
+#include <memory>
+
+#include <QMainWindow>
+#include <QMessageBox>
+#include <QPointer>
+#include <QTimer>
+
+#include "studio/asset_store.h"
+#include "studio/dialogs.h"
+#include "studio/scene_document.h"
+
+class QComboBox;
+class QMenu;
+class QPlainTextEdit;
+class QTreeView;
+
+namespace sylva {
+
+class GridCache;
+class Job;
+class JobManager;
+class JobPanel;
+class OutlinerModel;
+class PropertyPanel;
+class Viewport;
+
+class MainWindow : public QMainWindow {
+    Q_OBJECT
+
+public:
+    explicit MainWindow(QWidget* parent = nullptr);
+    ~MainWindow() override;
+
+    SceneDocument* document() const { return m_doc; }
+    OutlinerModel* outlinerModel() const { return m_model; }
+    QTreeView* outliner() const { return m_outliner; }
+    PropertyPanel* propertyPanel() const { return m_properties; }
+    Viewport* viewport() const { return m_viewport; }
+    JobManager* jobs() const { return m_jobs; }
+    JobPanel* jobPanel() const { return m_jobPanel; }
+    AssetStore* assetStore() { return &m_assets; }
+    QComboBox* modeSelector() const { return m_modeBox; }
+    QString logText() const;
+    void clearLog();
+
+    // How errors and the unsaved-changes question reach the user. Defaults: modal message boxes.
+    // Tests install non-blocking ones; errorReported is emitted either way.
+    using ErrorReporter = std::function<void(const QString& title, const QString& message)>;
+    void setErrorReporter(ErrorReporter reporter) { m_reportError = std::move(reporter); }
+    using SavePrompt = std::function<QMessageBox::StandardButton(const QString& documentName)>;
+    void setSavePrompt(SavePrompt prompt) { m_askSave = std::move(prompt); }
+
+    // Lighting starts by itself (debounced) when species, sun or mode change; off: Render > Compute Lighting.
+    void setAutoLighting(bool on);
+    bool autoLighting() const { return m_autoLighting; }
+
+    // File
+    bool newScene();                       // false when the user cancelled the unsaved-changes prompt
+    bool openFile(const QString& path);    // false (and an error report) on a bad file; prompts first
+    bool saveFile(const QString& path);    // false (and an error report) when it cannot be written
+    bool save();                           // to the current file, or Save As when untitled
+    QStringList recentFiles() const;
+    // Import a mesh file as a new species with one instance at the origin (a background job; the
+    // scene changes when it succeeds, never when it fails).
+    Job* importMesh(const QString& path);
+    void growSpecies(const GrowSpec& spec);
+    void loadExampleForest();
+    // Render
+    // Loads/grows, voxelizes and lights what the viewport needs (reload: drop the in-memory assets
+    // first, so the grid cache answers). Returns the job, or null when everything is in memory.
+    Job* computeLighting(bool reload = false);
+    Job* exportRender(const ExportSettings& settings);
+    // Edit
+    void deleteSelection();
+
+Q_SIGNALS:
+    void errorReported(const QString& title, const QString& message);
+    void lightingFinished(bool succeeded);
+    void logLineAdded(const QString& line);
+
+protected:
+    void closeEvent(QCloseEvent* event) override;
+    void showEvent(QShowEvent* event) override;
+    void dragEnterEvent(QDragEnterEvent* event) override;
+    void dropEvent(QDropEvent* event) override;
+
+private:
+    void buildActions();
+    void buildDocks();
+    void appendLog(const QString& line);
+    void reportError(const QString& title, const QString& message);
+    bool maybeSave();
+    void addRecentFile(const QString& path);
+    void updateRecentMenu();
+    void updateTitle();
+    void onDocumentChanged(ScenePart parts);
+    void updateViewport();
+    bool viewNeedsLighting() const;
+    void onSelectionChanged();
+    void addSpecies(SpeciesDesc species, const Bounds3& bounds, const QString& undoText);
+    void openDialog();
+    bool saveAsDialog();
+    void importDialog();
+    void growDialog();
+    void exportDialog();
+
+    SceneDocument* m_doc;
+    JobManager* m_jobs;
+    AssetStore m_assets;
+    std::unique_ptr<GridCache> m_cache;
+    OutlinerModel* m_model;
+    QTreeView* m_outliner;
+    PropertyPanel* m_properties;
+    Viewport* m_viewport;
+    JobPanel* m_jobPanel;
+    QPlainTextEdit* m_log;
+    QComboBox* m_modeBox;
+    QMenu* m_recentMenu = nullptr;
+    QMenu* m_viewMenu = nullptr;
+
+    ErrorReporter m_reportError;
+    SavePrompt m_askSave;
+    bool m_autoLighting = true;
+    QTimer m_lightingTimer;
+    QPointer<Job> m_lightingJob;
+    bool m_lightingAgain = false;
+    ExportSettings m_lastExport;
+    bool m_docksSized = false;
+};
+
+} // namespace sylva

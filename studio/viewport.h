@@ -1,0 +1,94 @@
+// The 3D view: a QOpenGLWidget showing the CPU-rendered film as a texture, with orbit/pan/zoom.
+// The texture upload is the seam where the CUDA-GL interop path (a later issue) plugs in.
+#pragma once
+
+#include <memory>
+
+#include <QImage>
+#include <QOpenGLBuffer>
+#include <QOpenGLFunctions>
+#include <QOpenGLWidget>
+#include <QPoint>
+
+#include "core/scene/scene.h"
+#include "studio/asset_store.h"
+
+class QOpenGLShaderProgram;
+class QOpenGLTexture;
+
+namespace sylva {
+
+class RenderWorker;
+
+class Viewport : public QOpenGLWidget, protected QOpenGLFunctions {
+    Q_OBJECT
+
+public:
+    explicit Viewport(QWidget* parent = nullptr);
+    ~Viewport() override;
+
+    // What to draw. assets: one per species, in order; empty = not ready (status says why).
+    void setScene(const Scene& scene, std::vector<AssetsPtr> assets);
+    void setStatus(const QString& status);
+    QString status() const { return m_status; }
+
+    // The last image the renderer delivered (tone-mapped sRGB), its pass and whether it was the last.
+    QImage lastImage() const { return m_image; }
+    int lastPass() const { return m_lastPass; }
+    bool lastImageFinal() const { return m_lastFinal; }
+    // Seconds from the request to its first image, for the latest request that produced one.
+    double firstImageSeconds() const { return m_firstImageSeconds; }
+    // Render size in pixels (widget size x device pixel ratio).
+    QSize renderSize() const;
+    RenderWorker* worker() const { return m_worker; }
+
+    QSize sizeHint() const override { return {800, 450}; }
+
+Q_SIGNALS:
+    // Navigation changed the camera; consecutive events of one gesture share mergeKey.
+    void cameraEdited(const sylva::CameraDesc& camera, int mergeKey);
+    void imageShown(int pass, bool last, double seconds);
+    void renderFailed(const QString& message);
+
+protected:
+    void initializeGL() override;
+    void paintGL() override;
+    void resizeGL(int w, int h) override;
+    void mousePressEvent(QMouseEvent* event) override;
+    void mouseMoveEvent(QMouseEvent* event) override;
+    void mouseReleaseEvent(QMouseEvent* event) override;
+    void wheelEvent(QWheelEvent* event) override;
+
+private:
+    void cleanupGL();
+    void requestRender();
+    void onImage(const QImage& image, int pass, bool last, double seconds);
+
+    RenderWorker* m_worker;
+    Scene m_scene;
+    std::vector<AssetsPtr> m_assets;
+    QString m_status;
+
+    QImage m_image;
+    bool m_imageDirty = false;
+    int m_lastPass = -1;
+    bool m_lastFinal = false;
+    double m_firstImageSeconds = -1.0;
+    bool m_awaitingFirst = false;
+
+    // navigation
+    enum class Drag { None, Orbit, Pan };
+    Drag m_drag = Drag::None;
+    QPoint m_dragStart;
+    CameraDesc m_dragCamera;
+    int m_dragKey = 0;
+    int m_wheelKey = 0;
+    qint64 m_lastWheelMs = 0;
+
+    // GL (hellogl2 pattern: created in initializeGL, freed on aboutToBeDestroyed)
+    QOpenGLShaderProgram* m_program = nullptr;
+    QOpenGLTexture* m_texture = nullptr;
+    QOpenGLBuffer m_quad;
+};
+
+} // namespace sylva

@@ -1,0 +1,88 @@
+// Helpers for the studio tests that open the main window (under Xvfb): skip without X, isolation,
+// picture checks, waiting for jobs and viewport passes.
+#pragma once
+
+#include <cmath>
+
+#include <QApplication>
+#include <QImage>
+#include <QSettings>
+#include <QSignalSpy>
+#include <QStandardPaths>
+#include <QTemporaryDir>
+#include <QTest>
+
+#include "studio/job_manager.h"
+#include "studio/main_window.h"
+#include "studio/viewport.h"
+
+namespace sylva::test {
+
+inline QString sharedTree() { return QStringLiteral(SYLVA_SHARED_DATA "/trees/quaternius/OBJ/Tree_1.obj"); }
+
+// Call first in initTestCase: QSKIP when CMake found no xvfb-run.
+#define SYLVA_SKIP_WITHOUT_X()                                                                                \
+    do {                                                                                                      \
+        if (qEnvironmentVariableIsSet("SYLVA_GUI_NO_X"))                                                       \
+            QSKIP("xvfb-run was not found when CMake ran: install xvfb (./build.sh does) to run the GL tests"); \
+    } while (false)
+
+// Settings in Qt's test location (emptied), grid cache in `dir` (a fresh cache: the first solve computes).
+inline void isolate(const QTemporaryDir& dir)
+{
+    QStandardPaths::setTestModeEnabled(true);
+    QApplication::setOrganizationName("SylvaTest");
+    QApplication::setApplicationName("sylva-studio-test");
+    QSettings().clear();   // test mode keeps its files between runs (~/.qttest)
+    qputenv("XDG_CACHE_HOME", dir.filePath("cache").toLocal8Bit());
+    QApplication::setStyle("Fusion");
+}
+
+// Mean and standard deviation of the luminance (0..255) of a picture.
+inline void lumaStats(const QImage& image, double* mean, double* stddev)
+{
+    const QImage img = image.convertToFormat(QImage::Format_RGB32);
+    double s = 0.0, s2 = 0.0;
+    const double n = double(img.width()) * double(img.height());
+    for (int y = 0; y < img.height(); ++y)
+        for (int x = 0; x < img.width(); ++x) {
+            const QRgb p = img.pixel(x, y);
+            const double l = 0.2126 * qRed(p) + 0.7152 * qGreen(p) + 0.0722 * qBlue(p);
+            s += l;
+            s2 += l * l;
+        }
+    *mean = n > 0 ? s / n : 0.0;
+    *stddev = n > 0 ? std::sqrt(std::max(0.0, s2 / n - *mean * *mean)) : 0.0;
+}
+
+// Waits for a job's end; true when it succeeded.
+// (The job deletes itself after finishing: read its state in the signal, not afterwards.)
+inline bool waitForJob(Job* job, int timeoutMs, Job::State* stateOut = nullptr)
+{
+    if (!job) return false;
+    bool done = false;
+    Job::State state = Job::State::Running;
+    const QMetaObject::Connection c = QObject::connect(job, &Job::finished, job, [&](Job* j) {
+        done = true;
+        state = j->state();
+    });
+    done = QTest::qWaitFor([&] { return done; }, timeoutMs);
+    if (!done) QObject::disconnect(c);
+    if (stateOut) *stateOut = state;
+    return done && state == Job::State::Succeeded;
+}
+
+// Waits until the viewport shows the last pass of its schedule.
+inline bool waitForFinalImage(Viewport* v, int timeoutMs)
+{
+    QSignalSpy shown(v, &Viewport::imageShown);
+    QElapsedTimer t;
+    t.start();
+    while (t.elapsed() < timeoutMs) {
+        if (!shown.isEmpty() && shown.last().at(1).toBool()) return true;
+        shown.wait(std::max<int>(1, timeoutMs - int(t.elapsed())));
+    }
+    return !shown.isEmpty() && shown.last().at(1).toBool();
+}
+
+} // namespace sylva::test

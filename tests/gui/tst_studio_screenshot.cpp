@@ -1,0 +1,93 @@
+// A screenshot of the main window with a lit tree under Xvfb, against a golden image with a loose
+// tolerance (fonts and widget styles may move a few pixels between machines; the tree must not).
+// The picture is written to the build tree (test-output/gui_main_window.png) for inspection; a missing
+// baseline is written and fails; SYLVA_TEST_UPDATE=1 rewrites it.
+#include <QDir>
+#include <QStatusBar>
+#include <QTreeView>
+
+#include <memory>
+
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+
+#include "studio/outliner_model.h"
+#include "studio/property_panel.h"
+#include "studio_test_util.h"
+
+using namespace sylva;
+using namespace sylva::test;
+
+class TstStudioScreenshot : public QObject {
+    Q_OBJECT
+
+    QTemporaryDir m_dir;
+
+private Q_SLOTS:
+    void initTestCase()
+    {
+        SYLVA_SKIP_WITHOUT_X();
+        isolate(m_dir);
+    }
+
+    void mainWindowWithLitTree()
+    {
+        MainWindow win;
+        QStringList errors;
+        win.setErrorReporter([&](const QString&, const QString& m) { errors << m; });
+        win.setSavePrompt([](const QString&) { return QMessageBox::Discard; });
+        win.setAutoLighting(false);
+        win.resize(1024, 640);
+        win.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&win));
+        QVERIFY(waitForJob(win.importMesh(sharedTree()), 30000));
+        Scene s = win.document()->scene();
+        s.species[0].grid = 16;
+        s.sun.direction = sunDirection(40.0, 210.0);
+        win.document()->edit(s, "grid 16");
+        QSignalSpy lit(&win, &MainWindow::lightingFinished);
+        QVERIFY(win.computeLighting());
+        QVERIFY(lit.wait(60000));
+        QVERIFY(lit.at(0).at(0).toBool());
+        QVERIFY(errors.isEmpty());
+        QVERIFY(waitForFinalImage(win.viewport(), 60000));
+        win.outliner()->setCurrentIndex(win.outlinerModel()->indexOf({OutlinerItem::Kind::Sun, -1}));
+        // What changes from run to run (times, paths) stays out of the picture.
+        win.clearLog();
+        win.statusBar()->clearMessage();
+        QTest::qWait(100);
+        const QImage shot = win.grab().toImage().convertToFormat(QImage::Format_RGB888);
+
+        const QString out = QString(SYLVA_TEST_OUTPUT) + "/gui_main_window.png";
+        const QString golden = QString(SYLVA_TEST_DATA) + "/golden/studio_main_window.png";
+        QVERIFY(shot.save(out));
+        if (qEnvironmentVariableIsSet("SYLVA_TEST_UPDATE") || !QFile::exists(golden)) {
+            QDir().mkpath(QFileInfo(golden).absolutePath());
+            QVERIFY(shot.save(golden));
+            if (!qEnvironmentVariableIsSet("SYLVA_TEST_UPDATE")) QFAIL(qPrintable("baseline was missing; wrote " + golden));
+            return;
+        }
+        OIIO::ImageBuf a(out.toStdString()), b(golden.toStdString());
+        QCOMPARE(a.spec().width, b.spec().width);
+        QCOMPARE(a.spec().height, b.spec().height);
+        // A pixel fails above 0.25 in any channel (64 of 255). The picture fails when more than 3% of
+        // its pixels fail (text re-flowed by another font) or its mean error exceeds 0.02 (a wrong or
+        // missing render changes the whole viewport, about half the window).
+        const auto cmp = OIIO::ImageBufAlgo::compare(a, b, 0.25f, 0.1f);
+        const double npx = double(a.spec().width) * double(a.spec().height);
+        qInfo("screenshot vs golden: %lld failing pixels (%.2f%%), mean error %.4f", (long long)cmp.nfail,
+              100.0 * double(cmp.nfail) / npx, cmp.meanerror);
+        if (double(cmp.nfail) > 0.03 * npx || cmp.meanerror > 0.02) {
+            OIIO::ImageBuf diff = OIIO::ImageBufAlgo::absdiff(a, b);
+            diff = OIIO::ImageBufAlgo::mul(diff, 16.0f);
+            diff.write(out.toStdString() + ".diff16.png");
+            QFAIL(qPrintable(QString("%1 differs from %2: %3 failing pixels, mean error %4")
+                                 .arg(out, golden)
+                                 .arg(cmp.nfail)
+                                 .arg(cmp.meanerror)));
+        }
+    }
+};
+
+QTEST_MAIN(TstStudioScreenshot)
+#include "tst_studio_screenshot.moc"
