@@ -2,6 +2,7 @@
 #include "core/lb/lb_params.h"
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "core/base/error.h"
@@ -41,6 +42,18 @@ LbParams paramsFromPreset(const Preset& preset)
 
 int defaultSteps(const glm::ivec3& dims) { return 2 * glm::max(dims.x, glm::max(dims.y, dims.z)); }
 
+namespace {
+
+// A parameter value as the message shows it: enough digits that a value just past a bound reads past it.
+std::string num(float v)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.9g", double(v));
+    return buf;
+}
+
+} // namespace
+
 void validate(const LbParams& params)
 {
     static const char* names[3] = {"R", "G", "B"};
@@ -50,15 +63,19 @@ void validate(const LbParams& params)
             throw Error(std::string("invalid LB parameter for channel ") + names[c] + ": " + what);
         };
         if (!std::isfinite(ch.sigmaA) || ch.sigmaA < 0.0f)
-            fail("sigma_a = " + std::to_string(ch.sigmaA) + " must be finite and >= 0");
+            fail("sigma_a = " + num(ch.sigmaA) + " must be finite and >= 0");
         if (!std::isfinite(ch.sigmaS) || ch.sigmaS < 0.0f)
-            fail("sigma_s = " + std::to_string(ch.sigmaS) + " must be finite and >= 0");
+            fail("sigma_s = " + num(ch.sigmaS) + " must be finite and >= 0");
         // Stability (LB_MODEL.md): every coefficient of I + rho*Omega is >= 0 iff sigma_t * max(rho) <= 1.
-        if (double(ch.sigmaA) + double(ch.sigmaS) > 1.0 + 1e-6)
-            fail("sigma_t = sigma_a + sigma_s = " + std::to_string(ch.sigmaA + ch.sigmaS) +
+        // Checked on the float sum the kernels use (compactOmega): any excess over 1 makes the coefficient
+        // 1 - rho * sigma_t negative and f with it. Decimal inputs that sum to 1 (0.118 + 0.882) round to
+        // exactly 1 there.
+        const float sigmaT = ch.sigmaA + ch.sigmaS;
+        if (sigmaT > 1.0f)
+            fail("sigma_t = sigma_a + sigma_s = " + num(sigmaT) +
                  " exceeds the stability bound 1 (sigma_t * max density must be <= 1)");
         if (!std::isfinite(ch.g) || std::fabs(ch.g) > 1.0f)
-            fail("g = " + std::to_string(ch.g) + " must lie in [-1, 1]");
+            fail("g = " + num(ch.g) + " must lie in [-1, 1]");
     }
     const glm::vec3 s = params.sun;
     if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || glm::length(s) < 1e-12f)
