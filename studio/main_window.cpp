@@ -321,7 +321,7 @@ bool MainWindow::maybeSave()
 bool MainWindow::newScene()
 {
     if (!maybeSave()) return false;
-    m_jobs->cancelAll();
+    if (m_lightingJob) m_lightingJob->cancel();   // exports of the old scene may finish
     m_doc->reset(Scene{}, QString());
     appendLog(tr("new scene"));
     return true;
