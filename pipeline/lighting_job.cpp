@@ -53,6 +53,7 @@ CacheKey lightKey(const DensityGrid& density, const lb::LbParams& p)
     key.add("brown threshold", double(p.brownThreshold));
     key.add("storage", int64_t(p.storage == lb::Storage::Fp16 ? 16 : 32));
     key.add("warm start", int64_t(p.warmStart));
+    if (p.coarseStart && p.tolerance > 0.0) key.add("coarse start", int64_t(1));
     if (p.tolerance > 0.0) {
         // Where the tolerance check falls depends on the block depth, so it is part of the key here.
         key.add("tolerance", p.tolerance).add("check every", p.checkEvery).add("max steps", p.maxSteps);

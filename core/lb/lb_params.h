@@ -31,6 +31,8 @@ struct LbParams {
     int maxSteps = 0;                          // tolerance mode cap; 0 = 4 x the longest edge
     bool warmStart = false;                    // start the interior from the unobstructed field instead of 0
                                                // (same steady state, reached in fewer steps; not the seed's start)
+    bool coarseStart = false;                  // tolerance mode: start from the same solve on a grid of half the
+                                               // resolution (recursively), interpolated; fewer fine steps
     int solvesPerPass = 0;                     // channel solves advanced together; 0 = all that fit in memory
     int blockSteps = 0;                        // steps per cache-blocked wavefront; 0 = sized to the cache
     float brownThreshold = 0.5f;               // wood fraction above which a node is brown (g = -1)

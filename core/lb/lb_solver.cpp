@@ -251,8 +251,11 @@ public:
     void setState(size_t c, const std::vector<float>& f)
     {
         ChannelField<S>& field = *m_fields[c];
-        for (size_t n = 0; n < f.size(); ++n) field.a[n] = toStorage<S>(f[n]);
-        field.b = field.a;
+        const size_t chunk = size_t(m_Z) * kDirections;   // one (i, j) row of all directions
+        tbb::parallel_for(size_t(0), f.size() / chunk, [&](size_t r) {
+            storeRow(f.data() + r * chunk, field.a.data() + r * chunk, int(chunk));
+            std::copy_n(field.a.data() + r * chunk, chunk, field.b.data() + r * chunk);
+        });
         field.flip = false;
     }
     void getState(size_t c, std::vector<float>& f) const
@@ -384,6 +387,145 @@ double availableMemoryBytes()
     return kb * 1024.0;
 }
 
+// Coarse start: a grid of half the resolution whose node I sits on fine node 2I (the last one may
+// lie past the fine edge). Density is the full-weighting average of the fine nodes around 2I,
+// doubled (a coarse step crosses two fine cells) and capped at 1; wood fraction is averaged.
+DensityGrid coarsen(const DensityGrid& fine)
+{
+    const glm::ivec3 fd = fine.geometry.dims;
+    DensityGrid c;
+    c.geometry.dims = fd / 2 + 1;
+    c.geometry.origin = fine.geometry.origin;
+    c.geometry.spacing = fine.geometry.spacing * 2.0;
+    const glm::ivec3 cd = c.geometry.dims;
+    c.density.assign(c.geometry.nodeCount(), 0.0f);
+    const bool wood = !fine.woodFraction.empty();
+    if (wood) c.woodFraction.assign(c.geometry.nodeCount(), 0.0f);
+    tbb::parallel_for(1, cd.x - 1, [&](int I) {
+        for (int J = 1; J < cd.y - 1; ++J)
+            for (int K = 1; K < cd.z - 1; ++K) {
+                double rho = 0.0, w = 0.0, sum = 0.0;
+                for (int a = -1; a <= 1; ++a)
+                    for (int b = -1; b <= 1; ++b)
+                        for (int e = -1; e <= 1; ++e) {
+                            const int i = 2 * I + a, j = 2 * J + b, k = 2 * K + e;
+                            if (i < 0 || j < 0 || k < 0 || i >= fd.x || j >= fd.y || k >= fd.z) continue;
+                            const double weight = (a ? 0.5 : 1.0) * (b ? 0.5 : 1.0) * (e ? 0.5 : 1.0);
+                            const size_t n = fine.geometry.index(i, j, k);
+                            rho += weight * fine.density[n];
+                            if (wood) w += weight * fine.woodFraction[n];
+                            sum += weight;
+                        }
+                const size_t n = c.geometry.index(I, J, K);
+                c.density[n] = sum > 0.0 ? float(std::min(1.0, 2.0 * rho / sum)) : 0.0f;
+                if (wood) c.woodFraction[n] = sum > 0.0 ? float(w / sum) : 0.0f;
+            }
+    });
+    return c;
+}
+
+// Fine state from a coarse one: interior nodes interpolate the coarse distributions trilinearly at
+// (i/2, j/2, k/2); boundary nodes keep the boundary condition.
+std::vector<float> prolongate(const std::vector<float>& coarse, const glm::ivec3& cd, const glm::ivec3& fd,
+                              const std::vector<float>& bc)
+{
+    std::vector<float> fine(size_t(fd.x) * fd.y * fd.z * kDirections);
+    auto cidx = [&](int I, int J, int K, int m) {
+        return ((size_t(I) * size_t(cd.y) + size_t(J)) * kDirections + size_t(m)) * size_t(cd.z) + size_t(K);
+    };
+    tbb::parallel_for(0, fd.x, [&](int i) {
+        for (int j = 0; j < fd.y; ++j)
+            for (int m = 0; m < kDirections; ++m) {
+                float* row = &fine[((size_t(i) * size_t(fd.y) + size_t(j)) * kDirections + size_t(m)) * size_t(fd.z)];
+                const bool edgeRow = i == 0 || j == 0 || i == fd.x - 1 || j == fd.y - 1;
+                const int I0 = std::min(i / 2, cd.x - 2), J0 = std::min(j / 2, cd.y - 2);
+                const float fx = float(i) / 2.0f - float(I0), fy = float(j) / 2.0f - float(J0);
+                for (int k = 0; k < fd.z; ++k) {
+                    if (edgeRow || k == 0 || k == fd.z - 1) {
+                        row[k] = bc[size_t(m)];
+                        continue;
+                    }
+                    const int K0 = std::min(k / 2, cd.z - 2);
+                    const float fz = float(k) / 2.0f - float(K0);
+                    float v = 0.0f;
+                    for (int corner = 0; corner < 8; ++corner) {
+                        const int dx = corner >> 2, dy = (corner >> 1) & 1, dz = corner & 1;
+                        const float w = (dx ? fx : 1.0f - fx) * (dy ? fy : 1.0f - fy) * (dz ? fz : 1.0f - fz);
+                        v += w * coarse[cidx(I0 + dx, J0 + dy, K0 + dz, m)];
+                    }
+                    row[k] = v;
+                }
+            }
+    });
+    return fine;
+}
+
+struct StepResult {
+    int steps = 0;
+    bool converged = false;
+};
+
+// Advances a solver in wavefront blocks until the step budget is spent or (tolerance mode) the
+// relative change per step falls under the tolerance. report(done) is called after each block.
+template <typename S, typename Report>
+StepResult runSteps(Solver<S>& solver, const LbParams& params, int steps, SolveStats& stats, Report&& report)
+{
+    const bool tolMode = params.tolerance > 0.0;
+    // Fixed steps run in wavefront blocks of the cache-sized depth. In tolerance mode the last two
+    // levels of a block measure the change per step; that check costs about a step, so by default
+    // it runs on the last block of every ~16 steps rather than on every block.
+    const int depth = params.blockSteps > 0 ? params.blockSteps : solver.autoLevels();
+    const int block = tolMode && params.checkEvery > 0 ? std::max(2, params.checkEvery) : std::max(tolMode ? 2 : 1, depth);
+    const int checkBlocks = tolMode && params.checkEvery <= 0 ? std::max(1, (16 + block - 1) / block) : 1;
+    stats.blockSteps = block;
+    StepResult r;
+    int blocksRun = 0;
+    while (r.steps < steps) {
+        const int levels = std::min(block, steps - r.steps);
+        ++blocksRun;
+        const bool checkNow = tolMode && (blocksRun % checkBlocks == 0 || r.steps + levels >= steps);
+        const int compare = checkNow && levels >= 2 ? levels - 1 : 0;
+        const double change = solver.advanceBlock(levels, compare);
+        r.steps += levels;
+        if (compare > 0) {
+            stats.changeHistory.emplace_back(r.steps, change);
+            stats.lastChange = change;
+            if (change < params.tolerance) {
+                r.converged = true;
+                break;
+            }
+        }
+        report(r.steps);
+    }
+    return r;
+}
+
+// The starting states of a coarse start for `solves` on `fine`: solved (to the tolerance) on the
+// coarsened grid, itself coarse-started while it has at least 32 nodes on its longest edge.
+template <typename S>
+std::vector<std::vector<float>> coarseStates(const DensityGrid& fine, const LbParams& params,
+                                             const std::vector<ChannelParams>& solves, SolveStats& stats)
+{
+    const DensityGrid coarse = coarsen(fine);
+    Solver<S> solver(coarse, params, solves);
+    if (coarse.geometry.longestEdge() >= 32) {
+        const auto init = coarseStates<S>(coarse, params, solves, stats);
+        for (size_t s = 0; s < solves.size(); ++s) solver.setState(s, init[s]);
+    }
+    SolveStats coarseStats;
+    const int maxSteps = params.maxSteps > 0 ? params.maxSteps : 4 * coarse.geometry.longestEdge();
+    const StepResult r = runSteps(solver, params, maxSteps, coarseStats, [](int) {});
+    stats.coarseSteps += r.steps + coarseStats.coarseSteps;
+    const std::vector<float> bc = boundaryDistribution(params.sun);
+    std::vector<std::vector<float>> out(solves.size());
+    std::vector<float> state;
+    for (size_t s = 0; s < solves.size(); ++s) {
+        solver.getState(s, state);
+        out[s] = prolongate(state, coarse.geometry.dims, fine.geometry.dims, bc);
+    }
+    return out;
+}
+
 template <typename S>
 LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progress* progress, SolveStats& stats)
 {
@@ -438,36 +580,19 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
         const std::vector<ChannelParams> these(solves.begin() + long(g0), solves.begin() + long(std::min(solves.size(), g0 + group)));
         Solver<S> solver(density, params, these);
         solver.m_progress = progress;
-        // Fixed steps run in wavefront blocks of the cache-sized depth. In tolerance mode the last two
-        // levels of a block measure the change per step; that check costs about a step, so by default
-        // it runs on the last block of every ~16 steps rather than on every block.
-        const int depth = params.blockSteps > 0 ? params.blockSteps : solver.autoLevels();
-        const int block = tolMode && params.checkEvery > 0 ? std::max(2, params.checkEvery) : std::max(tolMode ? 2 : 1, depth);
-        const int checkBlocks = tolMode && params.checkEvery <= 0 ? std::max(1, (16 + block - 1) / block) : 1;
-        stats.blockSteps = block;
+        if (params.coarseStart && tolMode && longest >= 32) {
+            const auto init = coarseStates<S>(density, params, these, stats);
+            for (size_t s = 0; s < these.size(); ++s) solver.setState(s, init[s]);
+        }
         const double groupIndex = double(g0 / group);
-        int done = 0, blocksRun = 0;
-        bool groupConverged = false;
-        while (done < steps) {
-            const int levels = std::min(block, steps - done);
-            ++blocksRun;
-            const bool checkNow = tolMode && (blocksRun % checkBlocks == 0 || done + levels >= steps);
-            const int compare = checkNow && levels >= 2 ? levels - 1 : 0;
-            const double change = solver.advanceBlock(levels, compare);
-            done += levels;
-            if (compare > 0) {
-                stats.changeHistory.emplace_back(done, change);
-                stats.lastChange = change;
-                if (change < params.tolerance) {
-                    groupConverged = true;
-                    break;
-                }
-            }
+        const StepResult r = runSteps(solver, params, steps, stats, [&](int done) {
             if (progress)
                 progress->report((groupIndex + double(done) / double(steps)) / double(groups),
                                  "LB step " + std::to_string(done) + "/" + std::to_string(steps) +
                                      (groups > 1 ? " (channel group " + std::to_string(g0 / group + 1) + "/" + std::to_string(groups) + ")" : ""));
-        }
+        });
+        const int done = r.steps;
+        const bool groupConverged = r.converged;
         stats.steps = std::max(stats.steps, done);
         allConverged = allConverged && groupConverged;
         for (size_t s = 0; s < these.size(); ++s) {

@@ -16,6 +16,7 @@ struct SolveStats {
     int channelSolves = 0;          // distinct channel solves (channels with equal optics share one)
     double seconds = 0.0;
     int blockSteps = 0;             // steps per wavefront block
+    int coarseSteps = 0;            // coarse start: steps taken on the coarser grids (each 1/8 the work of the next)
     double bytesPerStep = 0.0;      // f bytes read + written per step, all solved channels
     std::vector<std::pair<int, double>> changeHistory;   // (step, relative change) at each check
 };

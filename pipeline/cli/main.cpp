@@ -163,6 +163,7 @@ std::vector<Command> commands()
                      {"--tol", "T", "stop when the relative change per step falls under T"},
                      {"--fp16", "", "store the distributions in half precision (half the memory)"},
                      {"--warm-start", "", "start from the unobstructed light field: same steady state, fewer steps"},
+                     {"--coarse-start", "", "with --tol: solve on half-resolution grids first and start from that (fastest to a given error)"},
                      {"--backend", "auto|cpu|cuda", "compute backend (default auto)"},
                      kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
                     0, 0});
@@ -417,6 +418,10 @@ lb::LbParams lightParams(const Args& args)
     }
     if (args.has("--fp16")) p.storage = lb::Storage::Fp16;
     if (args.has("--warm-start")) p.warmStart = true;
+    if (args.has("--coarse-start")) {
+        if (!args.has("--tol")) throw UsageError("--coarse-start applies to tolerance mode (--tol T)");
+        p.coarseStart = true;
+    }
     lb::validate(p);   // bad parameter values are bad input (exit 1) with a message naming the bound
     return p;
 }
@@ -481,6 +486,7 @@ int cmdLight(const Args& args)
     if (params.tolerance > 0.0) extra << ",\"tolerance\":" << params.tolerance;
     else extra << ",\"steps\":" << (params.steps > 0 ? params.steps : lb::defaultSteps(density.geometry.dims));
     extra << ",\"warm_start\":" << (params.warmStart ? "true" : "false");
+    if (params.coarseStart) extra << ",\"coarse_start\":true";
     extra << "}";
     writeLightingGrid(out, light, extra.str());
     double maxV[3] = {0, 0, 0}, mean[3] = {0, 0, 0};

@@ -83,7 +83,7 @@ int main(int argc, char** argv)
 {
     int n = 128, reps = 1;
     double tol = 2e-4;
-    bool dense = false, grown = false;
+    bool dense = false, grown = false, coarseOnly = false;
     for (int a = 1; a < argc; ++a) {
         std::string s = argv[a];
         if (s == "--grid" && a + 1 < argc) n = std::atoi(argv[++a]);
@@ -91,8 +91,9 @@ int main(int argc, char** argv)
         else if (s == "--tol" && a + 1 < argc) tol = std::atof(argv[++a]);
         else if (s == "--dense") dense = true;
         else if (s == "--grown") grown = true;
+        else if (s == "--coarse-only") coarseOnly = true;
         else {
-            std::printf("usage: bench_lb [--grid N] [--reps R] [--tol T] [--dense | --grown]\n");
+            std::printf("usage: bench_lb [--grid N] [--reps R] [--tol T] [--dense | --grown] [--coarse-only]\n");
             return s == "--help" ? 0 : 2;
         }
     }
@@ -125,8 +126,10 @@ int main(int argc, char** argv)
         }
         std::sort(times.begin(), times.end());
         Row row{name, times[times.size() / 2], st.steps, ref ? relativeL2(out, *ref) : 0.0, st.bytesPerStep};
-        std::printf("  %-22s %8.3f s  %4d steps  %6.2f ms/step  rel L2 vs fp32 default %.2e  %.0f MB/step\n", name,
+        std::printf("  %-22s %8.3f s  %4d steps  %6.2f ms/step  rel L2 vs fp32 default %.2e  %.0f MB/step", name,
                     row.seconds, row.steps, 1e3 * row.seconds / row.steps, row.error, row.bytesPerStep / 1e6);
+        if (st.coarseSteps > 0) std::printf("  (+%d steps on coarser grids)", st.coarseSteps);
+        std::printf("\n");
         std::fflush(stdout);
         if (keep) *keep = std::move(out);
         return row;
@@ -136,6 +139,18 @@ int main(int argc, char** argv)
     Row fp32 = run("fp32 default steps", base, nullptr, &reference);
     LbParams p16 = base;
     p16.storage = Storage::Fp16;
+    if (coarseOnly) {
+        // Only the coarse-start rows (with the fp32 reference above), for quick experiments.
+        for (double t : {1e-3, 3e-3, 1e-2}) {
+            LbParams q = p16;
+            q.coarseStart = true;
+            q.tolerance = t;
+            char name[64];
+            std::snprintf(name, sizeof name, "fp16 coarse tol %.0e", t);
+            run(name, q, &reference, nullptr);
+        }
+        return 0;
+    }
     Row fp16 = run("fp16 default steps", p16, &reference, nullptr);
     LbParams t32 = base;
     t32.tolerance = tol;
@@ -155,6 +170,17 @@ int main(int argc, char** argv)
         char name[64];
         std::snprintf(name, sizeof name, "fp16 warm tol %.0e", t);
         sweep.push_back(run(name, q, &reference, nullptr));
+    }
+
+    // Coarse start: the solve on grids of half, quarter ... resolution first, interpolated as the start.
+    std::vector<Row> coarse;
+    for (double t : {3e-4, 1e-3, 3e-3, 1e-2}) {
+        LbParams q = t16;
+        q.coarseStart = true;
+        q.tolerance = t;
+        char name[64];
+        std::snprintf(name, sizeof name, "fp16 coarse tol %.0e", t);
+        coarse.push_back(run(name, q, &reference, nullptr));
     }
 
     const double floorStep32 = copySeconds(size_t(fp32.bytesPerStep));
@@ -177,6 +203,11 @@ int main(int argc, char** argv)
         const std::string tag = r.name.substr(r.name.rfind(' ') + 1);
         std::printf("lb_fp16_warm_tol_%s_s=%.4f\nlb_fp16_warm_tol_%s_steps=%d\nlb_fp16_warm_tol_%s_err=%.3e\n", tag.c_str(), r.seconds,
                     tag.c_str(), r.steps, tag.c_str(), r.error);
+    }
+    for (const Row& r : coarse) {
+        const std::string tag = r.name.substr(r.name.rfind(' ') + 1);
+        std::printf("lb_fp16_coarse_tol_%s_s=%.4f\nlb_fp16_coarse_tol_%s_steps=%d\nlb_fp16_coarse_tol_%s_err=%.3e\n", tag.c_str(),
+                    r.seconds, tag.c_str(), r.steps, tag.c_str(), r.error);
     }
     std::printf("lb_speedup_fp16_tol_vs_fp32_default=%.2f\n", fp32.seconds / tol16.seconds);
     std::printf("lb_speedup_fp16_tol_warm_vs_fp32_default=%.2f\n", fp32.seconds / warm16.seconds);

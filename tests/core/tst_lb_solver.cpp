@@ -1,6 +1,8 @@
 // LB solver against the seed's naive kernel, conservation, diffusion, symmetry, tolerance mode, fp16, validation.
 #include <QTest>
 
+#include <numeric>
+
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -265,6 +267,38 @@ private Q_SLOTS:
         QVERIFY(st.converged);
         QVERIFY(st.steps < 60);
         QVERIFY(relativeL2(tol, fixed) < 0.01);
+    }
+
+    // Coarse start: the same steady state (within the tolerance's error), in fewer fine steps than a
+    // tolerance run from zero, with the coarse levels' steps counted; an empty grid starts converged.
+    void coarseStartReachesTheSameAnswer()
+    {
+        DensityGrid d = randomDensity({40, 48, 36}, 5, 0.5, 0.1);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.sun = {0.2f, 1.0f, 0.3f};
+        p.steps = 4 * 48;   // well converged reference
+        const LightingGrid ref = solveLighting(d, p);
+        p.steps = 0;
+        p.tolerance = 1e-3;
+        SolveStats plain, coarse;
+        const LightingGrid a = solveLighting(d, p, nullptr, &plain);
+        p.coarseStart = true;
+        const LightingGrid b = solveLighting(d, p, nullptr, &coarse);
+        qInfo("tolerance 1e-3: from zero %d steps, rel L2 %.2e; coarse start %d fine + %d coarse steps, rel L2 %.2e", plain.steps,
+              relativeL2(a, ref), coarse.steps, coarse.coarseSteps, relativeL2(b, ref));
+        QVERIFY(coarse.coarseSteps > 0);
+        QVERIFY(coarse.steps < plain.steps);
+        QVERIFY(relativeL2(b, ref) < relativeL2(a, ref));   // closer to the steady state, in fewer fine steps
+        QVERIFY(relativeL2(b, ref) < 0.02);
+
+        DensityGrid empty = d;
+        std::fill(empty.density.begin(), empty.density.end(), 0.0f);
+        SolveStats e;
+        const LightingGrid open = solveLighting(empty, p, nullptr, &e);
+        const std::vector<float> bc = boundaryDistribution(p.sun);
+        const float free = std::accumulate(bc.begin(), bc.end(), 0.0f);
+        for (float v : open.rgb) QVERIFY(std::fabs(v - free) < 1e-5f * free);
+        QVERIFY(e.steps <= 16);
     }
 
     void fp16StorageCloseToFp32()
