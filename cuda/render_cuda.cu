@@ -30,20 +30,8 @@ __global__ void shadeKernel(RenderView v, SampleParts* film)
     film[size_t(y) * size_t(v.width) + size_t(x)] = shadePixel(v, x, y);
 }
 
-// Mode composition and the sums the tone mapper needs: acc[0] = sum log(1e-4 + L), acc[1] = sum
-// lum(indirect), acc[2] = sum lum(albedo).
-__device__ glm::vec3 composeDevice(const SampleParts& p, RenderMode mode, glm::vec3 sky, float ambient)
-{
-    glm::vec3 c(0.0f);
-    switch (mode) {
-    case RenderMode::Full: c = p.local + p.indirect; break;
-    case RenderMode::Local: c = p.local; break;
-    case RenderMode::Ambient: c = p.local + ambient * p.albedo; break;
-    case RenderMode::Lb: c = p.indirect; break;
-    }
-    return c + p.skyCover * sky;
-}
-
+// The sums the tone mapper needs: acc[0] = sum log(1e-4 + L), acc[1] = sum lum(indirect), acc[2] =
+// sum lum(albedo) (the ambient constant of the ambient mode).
 __global__ void ambientSums(const SampleParts* film, size_t n, double* acc)
 {
     const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -57,7 +45,7 @@ __global__ void logSum(const SampleParts* film, size_t n, RenderMode mode, glm::
     const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= n) return;
     const float ambient = ambientAcc[2] > 0.0 ? float(ambientAcc[1] / ambientAcc[2]) : 0.0f;
-    const float l = luminance(composeDevice(film[i], mode, sky, ambient));
+    const float l = luminance(composeSample(film[i], mode, sky, ambient));
     atomicAdd(&acc[0], double(logf(1e-4f + fmaxf(l, 0.0f))));
 }
 
@@ -68,7 +56,7 @@ __global__ void toneMapKernel(const SampleParts* film, size_t n, RenderMode mode
     if (i >= n) return;
     const float ambient = acc[2] > 0.0 ? float(acc[1] / acc[2]) : 0.0f;
     const float logAvg = expf(float(acc[0] / double(n)));
-    const glm::vec3 c = reinhard(composeDevice(film[i], mode, sky, ambient), key / logAvg);
+    const glm::vec3 c = reinhard(composeSample(film[i], mode, sky, ambient), key / logAvg);
     const uint32_t r = uint32_t(srgbEncode(c.x) * 255.0f + 0.5f), g = uint32_t(srgbEncode(c.y) * 255.0f + 0.5f),
                    b = uint32_t(srgbEncode(c.z) * 255.0f + 0.5f);
     out[i] = r | (g << 8) | (b << 16) | (255u << 24);

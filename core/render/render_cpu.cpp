@@ -55,17 +55,7 @@ std::vector<glm::vec3> composeMode(const Film& film, RenderMode mode, const glm:
         }
         ambient = alb > 0.0 ? float(ind / alb) : 0.0f;
     }
-    for (size_t i = 0; i < n; ++i) {
-        const SampleParts& p = film.pixels[i];
-        glm::vec3 c(0.0f);
-        switch (mode) {
-        case RenderMode::Full: c = p.local + p.indirect; break;
-        case RenderMode::Local: c = p.local; break;
-        case RenderMode::Ambient: c = p.local + ambient * p.albedo; break;
-        case RenderMode::Lb: c = p.indirect; break;
-        }
-        out[i] = c + p.skyCover * sky;
-    }
+    for (size_t i = 0; i < n; ++i) out[i] = composeSample(film.pixels[i], mode, sky, ambient);
     if (ambientOut) *ambientOut = ambient;
     return out;
 }

@@ -16,6 +16,20 @@ struct SampleParts {
     float skyCover;
 };
 
+// Linear RGB of a render mode from a pixel's parts: full = local + indirect, local = sun light only,
+// ambient = local + a constant ambient x albedo, lb = indirect only; plus the sky where samples saw it.
+SYLVA_HD SYLVA_INLINE glm::vec3 composeSample(const SampleParts& p, RenderMode mode, const glm::vec3& sky, float ambient)
+{
+    glm::vec3 c(0.0f);
+    switch (mode) {
+    case RenderMode::Full: c = p.local + p.indirect; break;
+    case RenderMode::Local: c = p.local; break;
+    case RenderMode::Ambient: c = p.local + ambient * p.albedo; break;
+    case RenderMode::Lb: c = p.indirect; break;
+    }
+    return c + p.skyCover * sky;
+}
+
 // Bilinear, wrapped texture lookup (v = 0 is the bottom row, as in OBJ).
 SYLVA_HD inline glm::vec4 sampleTexture(const RenderView& v, int32_t index, glm::vec2 uv)
 {
