@@ -77,10 +77,13 @@ SYLVA_HD inline bool sunVisible(const RenderView& v, const glm::vec3& p)
     return !traceScene<true>(v, r, h);
 }
 
-// Offset along the geometric normal, scaled to the coordinates' magnitude (no self-shadowing acne).
-SYLVA_HD SYLVA_INLINE glm::vec3 offsetPoint(const glm::vec3& p, const glm::vec3& ng)
+// Offset along the geometric normal, scaled to the magnitude of the coordinates the hit was computed
+// from (no self-shadowing acne): camera-relative p and, for a mesh hit, `extent` = its species-frame
+// point's largest coordinate in world units. No floor in metres: a 1 m floor lifted the shadow rays of
+// a micrometre-sized scene clear of all its geometry (it lost every shadow).
+SYLVA_HD SYLVA_INLINE glm::vec3 offsetPoint(const glm::vec3& p, const glm::vec3& ng, float extent = 0.0f)
 {
-    const float m = fmaxf(fmaxf(fabsf(p.x), fabsf(p.y)), fmaxf(fabsf(p.z), 1.0f));
+    const float m = fmaxf(fmaxf(fmaxf(fabsf(p.x), fabsf(p.y)), fmaxf(fabsf(p.z), extent)), 1e-30f);
     return p + ng * (m * 2e-5f);
 }
 
@@ -121,7 +124,8 @@ SYLVA_HD inline SampleParts shadeRay(const RenderView& v, const Ray& ray)
     }
     out.albedo = kd;
     const float nl = glm::dot(ng, v.sunDir);
-    if (nl > 0.0f && sunVisible(v, offsetPoint(p, ng))) {
+    const float extent = in.scale * fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));
+    if (nl > 0.0f && sunVisible(v, offsetPoint(p, ng, extent))) {
         glm::vec3 c = kd * nl;
         if (m.shininess > 0.0f && (m.specular.x > 0.0f || m.specular.y > 0.0f || m.specular.z > 0.0f)) {
             const glm::vec3 r = 2.0f * nl * ng - v.sunDir;
