@@ -156,6 +156,12 @@ MainWindow::~MainWindow()
 {
     m_jobs->cancelAll();
     m_jobs->waitForAll();
+    // Children outlive this body: nothing they emit while being deleted (the undo stack's clear,
+    // a last image) may reach this half-destroyed window.
+    m_doc->disconnect(this);
+    m_jobs->disconnect(this);
+    m_viewport->disconnect(this);
+    m_lightingTimer.stop();
 }
 
 void MainWindow::buildDocks()

@@ -38,6 +38,8 @@ public:
     QDoubleSpinBox* sunElevation() const { return m_sunElevation; }
     QDoubleSpinBox* sunTemperature() const { return m_sunTemperature; }
     QSpinBox* speciesGrid() const { return m_speciesGrid; }
+    QLineEdit* speciesName() const { return m_speciesName; }
+    QComboBox* speciesPreset() const { return m_speciesPreset; }
 
 private:
     QWidget* buildEmptyPage();

@@ -2,7 +2,9 @@
 // reopen, the outliner model under QAbstractItemModelTester, the property panel's edits, navigation math.
 #include <QAbstractItemModelTester>
 #include <QDial>
+#include <QComboBox>
 #include <QDoubleSpinBox>
+#include <QLineEdit>
 #include <QSignalSpy>
 #include <QSpinBox>
 #include <QStandardPaths>
@@ -204,6 +206,17 @@ private Q_SLOTS:
         panel.showItem({OutlinerItem::Kind::Species, 0});
         panel.speciesGrid()->setValue(16);
         QCOMPARE(doc.scene().species[0].grid, 16);
+        panel.speciesPreset()->setCurrentText("cloud");
+        QCOMPARE(QString::fromStdString(doc.scene().species[0].preset), QStringLiteral("cloud"));
+        QCOMPARE(doc.scene().species[0].lighting.zeroF0, lb::findPreset("cloud")->zeroF0);
+        QCOMPARE(doc.scene().species[0].grid, 16);   // the preset leaves the grid alone
+        panel.speciesName()->setText("Oak");
+        Q_EMIT panel.speciesName()->editingFinished();
+        QCOMPARE(QString::fromStdString(doc.scene().species[0].name), QStringLiteral("Oak"));
+        panel.speciesName()->setText("  ");   // names stay non-empty (and unique)
+        Q_EMIT panel.speciesName()->editingFinished();
+        QCOMPARE(QString::fromStdString(doc.scene().species[0].name), QStringLiteral("Oak"));
+        QCOMPARE(panel.speciesName()->text(), QStringLiteral("Oak"));
     }
 
     void navigation()

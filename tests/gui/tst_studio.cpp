@@ -2,6 +2,9 @@
 // background while the UI keeps running, see the viewport draw it, undo/redo, navigate, save and
 // reopen, export a PNG, the unsaved-changes prompt.
 #include <QAction>
+#include <QComboBox>
+#include <QDropEvent>
+#include <QMimeData>
 #include <QDoubleSpinBox>
 #include <QElapsedTimer>
 #include <QFile>
@@ -267,6 +270,55 @@ private Q_SLOTS:
         QCOMPARE(scene().camera.position, before.position);
     }
 
+    void panAndRenderMode()
+    {
+        Viewport* v = m_win->viewport();
+        const CameraDesc before = scene().camera;
+        const QPoint c = v->rect().center();
+        QTest::mousePress(v, Qt::LeftButton, Qt::ShiftModifier, c);
+        QTest::mouseMove(v, c + QPoint(30, -10));
+        QTest::mouseRelease(v, Qt::LeftButton, Qt::ShiftModifier, c + QPoint(30, -10));
+        const glm::dvec3 moved = scene().camera.target - before.target;
+        QVERIFY(glm::length(moved) > 0.0);
+        QVERIFY(glm::length((scene().camera.position - before.position) - moved) < 1e-9);   // pan moves both
+        action("actionUndo")->trigger();
+        QCOMPARE(scene().camera.target, before.target);
+
+        QVERIFY(waitForFinalImage(v, 60000));
+        const QImage full = v->lastImage();
+        QComboBox* mode = m_win->modeSelector();
+        const int lb = mode->findText("lb");
+        QVERIFY(lb >= 0);
+        mode->setCurrentIndex(lb);
+        Q_EMIT mode->activated(lb);
+        QCOMPARE(scene().render.mode, RenderMode::Lb);
+        QVERIFY(waitForFinalImage(v, 60000));
+        QVERIFY(v->lastImage() != full);
+        action("actionUndo")->trigger();
+        QCOMPARE(scene().render.mode, RenderMode::Full);
+        QCOMPARE(mode->currentText(), QStringLiteral("full"));
+    }
+
+    void deleteAndUndo()
+    {
+        Scene s = scene();
+        s.instances.push_back(s.instances[0]);
+        s.instances.back().position.x = 4.0;
+        m_win->document()->edit(s, "second instance");
+        select({OutlinerItem::Kind::Instance, 1});
+        action("actionDelete")->trigger();
+        QCOMPARE(scene().instances.size(), size_t(1));
+        action("actionUndo")->trigger();
+        QCOMPARE(scene().instances.size(), size_t(2));
+        select({OutlinerItem::Kind::Species, 0});
+        action("actionDelete")->trigger();   // a species goes with its instances
+        QVERIFY(scene().species.empty() && scene().instances.empty());
+        action("actionUndo")->trigger();
+        action("actionUndo")->trigger();
+        QCOMPARE(scene().instances.size(), size_t(1));
+        QVERIFY(waitForFinalImage(m_win->viewport(), 60000));
+    }
+
     void saveReopenCompare()
     {
         const QString path = m_dir.filePath("scenes/forest.sylva.json");
@@ -287,8 +339,24 @@ private Q_SLOTS:
         QVERIFY(waitForFinalImage(m_win->viewport(), 60000));
     }
 
+    void exportPng_data()
+    {
+        QTest::addColumn<QString>("name");
+        QTest::newRow("png") << "out/render.png";
+        QTest::newRow("exr") << "out/render.exr";
+        QTest::newRow("tiff") << "out/render.tif";
+    }
+
     void exportPng()
     {
+        QFETCH(QString, name);
+        m_errors.clear();
+        if (!name.endsWith(".png")) {
+            const QString path = m_dir.filePath(name);
+            QVERIFY(waitForJob(m_win->exportRender({path, 32, 18, 1}), 60000));
+            QVERIFY(QFileInfo(path).size() > 0);
+            return;
+        }
         const QString path = m_dir.filePath("out/render.png");
         ExportSettings es{path, 160, 90, 1};
         QVERIFY(waitForJob(m_win->exportRender(es), 60000));
@@ -298,10 +366,54 @@ private Q_SLOTS:
         lumaStats(img, &mean, &sd);
         QVERIFY(sd > 8.0);
         QVERIFY(m_win->logText().contains("exported"));
+        QCOMPARE(m_errors.size(), 0);
         // A bad extension is an error report, not a crash.
         m_errors.clear();
         QVERIFY(!waitForJob(m_win->exportRender({m_dir.filePath("render.bmpx"), 32, 18, 1}), 60000));
         QCOMPARE(m_errors.size(), 1);
+    }
+
+    // Grow Species adds a grown species with one instance; lighting grows, voxelizes and lights it.
+    void growSpecies()
+    {
+        GrowSpec g;
+        g.species = "shrub";
+        g.seed = 3;
+        g.triangles = 2000;
+        m_win->growSpecies(g);
+        QCOMPARE(scene().species.size(), size_t(2));
+        QCOMPARE(QString::fromStdString(scene().species[1].name), QStringLiteral("shrub 3"));
+        QVERIFY(scene().species[1].grow.has_value());
+        QCOMPARE(scene().instances.back().species, 1u);
+        Scene s = scene();
+        s.species[1].grid = 16;
+        s.instances.back().position = {3.0, 0.0, 0.0};
+        m_win->document()->edit(s, "small grid");
+        QSignalSpy finished(m_win.get(), &MainWindow::lightingFinished);
+        QVERIFY(m_win->computeLighting());
+        QVERIFY(finished.wait(60000));
+        QVERIFY(finished.at(0).at(0).toBool());
+        QVERIFY(m_win->logText().contains("shrub 3: grow"));
+        QVERIFY(waitForFinalImage(m_win->viewport(), 60000));
+    }
+
+    // Dropping a mesh file on the window imports it.
+    void dropImports()
+    {
+        const size_t before = scene().species.size();
+        QSignalSpy finished(m_win->jobs(), &JobManager::jobFinished);
+        auto* mime = new QMimeData;
+        mime->setUrls({QUrl::fromLocalFile(sharedTree())});
+        QDragEnterEvent enter(QPoint(200, 200), Qt::CopyAction, mime, Qt::LeftButton, Qt::NoModifier);
+        QApplication::sendEvent(m_win.get(), &enter);
+        QVERIFY(enter.isAccepted());
+        QDropEvent drop(QPointF(200, 200), Qt::CopyAction, mime, Qt::LeftButton, Qt::NoModifier);
+        QApplication::sendEvent(m_win.get(), &drop);
+        QVERIFY2(m_win->logText().contains("importing"), qPrintable(m_win->logText()));
+        QVERIFY(finished.wait(30000));
+        QCOMPARE(scene().species.size(), before + 1);
+        QCOMPARE(QString::fromStdString(scene().species.back().name), QStringLiteral("Tree_1 (2)"));   // names stay unique
+        delete mime;
     }
 
     void unsavedChangesPrompt()
