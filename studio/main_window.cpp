@@ -508,8 +508,15 @@ Job* MainWindow::computeLighting(bool reload)
     m_lightingTimer.stop();
     const Scene scene = m_doc->scene();
     const bool lit = viewNeedsLighting();
+    std::vector<std::string> target;
+    for (const SpeciesDesc& sp : scene.species) target.push_back(assetKey(sp, scene.sun, lit));
     if (m_lightingJob) {
-        // One lighting job at a time: stop it and run again for the scene as it is now.
+        // One lighting job at a time. One that already makes what the scene needs (the camera or an
+        // instance moved meanwhile) runs on; otherwise stop it and run again for the scene as it is now.
+        if (!reload && target == m_lightingTarget && !m_lightingJob->cancelRequested()) {
+            m_lightingAgain = false;
+            return m_lightingJob;
+        }
         m_lightingJob->cancel();
         m_lightingAgain = true;
         return nullptr;
@@ -534,6 +541,7 @@ Job* MainWindow::computeLighting(bool reload)
     AssetStore* store = &m_assets;
     appendLog(lit ? tr("lighting %n species", nullptr, int(m_assets.missingSpecies(scene, lit).size()))
                   : tr("loading %n species", nullptr, int(m_assets.missingSpecies(scene, lit).size())));
+    m_lightingTarget = target;
     m_lightingJob = m_jobs->start(lit ? tr("Lighting") : tr("Loading"),
                                   [scene, lit, store, cache](Job& job, Progress& progress) {
                                       ensureAssets(scene, lit, *store, cache, &progress, [&job](const std::string& line) {

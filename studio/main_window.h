@@ -128,6 +128,7 @@ private:
     bool m_autoLighting = true;
     QTimer m_lightingTimer;
     QPointer<Job> m_lightingJob;
+    std::vector<std::string> m_lightingTarget;   // asset keys the running lighting job produces
     bool m_lightingAgain = false;
     ExportSettings m_lastExport;
     bool m_docksSized = false;

@@ -43,8 +43,15 @@ private Q_SLOTS:
         Scene s = win.document()->scene();
         for (SpeciesDesc& sp : s.species) sp.grid = 32;
         win.document()->edit(s, "grid 32");
+        // Orbiting while the species are lit does not restart the job.
+        QVERIFY(QTest::qWaitFor([&] { return win.jobs()->isBusy(); }, 5000));
+        QTest::mousePress(v, Qt::LeftButton, {}, v->rect().center());
+        QTest::mouseRelease(v, Qt::LeftButton, {}, v->rect().center() + QPoint(20, 0));
+        QTest::qWait(400);   // past the automatic-lighting delay
         QVERIFY(lit.wait(300000));
+        QCOMPARE(lit.count(), 1);
         QVERIFY(lit.last().at(0).toBool());
+        QVERIFY2(!win.logText().contains("cancelled"), qPrintable(win.logText()));
         QVERIFY(waitForFinalImage(v, 120000));
         QVERIFY2(errors.isEmpty(), qPrintable(errors.join('\n')));
         QCOMPARE(v->lastImage().size(), QSize(640, 360));
