@@ -2,6 +2,7 @@
 #include "pipeline/render/render_job.h"
 
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <numeric>
 
@@ -31,6 +32,38 @@ std::string readResource(const char* name)
 double secondsSince(std::chrono::steady_clock::time_point t0)
 {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// MemAvailable from /proc/meminfo in bytes, 0 when unknown.
+double availableMemoryBytes()
+{
+    std::FILE* f = std::fopen("/proc/meminfo", "r");
+    if (!f) return 0.0;
+    char line[256];
+    double kb = 0.0;
+    while (std::fgets(line, sizeof line, f))
+        if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
+    std::fclose(f);
+    return kb * 1024.0;
+}
+
+// Refuses, before any work, a frame whose film and composed picture would not fit in memory (the
+// film holds every pixel's shading parts until the picture is composed): better a message than the
+// out-of-memory killer halfway through.
+void checkFrameMemory(const RenderSettings& r)
+{
+    const double pixels = double(r.width) * double(r.height);
+    const double needed = pixels * double(kFrameBytesPerPixel);
+    const double available = availableMemoryBytes();
+    if (available > 0.0 && needed > 0.8 * available) {
+        char msg[320];
+        std::snprintf(msg, sizeof msg,
+                      "render: a %dx%d image needs %.1f GB for its film and composed picture (%d bytes per pixel) but "
+                      "%.1f GB of memory is available; render at most about %.0f megapixels",
+                      r.width, r.height, needed / 1e9, int(kFrameBytesPerPixel), available / 1e9,
+                      0.8 * available / double(kFrameBytesPerPixel) / 1e6);
+        throw Error(msg);
+    }
 }
 
 // Coverage in the alpha channel from an opacity map: its alpha when it has one below 1, else its red channel.
@@ -136,6 +169,7 @@ std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cach
 
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend)
 {
+    checkFrameMemory(scene.render);
     RenderOutput out;
     auto t0 = std::chrono::steady_clock::now();
     SubProgress assetsPart(progress, 0.0, 0.6);
