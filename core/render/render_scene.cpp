@@ -1,11 +1,13 @@
 // Flattens species, instances, textures and lighting grids into the RenderView arrays; builds the BVHs.
 #include "core/render/render_scene.h"
 
+#include <array>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
 
 #include "core/base/error.h"
+#include "core/render/prune.h"
 #include "core/render/tonemap.h"
 
 namespace sylva {
@@ -78,6 +80,7 @@ InstanceRecord makeInstance(const InstanceDesc& inst, const glm::dvec3& frameOri
     for (int i = 0; i < 3; ++i) r.row[i] = glm::vec4(float(rt[0][i]), float(rt[1][i]), float(rt[2][i]), float(t[i]));
     r.species = inst.species;
     r.scale = inst.scale;
+    r.geometry = inst.species;   // the full species; buildRenderScene picks a pruned level where it prunes
     return r;
 }
 
@@ -116,31 +119,127 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
     if (assets.size() != scene.species.size()) throw Error("render: one set of assets per species is required");
     if (scene.instances.empty()) throw Error("render: the scene has no instances");
     RenderScene rs;
-    const size_t ns = assets.size();
+    const size_t ns = assets.size(), ni = scene.instances.size();
+    const glm::dvec3 origin = scene.camera.position;
+    for (size_t s = 0; s < ns; ++s)
+        if (assets[s].mesh.triangles.empty()) throw Error("render: species '" + scene.species[s].name + "' has no triangles");
+    for (size_t i = 0; i < ni; ++i)
+        if (scene.instances[i].species >= ns) throw Error("render: instance " + std::to_string(i) + " names a missing species");
 
-    // Bottom level: one BVH per species, built in parallel.
-    std::vector<Bvh> blas(ns);
-    tbb::parallel_for(size_t(0), ns, [&](size_t s) {
-        const TriangleMesh& m = assets[s].mesh;
-        std::vector<Bounds3> boxes(m.triangles.size());
-        for (size_t t = 0; t < boxes.size(); ++t)
-            for (int c = 0; c < 3; ++c) boxes[t].extend(m.positions[m.triangles[t][c]]);
+    // Stochastic pruning: each instance's level of detail from the distance of its box centre to the camera.
+    const double pruneStart = scene.render.pruneDistance;
+    std::vector<int> instanceLevel(ni, 0);
+    std::vector<LeafElements> leaves(pruneStart > 0.0 ? ns : 0);
+    std::vector<std::vector<uint32_t>> orders(leaves.size());
+    if (pruneStart > 0.0) {
+        std::vector<int> levels(ns, 1);
+        std::vector<glm::dvec3> centre(ns);
+        tbb::parallel_for(size_t(0), ns, [&](size_t s) {
+            leaves[s] = findLeafElements(assets[s].mesh);
+            orders[s] = pruneOrder(leaves[s].count());
+            levels[s] = pruneLevelCount(leaves[s]);
+            centre[s] = glm::dvec3(meshBounds(assets[s].mesh).center());
+        });
+        for (size_t i = 0; i < ni; ++i) {
+            const InstanceDesc& d = scene.instances[i];
+            const glm::dvec3 c = rotationDeg(d.rotationDeg) * (double(d.scale) * centre[d.species]) + d.position;
+            instanceLevel[i] = pruneLevelFor(glm::length(c - origin), pruneStart, levels[d.species]);
+        }
+    }
+
+    // Geometry records: the species (0 .. ns-1), then every pruned level some instance uses.
+    struct Geometry {
+        uint32_t species;
+        int level;
+        PrunedLevel pruned;   // level > 0
+        Bvh bvh;
+        size_t triangles = 0;
+    };
+    std::vector<Geometry> geos(ns);
+    std::vector<std::array<uint32_t, kMaxPruneLevels>> geometryOf(ns);
+    for (size_t s = 0; s < ns; ++s) {
+        geos[s].species = uint32_t(s);
+        geos[s].level = 0;
+        geometryOf[s].fill(kNoHit);
+        geometryOf[s][0] = uint32_t(s);
+    }
+    for (size_t i = 0; i < ni; ++i) {
+        const uint32_t sp = scene.instances[i].species;
+        const int level = instanceLevel[i];
+        if (geometryOf[sp][size_t(level)] != kNoHit) continue;
+        geometryOf[sp][size_t(level)] = uint32_t(geos.size());
+        geos.push_back(Geometry{sp, level, {}, {}, 0});
+    }
+
+    // Bottom level: one BVH per geometry record, built in parallel.
+    tbb::parallel_for(size_t(0), geos.size(), [&](size_t g) {
+        Geometry& geo = geos[g];
+        const TriangleMesh& m = assets[geo.species].mesh;
+        std::vector<Bounds3> boxes;
+        if (geo.level == 0) {
+            boxes.resize(m.triangles.size());
+            for (size_t t = 0; t < boxes.size(); ++t)
+                for (int c = 0; c < 3; ++c) boxes[t].extend(m.positions[m.triangles[t][c]]);
+        } else {
+            geo.pruned = buildPrunedLevel(m, leaves[geo.species], orders[geo.species], geo.level);
+            boxes.resize(geo.pruned.tris.size());
+            for (size_t t = 0; t < boxes.size(); ++t)
+                for (int c = 0; c < 3; ++c) boxes[t].extend(geo.pruned.corners[3 * t + size_t(c)]);
+        }
+        geo.triangles = boxes.size();
         BvhBuildSettings bs;
         bs.maxLeafSize = 4;
         bs.leafBlock = 4;   // leaves are tested as one 4-wide block
-        blas[s] = buildBvh(boxes, bs);
+        geo.bvh = buildBvh(boxes, bs);
     });
     if (progress) progress->report(0.7, "species BVHs built");
 
-    std::vector<Bounds3> speciesBounds(ns);
+    // Triangles of a geometry record in BVH order, then its leaves as 4-wide blocks. corner(prim, c)
+    // is the species-frame position of corner c of BVH primitive prim, meshTri(prim) its mesh triangle.
+    std::vector<uint32_t> triBase(ns);
+    auto appendTriangles = [&rs](SpeciesRecord& sr, const Bvh& bvh, uint32_t base, auto corner, auto meshTri) {
+        sr.nodeOffset = uint32_t(rs.blasNodes.size());
+        sr.triOffset = uint32_t(rs.tris.size());
+        rs.blasNodes.insert(rs.blasNodes.end(), bvh.nodes.begin(), bvh.nodes.end());
+        for (uint32_t prim : bvh.primOrder) {
+            const glm::vec3 v0 = corner(prim, 0);
+            TriAccel ta{};
+            ta.v0 = v0;
+            ta.e1 = corner(prim, 1) - v0;
+            ta.e2 = corner(prim, 2) - v0;
+            ta.tri = base + meshTri(prim);
+            const MaterialRecord& mr = rs.materials[rs.triMaterial[ta.tri]];
+            ta.alpha = mr.alphaMask >= 0 ? uint32_t(mr.alphaMask) + 1u : 0u;
+            rs.tris.push_back(ta);
+        }
+        // BVH leaves become 4-wide triangle blocks: leaf children then index blocks, not slots.
+        sr.blockOffset = uint32_t(rs.blocks.size());
+        for (size_t ni2 = sr.nodeOffset; ni2 < rs.blasNodes.size(); ++ni2) {
+            BvhNode& node = rs.blasNodes[ni2];
+            for (int k = 0; k < 4; ++k) {
+                if (node.count[k] == 0 || node.child[k] == kNoHit) continue;
+                if (node.count[k] > 4) throw Error("render: a BVH leaf holds more than four triangles");
+                TriBlock blk{};
+                for (uint32_t l = 0; l < node.count[k]; ++l) {
+                    const TriAccel& t = rs.tris[sr.triOffset + node.child[k] + l];
+                    blk.v0x[l] = t.v0.x, blk.v0y[l] = t.v0.y, blk.v0z[l] = t.v0.z;
+                    blk.e1x[l] = t.e1.x, blk.e1y[l] = t.e1.y, blk.e1z[l] = t.e1.z;
+                    blk.e2x[l] = t.e2.x, blk.e2y[l] = t.e2.y, blk.e2z[l] = t.e2.z;
+                    blk.tri[l] = t.tri;
+                    blk.alpha[l] = t.alpha;
+                }
+                node.child[k] = uint32_t(rs.blocks.size() - sr.blockOffset);
+                rs.blocks.push_back(blk);
+            }
+        }
+    };
+
     for (size_t s = 0; s < ns; ++s) {
         const SpeciesAssets& a = assets[s];
         const TriangleMesh& m = a.mesh;
-        if (m.triangles.empty()) throw Error("render: species '" + scene.species[s].name + "' has no triangles");
         const uint32_t vertBase = uint32_t(rs.normals.size());
-        const uint32_t triBase = uint32_t(rs.triVerts.size());
         const uint32_t matBase = uint32_t(rs.materials.size());
-        speciesBounds[s] = blas[s].bounds;
+        triBase[s] = uint32_t(rs.triVerts.size());
 
         // Shading arrays (normals: given, else from the faces).
         std::vector<glm::vec3> normals = m.normals;
@@ -181,42 +280,9 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
 
         // Triangles in BVH order.
         SpeciesRecord sr{};
-        sr.nodeOffset = uint32_t(rs.blasNodes.size());
-        sr.triOffset = uint32_t(rs.tris.size());
-        rs.blasNodes.insert(rs.blasNodes.end(), blas[s].nodes.begin(), blas[s].nodes.end());
-        for (uint32_t t : blas[s].primOrder) {
-            const glm::uvec3 tri = m.triangles[t];
-            const glm::vec3 v0 = m.positions[tri.x];
-            TriAccel ta{};
-            ta.v0 = v0;
-            ta.e1 = m.positions[tri.y] - v0;
-            ta.e2 = m.positions[tri.z] - v0;
-            ta.tri = triBase + t;
-            const MaterialRecord& mr = rs.materials[rs.triMaterial[triBase + t]];
-            ta.alpha = mr.alphaMask >= 0 ? uint32_t(mr.alphaMask) + 1u : 0u;
-            rs.tris.push_back(ta);
-        }
-
-        // BVH leaves become 4-wide triangle blocks: leaf children then index blocks, not slots.
-        sr.blockOffset = uint32_t(rs.blocks.size());
-        for (size_t ni = sr.nodeOffset; ni < rs.blasNodes.size(); ++ni) {
-            BvhNode& node = rs.blasNodes[ni];
-            for (int k = 0; k < 4; ++k) {
-                if (node.count[k] == 0 || node.child[k] == kNoHit) continue;
-                if (node.count[k] > 4) throw Error("render: a BVH leaf holds more than four triangles");
-                TriBlock blk{};
-                for (uint32_t l = 0; l < node.count[k]; ++l) {
-                    const TriAccel& t = rs.tris[sr.triOffset + node.child[k] + l];
-                    blk.v0x[l] = t.v0.x, blk.v0y[l] = t.v0.y, blk.v0z[l] = t.v0.z;
-                    blk.e1x[l] = t.e1.x, blk.e1y[l] = t.e1.y, blk.e1z[l] = t.e1.z;
-                    blk.e2x[l] = t.e2.x, blk.e2y[l] = t.e2.y, blk.e2z[l] = t.e2.z;
-                    blk.tri[l] = t.tri;
-                    blk.alpha[l] = t.alpha;
-                }
-                node.child[k] = uint32_t(rs.blocks.size() - sr.blockOffset);
-                rs.blocks.push_back(blk);
-            }
-        }
+        appendTriangles(
+            sr, geos[s].bvh, triBase[s], [&m](uint32_t prim, int c) { return m.positions[m.triangles[prim][c]]; },
+            [](uint32_t prim) { return prim; });
 
         // Lighting grid, normalized by the unobstructed photon density.
         const LightingGrid& g = a.lighting;
@@ -233,18 +299,32 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         }
         rs.species.push_back(sr);
         rs.m_stats.speciesTriangles += m.triangles.size();
-        rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, blas[s].depth);
+        rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, geos[s].bvh.depth);
     }
 
+    // Pruned levels: own triangles and BVH, the species' shading data and lighting grid.
+    const size_t nodesBefore = rs.blasNodes.size(), trisBefore = rs.tris.size(), blocksBefore = rs.blocks.size();
+    for (size_t gi = ns; gi < geos.size(); ++gi) {
+        const Geometry& geo = geos[gi];
+        SpeciesRecord sr = rs.species[geo.species];
+        const PrunedLevel& p = geo.pruned;
+        appendTriangles(
+            sr, geo.bvh, triBase[geo.species], [&p](uint32_t prim, int c) { return p.corners[3 * size_t(prim) + size_t(c)]; },
+            [&p](uint32_t prim) { return p.tris[prim]; });
+        rs.species.push_back(sr);
+        rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, geo.bvh.depth);
+    }
+    rs.m_stats.prunedLevels = geos.size() - ns;
+
     // Top level over the instances' camera-relative boxes.
-    const glm::dvec3 origin = scene.camera.position;
-    rs.instances.reserve(scene.instances.size());
-    std::vector<Bounds3> boxes(scene.instances.size());
-    for (size_t i = 0; i < scene.instances.size(); ++i) {
+    rs.instances.reserve(ni);
+    std::vector<Bounds3> boxes(ni);
+    for (size_t i = 0; i < ni; ++i) {
         const InstanceDesc& d = scene.instances[i];
-        if (d.species >= ns) throw Error("render: instance " + std::to_string(i) + " names a missing species");
-        rs.instances.push_back(makeInstance(d, origin));
-        const Bounds3& lb = speciesBounds[d.species];
+        InstanceRecord rec = makeInstance(d, origin);
+        rec.geometry = geometryOf[d.species][size_t(instanceLevel[i])];
+        rs.instances.push_back(rec);
+        const Bounds3& lb = geos[rec.geometry].bvh.bounds;
         const glm::dmat3 r = rotationDeg(d.rotationDeg) * double(d.scale);
         for (int c = 0; c < 8; ++c) {
             const glm::dvec3 corner((c & 1) ? lb.hi.x : lb.lo.x, (c & 2) ? lb.hi.y : lb.lo.y, (c & 4) ? lb.hi.z : lb.lo.z);
@@ -254,16 +334,17 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         const glm::vec3 pad = 1e-5f * (glm::abs(boxes[i].lo) + glm::abs(boxes[i].hi)) + 1e-6f;
         boxes[i].lo -= pad;
         boxes[i].hi += pad;
-        rs.m_stats.instancedTriangles += double(assets[d.species].mesh.triangles.size());
+        rs.m_stats.instancedTriangles += double(geos[rec.geometry].triangles);
+        ++rs.m_stats.instancesPerLevel[size_t(instanceLevel[i])];
     }
     if (scene.render.accel == AccelKind::KdTree) {
         // The seed's structure at both levels. Species trees index triangles by BVH slot (the order
         // of rs.tris) and clip them to the split boxes ("perfect splits").
         rs.m_stats.maxBlasDepth = 0;
-        std::vector<KdTree> kd(ns);
-        tbb::parallel_for(size_t(0), ns, [&](size_t s) {
-            const TriAccel* tris = rs.tris.data() + rs.species[s].triOffset;
-            const size_t n = assets[s].mesh.triangles.size();
+        std::vector<KdTree> kd(geos.size());
+        tbb::parallel_for(size_t(0), geos.size(), [&](size_t g) {
+            const TriAccel* tris = rs.tris.data() + rs.species[g].triOffset;
+            const size_t n = geos[g].triangles;
             std::vector<Bounds3> triBoxes(n);
             for (size_t t = 0; t < n; ++t) {
                 triBoxes[t].extend(tris[t].v0);
@@ -275,18 +356,18 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
                 const TriAccel& t = tris[prim];
                 return clipTriangleToBox(t.v0, t.v0 + t.e1, t.v0 + t.e2, box);
             };
-            kd[s] = buildKdTree(triBoxes, ks);
+            kd[g] = buildKdTree(triBoxes, ks);
         });
-        for (size_t s = 0; s < ns; ++s) {
+        for (size_t g = 0; g < geos.size(); ++g) {
             KdSpeciesRecord r{};
-            r.lo = kd[s].bounds.lo;
-            r.hi = kd[s].bounds.hi;
+            r.lo = kd[g].bounds.lo;
+            r.hi = kd[g].bounds.hi;
             r.nodeOffset = uint32_t(rs.kdBlasNodes.size());
             r.refOffset = uint32_t(rs.kdBlasRefs.size());
-            rs.kdBlasNodes.insert(rs.kdBlasNodes.end(), kd[s].nodes.begin(), kd[s].nodes.end());
-            rs.kdBlasRefs.insert(rs.kdBlasRefs.end(), kd[s].primRefs.begin(), kd[s].primRefs.end());
+            rs.kdBlasNodes.insert(rs.kdBlasNodes.end(), kd[g].nodes.begin(), kd[g].nodes.end());
+            rs.kdBlasRefs.insert(rs.kdBlasRefs.end(), kd[g].primRefs.begin(), kd[g].primRefs.end());
             rs.kdSpecies.push_back(r);
-            rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, kd[s].stats.depth);
+            rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, kd[g].stats.depth);
         }
         KdTree top = buildKdTree(boxes);
         rs.kdTlasNodes = std::move(top.nodes);
@@ -319,6 +400,7 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
     b.accel = scene.render.accel;
     b.shadows = scene.render.shadows;
     b.indirectScale = scene.render.indirectScale;
+    b.alphaDistance = scene.render.alphaDistance;
 
     AccelStats& st = rs.m_stats;
     if (scene.render.accel == AccelKind::KdTree) {
@@ -332,6 +414,8 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
     st.instanceBytes = rs.instances.size() * sizeof(InstanceRecord);
     st.triangleBytes = scene.render.accel == AccelKind::KdTree ? rs.tris.size() * sizeof(TriAccel)
                                                                : rs.blocks.size() * sizeof(TriBlock);
+    st.pruneBytes = (rs.blasNodes.size() - nodesBefore) * sizeof(BvhNode) + (rs.tris.size() - trisBefore) * sizeof(TriAccel) +
+                    (rs.blocks.size() - blocksBefore) * sizeof(TriBlock);
     st.instances = rs.instances.size();
     if (progress) progress->report(1.0, "acceleration structures built");
     return rs;

@@ -8,6 +8,7 @@
 #include "core/grid/grid.h"
 #include "core/image/image.h"
 #include "core/mesh/triangle_mesh.h"
+#include "core/render/prune.h"
 #include "core/render/render_view.h"
 #include "core/scene/scene.h"
 
@@ -26,8 +27,11 @@ struct SpeciesAssets {
 struct AccelStats {
     size_t tlasBytes = 0, instanceBytes = 0, blasBytes = 0, triangleBytes = 0;   // the structures the run traverses
     size_t instances = 0, speciesTriangles = 0;
-    double instancedTriangles = 0.0;
+    double instancedTriangles = 0.0;     // triangles the instances trace (pruned levels count their own)
     int tlasDepth = 0, maxBlasDepth = 0;
+    size_t prunedLevels = 0;             // pruned levels of detail built (only those some instance uses)
+    size_t pruneBytes = 0;               // their BVH nodes, triangles and blocks (included in the sizes above)
+    size_t instancesPerLevel[kMaxPruneLevels] = {};   // instances per level of detail, 0 = full
 };
 
 // Owns the flat arrays; view() points into them (valid while this object lives and is not modified).
@@ -66,6 +70,9 @@ public:
 // parallel), one over the instances in the
 // camera-relative frame (world minus the camera position, computed in double: precision does not
 // depend on the distance from the world origin). assets[i] belongs to scene.species[i].
+// With render.pruneDistance > 0 each instance gets the level of detail of its distance to the camera
+// (core/render/prune.h) and every level in use gets its own BVH (kd-tree), after the species' records;
+// render.alphaDistance goes to RenderView::alphaDistance.
 // sunRadiance is the sun's linear RGB (colour x intensity). Throws Error on inconsistent input.
 RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
                              Progress* progress = nullptr);

@@ -38,13 +38,17 @@ static_assert(sizeof(TriBlock) == 192);
 // (rotation and uniform scale only, so normals map back with the transpose). 64 bytes.
 struct InstanceRecord {
     glm::vec4 row[3];        // local = row[i].xyz . world + row[i].w
-    uint32_t species;
+    uint32_t species;        // shading: materials, lighting grid (RenderView::species[species])
     float scale;             // world metres per species metre
-    uint32_t pad[2];
+    uint32_t geometry;       // the triangles traced: RenderView::species[geometry] (kdSpecies[geometry]) is the
+                             // species itself or one of its pruned levels of detail
+    uint32_t pad;
 };
 static_assert(sizeof(InstanceRecord) == 64);
 
 // Per species: where its BVH nodes and triangles start in the flat arrays, its lighting grid. 48 bytes.
+// Records 0 .. species-1 are the species; the records after them are pruned levels of detail of a
+// species (own BVH and triangles, the species' lighting grid), reached only through InstanceRecord::geometry.
 struct SpeciesRecord {
     uint32_t nodeOffset;     // into RenderView::blasNodes (leaves index blocks of RenderView::blocks)
     uint32_t triOffset;      // into RenderView::tris (BVH slot order; kd-tree runs and tests)
@@ -144,6 +148,8 @@ struct RenderView {
     AccelKind accel;
     bool shadows;
     float indirectScale;
+    float alphaDistance;             // adaptive transparency: alpha tests only within this distance of the camera
+                                     // (metres, camera-relative frame); 0 = everywhere
 };
 
 } // namespace sylva

@@ -28,14 +28,30 @@ SYLVA_HD SYLVA_INLINE glm::vec2 triangleUv(const RenderView& v, uint32_t tri, fl
     return (1.0f - u - w) * v.uvs[t.x] + u * v.uvs[t.y] + w * v.uvs[t.z];
 }
 
+// tAlpha of a ray that tests every cut-out (adaptive transparency off).
+inline constexpr float kAlphaEverywhere = 3.0e38f;
+
+// Adaptive transparency (seed 000 section 2.1, Dietrich et al.): beyond v.alphaDistance from the camera
+// leaf cards count as opaque. In the camera-relative frame a ray point's distance from the camera is at
+// most |org| + t |dir|, so cut-outs are honoured for t < tAlpha = (D - |org|) / |dir| only: exactly the
+// points within D on camera rays (org = 0); on shadow rays those surely within D (from a point beyond D,
+// none). t is the same in every instance's frame, so one threshold per ray serves both levels.
+SYLVA_HD SYLVA_INLINE float alphaTestLimit(const RenderView& v, const Ray& ray)
+{
+    if (!(v.alphaDistance > 0.0f)) return kAlphaEverywhere;
+    return (v.alphaDistance - glm::length(ray.org)) / glm::length(ray.dir);
+}
+
 // Tests triangle `slot` of a species in its frame; alpha-tested triangles let the ray through where
-// the cut-out is transparent. Returns true on an accepted hit closer than tmax (then tmax = t).
+// the cut-out is transparent, for t < tAlpha (beyond it they are opaque). Returns true on an accepted
+// hit closer than tmax (then tmax = t).
 SYLVA_HD SYLVA_INLINE bool hitTriangle(const RenderView& v, const TriAccel& tri, const glm::vec3& org,
-                                       const glm::vec3& dir, float tmin, float& tmax, float& u, float& w)
+                                       const glm::vec3& dir, float tmin, float& tmax, float& u, float& w,
+                                       float tAlpha = kAlphaEverywhere)
 {
     float t, uu, ww;
     if (!intersectTriangle(org, dir, tri.v0, tri.e1, tri.e2, tmin, tmax, t, uu, ww)) return false;
-    if (tri.alpha != 0u && !alphaOpaque(v, tri.alpha - 1u, triangleUv(v, tri.tri, uu, ww))) return false;
+    if (tri.alpha != 0u && t < tAlpha && !alphaOpaque(v, tri.alpha - 1u, triangleUv(v, tri.tri, uu, ww))) return false;
     tmax = t;
     u = uu;
     w = ww;
@@ -43,11 +59,12 @@ SYLVA_HD SYLVA_INLINE bool hitTriangle(const RenderView& v, const TriAccel& tri,
 }
 
 // Tests the first `count` triangles of a block (one SIMD pass on the host); the accepted hit
-// (alpha cut-outs pass the ray through) closest and below tmax wins: tmax, u, w, tri are set.
-// AnyHit returns at the first accepted hit. Returns true when a hit was accepted.
+// (alpha cut-outs pass the ray through for t < tAlpha) closest and below tmax wins: tmax, u, w, tri
+// are set. AnyHit returns at the first accepted hit. Returns true when a hit was accepted.
 template <bool AnyHit>
 SYLVA_HD inline bool hitBlock(const RenderView& v, const TriBlock& b, uint32_t count, const glm::vec3& org,
-                              const glm::vec3& dir, float tmin, float& tmax, float& u, float& w, uint32_t& tri)
+                              const glm::vec3& dir, float tmin, float& tmax, float& u, float& w, uint32_t& tri,
+                              float tAlpha = kAlphaEverywhere)
 {
     float tt[4], uu[4], vv[4];
     bool ok[4];
@@ -85,7 +102,8 @@ SYLVA_HD inline bool hitBlock(const RenderView& v, const TriBlock& b, uint32_t c
     bool found = false;
     for (int k = 0; k < 4; ++k) {
         if (!ok[k] || !(tt[k] < tmax)) continue;
-        if (b.alpha[k] != 0u && !alphaOpaque(v, b.alpha[k] - 1u, triangleUv(v, b.tri[k], uu[k], vv[k]))) continue;
+        if (b.alpha[k] != 0u && tt[k] < tAlpha && !alphaOpaque(v, b.alpha[k] - 1u, triangleUv(v, b.tri[k], uu[k], vv[k])))
+            continue;
         tmax = tt[k];
         u = uu[k];
         w = vv[k];
@@ -115,13 +133,15 @@ SYLVA_HD SYLVA_INLINE glm::vec3 toWorldNormal(const InstanceRecord& in, const gl
 
 // Closest hit along the ray (camera-relative world frame) over instances and the ground, through
 // the BVHs (Kd = false) or the kd-trees (Kd = true) at both levels. AnyHit stops at the first
-// accepted hit (shadow rays). Returns true on a hit.
+// accepted hit (shadow rays). An instance is traced with its geometry record (the species or a pruned
+// level of it); cut-outs are tested up to alphaTestLimit. Returns true on a hit.
 template <bool AnyHit, bool Kd>
 SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hit)
 {
     hit.prim = kNoHit;
     hit.inst = kNoHit;
     float tmax = ray.tmax;
+    const float tAlpha = alphaTestLimit(v, ray);
     if (v.groundEnabled && ray.dir.y != 0.0f) {
         const float tg = (v.groundY - ray.org.y) / ray.dir.y;
         if (tg > ray.tmin && tg < tmax) {
@@ -135,10 +155,11 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
     auto instanceFn = [&](uint32_t inst, float& tlasMax) {
         const InstanceRecord& in = v.instances[inst];
         const glm::vec3 o = toLocalPoint(in, ray.org), d = toLocalDir(in, ray.dir);
-        const TriAccel* tris = v.tris + v.species[in.species].triOffset;
+        const SpeciesRecord& geo = v.species[in.geometry];
+        const TriAccel* tris = v.tris + geo.triOffset;
         auto triFn = [&](uint32_t s, float& blasMax) {
             float u, w;
-            if (!hitTriangle(v, tris[s], o, d, ray.tmin, blasMax, u, w)) return false;
+            if (!hitTriangle(v, tris[s], o, d, ray.tmin, blasMax, u, w, tAlpha)) return false;
             if (!AnyHit) {
                 hit.t = blasMax;
                 hit.u = u;
@@ -149,17 +170,16 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
             return AnyHit;
         };
         if constexpr (Kd) {
-            const KdSpeciesRecord& k = v.kdSpecies[in.species];
+            const KdSpeciesRecord& k = v.kdSpecies[in.geometry];
             const KdView view{v.kdBlasNodes + k.nodeOffset, v.kdBlasRefs + k.refOffset, k.lo, k.hi};
             return traverseKd(view, o, d, ray.tmin, tlasMax, triFn);
         } else {
-            const SpeciesRecord& sp = v.species[in.species];
-            const TriBlock* blocks = v.blocks + sp.blockOffset;
-            return traverseBvh(BvhView{v.blasNodes + sp.nodeOffset}, o, d, ray.tmin, tlasMax,
+            const TriBlock* blocks = v.blocks + geo.blockOffset;
+            return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset}, o, d, ray.tmin, tlasMax,
                                [&](uint32_t block, uint32_t count, float& blasMax) {
                                    float u, w;
                                    uint32_t tri;
-                                   if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, ray.tmin, blasMax, u, w, tri))
+                                   if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, ray.tmin, blasMax, u, w, tri, tAlpha))
                                        return false;
                                    if (!AnyHit) {
                                        hit.t = blasMax;

@@ -73,6 +73,10 @@ struct RenderSettings {
     bool shadows = true;
     float indirectScale = 1.0f;          // weight of the LB indirect light (1 = as solved, normalized to open sky)
     float exposureKey = 0.18f;           // Reinhard key value a
+    float alphaDistance = 0.0f;          // metres; beyond it from the camera leaf cut-outs are not tested
+                                         // (cards count as opaque; seed 000 section 2.1); 0 = off
+    float pruneDistance = 0.0f;          // metres; stochastic pruning of leaves starts there (seed 003): an
+                                         // instance at distance d keeps about start / d of them; 0 = off
 };
 
 struct Scene {

@@ -195,6 +195,8 @@ std::vector<Command> commands()
                      {"--mode", "M", "full (LB indirect + sun), local (sun only), ambient (sun + matched constant), lb"},
                      {"--accel", "bvh|kdtree", "acceleration structure (default: the scene's, bvh)"},
                      {"--no-shadows", "", "no shadow rays"},
+                     {"--alpha-distance", "M", "skip leaf cut-out tests beyond M metres from the camera (0: off, default)"},
+                     {"--prune-distance", "M", "prune leaves of plants beyond M metres, area-preserving (0: off, default)"},
                      {"--backend", "auto|cpu|cuda", "compute backend (default auto)"},
                      {"--stats", "", "print timings and acceleration structure sizes"},
                      kOutput, kCache, kNoCache, kThreads, kQuiet},
@@ -649,6 +651,12 @@ int cmdRender(const Args& args)
     if (args.has("--accel") && !parseAccel(args.get("--accel"), &r.accel))
         throw UsageError("option --accel: expected bvh or kdtree, got '" + args.get("--accel") + "'");
     if (args.has("--no-shadows")) r.shadows = false;
+    for (auto [option, field] : {std::pair{"--alpha-distance", &r.alphaDistance}, std::pair{"--prune-distance", &r.pruneDistance}}) {
+        if (!args.has(option)) continue;
+        const double m = parseNumber(option, args.get(option));
+        if (m < 0.0 || m > 1e30) throw UsageError(std::string("option ") + option + ": expected metres >= 0 (0: off), got " + args.get(option));
+        *field = float(m);
+    }
     const std::string out = args.get("--output", stem + ".png");
     const std::string ext = lowerExtension(out);
     if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff")
@@ -677,6 +685,12 @@ int cmdRender(const Args& args)
                     accelBytes / 1e6, st.tlasBytes, st.instanceBytes, st.blasBytes, st.triangleBytes,
                     accelBytes / std::max(1.0, st.instancedTriangles), double(st.tlasBytes + st.instanceBytes) / double(std::max<size_t>(1, st.instances)),
                     st.tlasDepth, st.maxBlasDepth);
+        if (st.prunedLevels > 0) {
+            std::printf("pruning from %g m: %zu pruned levels built (%.1f MB); instances per level (kept 1, 1/2, 1/4, ...):",
+                        double(r.pruneDistance), st.prunedLevels, double(st.pruneBytes) / 1e6);
+            for (size_t n : st.instancesPerLevel) std::printf(" %zu", n);
+            std::printf("\n");
+        }
         if (r.mode == RenderMode::Ambient) std::printf("ambient constant %.4f\n", ambient);
     }
     return kOk;

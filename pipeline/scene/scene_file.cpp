@@ -10,6 +10,7 @@
 #include <limits>
 #include <string_view>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include <QByteArray>
@@ -604,7 +605,8 @@ private:
     void readRender(const QJsonValue& v, const KeyPath& path, RenderSettings& r) const
     {
         const QJsonObject o = optionalObject(v, path);
-        checkKeys(o, path, {"width", "height", "spp", "mode", "accel", "shadows", "indirect", "key"});
+        checkKeys(o, path, {"width", "height", "spp", "mode", "accel", "shadows", "indirect", "key", "alpha_distance",
+                            "prune_distance"});
         if (o.contains(QLatin1String("width")))
             r.width = int(integer(o.value(QLatin1String("width")), path.field("width"), kMinImageSize, kMaxImageSize));
         if (o.contains(QLatin1String("height")))
@@ -628,6 +630,11 @@ private:
         if (o.contains(QLatin1String("key"))) {
             r.exposureKey = floatNumber(o.value(QLatin1String("key")), path.field("key"));
             if (!(r.exposureKey > 0.0f)) fail(path.field("key"), "must be > 0, got " + fmt(r.exposureKey));
+        }
+        for (auto [key, field] : {std::pair{"alpha_distance", &r.alphaDistance}, std::pair{"prune_distance", &r.pruneDistance}}) {
+            if (!o.contains(QLatin1String(key))) continue;
+            *field = floatNumber(o.value(QLatin1String(key)), path.field(key));
+            if (*field < 0.0f) fail(path.field(key), "must be >= 0 (metres; 0 = off), got " + fmt(*field));
         }
     }
 
@@ -976,6 +983,12 @@ std::string sceneToJson(const Scene& scene, const std::string& baseDir)
     out.raw(", ");
     out.key("key");
     out.number(r.exposureKey, rp.field("key"));
+    out.raw(", ");
+    out.key("alpha_distance");
+    out.number(r.alphaDistance, rp.field("alpha_distance"));
+    out.raw(", ");
+    out.key("prune_distance");
+    out.number(r.pruneDistance, rp.field("prune_distance"));
     out.raw("}\n}\n");
     return std::move(out.text);
 }
@@ -1082,7 +1095,10 @@ std::string describeScene(const Scene& scene)
     const RenderSettings& r = scene.render;
     s += "render: " + std::to_string(r.width) + "x" + std::to_string(r.height) + ", " + std::to_string(r.spp) + " spp, mode " +
          renderModeName(r.mode) + ", " + accelName(r.accel) + ", shadows " + (r.shadows ? "on" : "off") + ", indirect " +
-         human(r.indirectScale) + ", key " + human(r.exposureKey) + "\n";
+         human(r.indirectScale) + ", key " + human(r.exposureKey);
+    if (r.alphaDistance > 0.0f) s += ", alpha tests within " + human(r.alphaDistance) + " m";
+    if (r.pruneDistance > 0.0f) s += ", leaves pruned from " + human(r.pruneDistance) + " m";
+    s += "\n";
     return s;
 }
 

@@ -120,6 +120,8 @@ void compareScenes(const Scene& a, const Scene& b)
     QCOMPARE(a.render.shadows, b.render.shadows);
     QCOMPARE(a.render.indirectScale, b.render.indirectScale);
     QCOMPARE(a.render.exposureKey, b.render.exposureKey);
+    QCOMPARE(a.render.alphaDistance, b.render.alphaDistance);
+    QCOMPARE(a.render.pruneDistance, b.render.pruneDistance);
 }
 
 // Sets (or, with an undefined value, removes) the value at PATH ("instances", "0", "scale": keys and
@@ -228,7 +230,7 @@ Scene fullScene(const QString& sceneDir)
     s.sun = {{-0.2f, 0.9f, 0.1f}, 5200.5, 3.25f};
     s.sky = {0.1f, 0.2f, 1.7f};
     s.camera = {{10.5, 3.25, -40.0}, {1.0, 4.0, 2.0}, {0.0f, 1.0f, 0.1f}, 33.3f};
-    s.render = {1920, 1080, 64, RenderMode::Lb, AccelKind::KdTree, false, 0.75f, 0.3f};
+    s.render = {1920, 1080, 64, RenderMode::Lb, AccelKind::KdTree, false, 0.75f, 0.3f, 87.5f, 33.25f};
     return s;
 }
 
@@ -456,6 +458,9 @@ private Q_SLOTS:
         QTest::newRow("shadows type") << with({"render", "shadows"}, "yes") << "render.shadows: expected true or false, got a string";
         QTest::newRow("key zero") << with({"render", "key"}, 0) << "render.key: must be > 0";
         QTest::newRow("indirect negative") << with({"render", "indirect"}, -0.5) << "render.indirect: must be >= 0";
+        QTest::newRow("alpha distance negative") << with({"render", "alpha_distance"}, -1) << "render.alpha_distance: must be >= 0";
+        QTest::newRow("prune distance type") << with({"render", "prune_distance"}, "far") << "render.prune_distance: expected a number";
+        QTest::newRow("prune distance huge") << with({"render", "prune_distance"}, 1e300) << "render.prune_distance:";
         QTest::newRow("fov 180") << with({"camera", "fov"}, 180) << "camera.fov: must lie in (0, 180) degrees, got 180";
         QTest::newRow("fov 0") << with({"camera", "fov"}, 0) << "camera.fov: must lie in (0, 180)";
         QTest::newRow("camera same point") << with({"camera", "target"}, QJsonArray{0, 2, -20}) << "camera.target: must differ from camera.position";
