@@ -50,6 +50,9 @@ Viewport::~Viewport()
     // Stop the worker before the GL context goes (it only emits queued images, but be tidy).
     delete m_worker;
     m_worker = nullptr;
+    // ~QOpenGLWidget destroys the context after this object's members are gone: the context's
+    // aboutToBeDestroyed must not reach cleanupGL then (it would touch the destroyed m_quad).
+    if (context()) disconnect(context(), &QOpenGLContext::aboutToBeDestroyed, this, &Viewport::cleanupGL);
     makeCurrent();
     cleanupGL();
     doneCurrent();
