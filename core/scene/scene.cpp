@@ -5,6 +5,14 @@
 
 namespace sylva {
 
+lb::LbParams defaultSpeciesLighting(const lb::Preset& preset)
+{
+    lb::LbParams p = lb::paramsFromPreset(preset);
+    p.steps = 0;
+    p.tolerance = kDefaultLightingTolerance;
+    return p;
+}
+
 const char* renderModeName(RenderMode mode)
 {
     switch (mode) {

@@ -20,6 +20,13 @@ struct GrowSpec {
     float height = 0.0f;                 // metres; 0 = the grower's default for the species
 };
 
+// The LB solve of a species unless its scene says otherwise (docs/ACCURACY.md): the preset's optics,
+// solved until the relative change per step falls under this tolerance. On the measured fronts it is
+// as accurate as the seed's fixed 2 x longest edge steps (the LB's transport error dwarfs the
+// difference) at about half the time.
+inline constexpr double kDefaultLightingTolerance = 1e-3;
+lb::LbParams defaultSpeciesLighting(const lb::Preset& preset);
+
 // One plant model shared by all its instances. Its lighting grid is solved once, in its own frame.
 struct SpeciesDesc {
     std::string name;                    // unique within the scene; instances refer to it
@@ -27,7 +34,8 @@ struct SpeciesDesc {
     std::optional<GrowSpec> grow;        // set when the mesh is grown instead of read
     std::vector<std::string> leafMaterials;   // importer override: material names that are leaves
     std::string preset = "leaf";         // LB preset the lighting starts from
-    lb::LbParams lighting;               // preset + overrides (sun is set from the scene's sun at solve time)
+    lb::LbParams lighting;               // preset + overrides (sun is set from the scene's sun at solve time);
+                                         // scene files start from defaultSpeciesLighting
     int grid = 64;                       // LB grid nodes along the longest edge
 };
 

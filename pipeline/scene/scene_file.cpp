@@ -462,7 +462,7 @@ private:
             for (const auto& p : lb::presets()) names.push_back(p.name);
             fail(path.field("preset"), "unknown preset '" + d.preset + "' (known: " + nameList(names) + ")");
         }
-        lb::LbParams params = lb::paramsFromPreset(*preset);
+        lb::LbParams params = defaultSpeciesLighting(*preset);
         auto applyOverride = [&](const char* key, float lb::ChannelParams::*member) {
             const QJsonValue value = o.value(QLatin1String(key));
             if (value.isUndefined()) return;
@@ -477,7 +477,11 @@ private:
         const QJsonValue grid = o.value(QLatin1String("grid"));
         if (!grid.isUndefined()) d.grid = int(integer(grid, path.field("grid"), kMinGrid, kMaxGrid));
         const QJsonValue steps = o.value(QLatin1String("steps"));
-        if (!steps.isUndefined()) params.steps = int(integer(steps, path.field("steps"), 0, kMaxSteps));
+        if (!steps.isUndefined()) {
+            // A step count (0: the seed's 2 x the longest edge) asks for fixed steps, not the default tolerance.
+            params.steps = int(integer(steps, path.field("steps"), 0, kMaxSteps));
+            params.tolerance = 0.0;
+        }
         const QJsonValue tolerance = o.value(QLatin1String("tolerance"));
         if (!tolerance.isUndefined()) {
             params.tolerance = number(tolerance, path.field("tolerance"));

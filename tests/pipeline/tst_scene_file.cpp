@@ -310,7 +310,8 @@ private Q_SLOTS:
         QVERIFY(s.species[0].leafMaterials.empty());
         QCOMPARE(s.species[0].preset, defaultSpecies.preset);
         QCOMPARE(s.species[0].grid, defaultSpecies.grid);
-        compareLb(s.species[0].lighting, lb::paramsFromPreset(*lb::findPreset("leaf")));
+        compareLb(s.species[0].lighting, defaultSpeciesLighting(*lb::findPreset("leaf")));
+        QCOMPARE(s.species[0].lighting.tolerance, kDefaultLightingTolerance);
         QVERIFY(s.species[1].meshPath.empty());
         QVERIFY(s.species[1].grow);
         const GrowSpec g;
@@ -327,6 +328,24 @@ private Q_SLOTS:
         expected.species = s.species;
         expected.instances = s.instances;
         compareScenes(s, expected);   // ground, sun, sky, camera, render: all defaults
+    }
+
+    // The default solve is the tolerance kDefaultLightingTolerance; a step count (even 0, the seed's
+    // 2 x longest edge) asks for fixed steps; an explicit tolerance wins over the default.
+    void lightingStepsAndTolerance()
+    {
+        auto lighting = [&](const char* json) {
+            const std::string text = std::string(R"({"version": 1, "species": [{"name": "b", "grow": {}, "lighting": )") + json +
+                                     R"(}], "instances": [{"species": "b", "position": [0, 0, 0]}]})";
+            return parseScene(text, dir().toStdString(), kName).species[0].lighting;
+        };
+        QCOMPARE(lighting("{}").tolerance, kDefaultLightingTolerance);
+        QCOMPARE(lighting("{}").steps, 0);
+        QCOMPARE(lighting(R"({"steps": 0})").tolerance, 0.0);
+        QCOMPARE(lighting(R"({"steps": 200})").steps, 200);
+        QCOMPARE(lighting(R"({"steps": 200})").tolerance, 0.0);
+        QCOMPARE(lighting(R"({"tolerance": 0})").tolerance, 0.0);
+        QCOMPARE(lighting(R"({"tolerance": 1e-4})").tolerance, 1e-4);
     }
 
     void optionalForms()
