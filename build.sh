@@ -15,7 +15,9 @@ PACKAGES=(cmake ninja-build ccache g++ pkg-config
   libassimp-dev libopenmesh-dev libopenimageio-dev openimageio-tools libopencv-core-dev
   libglm-dev libtbb-dev libembree-dev
   # sylva-studio's GL tests run under Xvfb with Mesa's software OpenGL
-  qt6-qpa-plugins xvfb xauth libgl1-mesa-dri)
+  qt6-qpa-plugins xvfb xauth libgl1-mesa-dri
+  # sylva study draws the plots of docs/ACCURACY.md
+  gnuplot-nox)
 
 install_missing() {
   local missing=()

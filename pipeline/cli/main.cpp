@@ -1,4 +1,4 @@
-// sylva: the command line (grow, voxelize, light, info). Exit codes: 0 ok, 1 bad input or failure, 2 bad usage.
+// sylva: the command line (grow, voxelize, light, reference, render, study, info). Exit codes: 0 ok, 1 bad input or failure, 2 bad usage.
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -30,6 +30,7 @@
 #include "pipeline/lighting_job.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
+#include "pipeline/study/study.h"
 
 namespace fs = std::filesystem;
 using namespace sylva;
@@ -201,6 +202,13 @@ std::vector<Command> commands()
                      {"--stats", "", "print timings and acceleration structure sizes"},
                      kOutput, kCache, kNoCache, kThreads, kQuiet},
                     0, 1});
+    list.push_back({"study", "lb|voxel|render|all|report [--out DIR] [--quick]",
+                    "measure speed against accuracy; regenerate ACCURACY.md with tables and plots (report: from stored numbers)",
+                    {{"--out", "DIR", "folder of ACCURACY.md; plots and numbers go to DIR/accuracy (default docs)"},
+                     {"--quick", "", "small grids, fewer paths and samples: a few minutes"},
+                     {"--tree", "MESH", "the real tree (default ../shared/data/trees/quaternius/OBJ/Tree_1.obj)"},
+                     kCache, kNoCache, kThreads, kQuiet},
+                    1, 1});
     list.push_back({"info", "FILE", "print what a scene (.json), mesh, grid (.npy) or cache file holds", {}, 1, 1});
     return list;
 }
@@ -696,6 +704,33 @@ int cmdRender(const Args& args)
     return kOk;
 }
 
+int cmdStudy(const Args& args)
+{
+    auto threads = threadLimit(args);
+    study::Options o;
+    const std::string what = args.positional()[0];
+    if (what == "all") {
+        o.parts = {study::Part::Lb, study::Part::Voxel, study::Part::Render};
+    } else if (what != "report") {
+        study::Part part;
+        if (!study::parsePart(what, &part)) throw UsageError("expected lb, voxel, render, all or report, got '" + what + "'");
+        o.parts = {part};
+    }
+    o.outDir = args.get("--out", "docs");
+    o.quick = args.has("--quick");
+    o.treeMesh = args.get("--tree");
+    auto cache = openCache(args);
+    o.cache = cache.get();
+    const bool quiet = args.has("--quiet");
+    o.log = [quiet](const std::string& line) {
+        if (!quiet) std::fprintf(stderr, "%s\n", line.c_str());
+    };
+    const study::Result r = study::run(o);
+    std::printf("wrote %s and %zu plots in %.0f s\n", r.markdown.c_str(), r.plots.size(), r.seconds);
+    if (!r.plotNote.empty()) std::printf("plots skipped: %s\n", r.plotNote.c_str());
+    return kOk;
+}
+
 int cmdInfo(const Args& args)
 {
     const std::string path = args.positional()[0];
@@ -783,6 +818,7 @@ int main(int argc, char** argv)
         if (cmd->name == "light") return cmdLight(args);
         if (cmd->name == "reference") return cmdReference(args);
         if (cmd->name == "render") return cmdRender(args);
+        if (cmd->name == "study") return cmdStudy(args);
         if (cmd->name == "info") return cmdInfo(args);
     } catch (const UsageError& e) {
         std::fprintf(stderr, "sylva %s: %s\n", cmd->name.c_str(), e.what());
