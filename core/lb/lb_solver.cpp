@@ -21,6 +21,7 @@
 #define SYLVA_LB_F16C 1
 #endif
 
+#include "core/base/memory.h"
 #include "core/base/error.h"
 #include "core/base/half.h"
 #include "core/lb/lb_node.h"
@@ -373,19 +374,6 @@ private:
     std::vector<double> m_rowDiff, m_rowNorm;
     tbb::enumerable_thread_specific<Scratch> m_scratch;
 };
-
-// MemAvailable from /proc/meminfo in bytes, 0 when unknown.
-double availableMemoryBytes()
-{
-    std::FILE* f = std::fopen("/proc/meminfo", "r");
-    if (!f) return 0.0;
-    char line[256];
-    double kb = 0.0;
-    while (std::fgets(line, sizeof line, f))
-        if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
-    std::fclose(f);
-    return kb * 1024.0;
-}
 
 // Coarse start: a grid of half the resolution whose node I sits on fine node 2I (the last one may
 // lie past the fine edge). Density is the full-weighting average of the fine nodes around 2I,

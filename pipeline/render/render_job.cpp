@@ -8,6 +8,7 @@
 
 #include <QFile>
 
+#include "core/base/memory.h"
 #include "core/backend/backend.h"
 #include "core/base/error.h"
 #include "core/lb/lb_solver.h"
@@ -32,19 +33,6 @@ std::string readResource(const char* name)
 double secondsSince(std::chrono::steady_clock::time_point t0)
 {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// MemAvailable from /proc/meminfo in bytes, 0 when unknown.
-double availableMemoryBytes()
-{
-    std::FILE* f = std::fopen("/proc/meminfo", "r");
-    if (!f) return 0.0;
-    char line[256];
-    double kb = 0.0;
-    while (std::fgets(line, sizeof line, f))
-        if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
-    std::fclose(f);
-    return kb * 1024.0;
 }
 
 // Refuses, before any work, a frame whose film and composed picture would not fit in memory (the
