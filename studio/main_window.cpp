@@ -38,6 +38,7 @@
 #include "studio/outliner_model.h"
 #include "studio/property_panel.h"
 #include "studio/viewport.h"
+#include "studio/volume_inspector.h"
 
 namespace sylva {
 namespace {
@@ -197,12 +198,23 @@ void MainWindow::buildDocks()
     logDock->setObjectName("logDock");
     logDock->setWidget(m_log);
 
+    m_inspector = new VolumeInspector;
+    m_inspectorDock = new QDockWidget(tr("Lighting Inspector"), this);
+    m_inspectorDock->setObjectName("inspectorDock");
+    m_inspectorDock->setWidget(m_inspector);
+    connect(m_inspectorDock, &QDockWidget::visibilityChanged, this, [this](bool visible) {
+        if (visible) refreshInspector();
+    });
+
     // Outliner over properties on the right, full height; jobs beside the log under the viewport.
     setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
     addDockWidget(Qt::RightDockWidgetArea, outlinerDock);
     splitDockWidget(outlinerDock, propDock, Qt::Vertical);
     addDockWidget(Qt::BottomDockWidgetArea, jobDock);
     splitDockWidget(jobDock, logDock, Qt::Horizontal);
+    // The inspector on the left, hidden until View > Lighting Inspector.
+    addDockWidget(Qt::LeftDockWidgetArea, m_inspectorDock);
+    m_inspectorDock->hide();
 }
 
 void MainWindow::showEvent(QShowEvent* event)
@@ -400,6 +412,8 @@ void MainWindow::onDocumentChanged(ScenePart parts)
     }
     if (parts == ScenePart::All) m_properties->showItem(m_properties->item());
     updateViewport();
+    if (hasPart(parts, ScenePart::Species) || hasPart(parts, ScenePart::Sun) || hasPart(parts, ScenePart::Instances))
+        refreshInspector();
 }
 
 bool MainWindow::viewNeedsLighting() const { return modeNeedsLighting(m_doc->scene().render.mode); }
@@ -423,7 +437,86 @@ void MainWindow::updateViewport()
     }
 }
 
-void MainWindow::onSelectionChanged() { m_properties->showItem(m_model->itemAt(m_outliner->currentIndex())); }
+void MainWindow::onSelectionChanged()
+{
+    m_properties->showItem(m_model->itemAt(m_outliner->currentIndex()));
+    refreshInspector();
+}
+
+int MainWindow::selectedSpecies() const
+{
+    const OutlinerItem it = m_model->itemAt(m_outliner->currentIndex());
+    const Scene& s = m_doc->scene();
+    if (it.kind == OutlinerItem::Kind::Species && it.row >= 0 && size_t(it.row) < s.species.size()) return it.row;
+    if (it.kind == OutlinerItem::Kind::Instance && it.row >= 0 && size_t(it.row) < s.instances.size() &&
+        s.instances[size_t(it.row)].species < s.species.size())
+        return int(s.instances[size_t(it.row)].species);
+    return -1;
+}
+
+// ---- lighting volume inspector ----
+
+void MainWindow::refreshInspector()
+{
+    if (!m_inspectorDock || !m_inspectorDock->isVisible()) return;
+    const int species = selectedSpecies();
+    if (species < 0) {
+        if (m_inspectorJob) m_inspectorJob->cancel();
+        m_inspectedKey.clear();
+        m_inspector->setMessage(tr("Select a species (or one of its instances) to inspect its lighting grids."));
+        Q_EMIT inspectorUpdated();
+        return;
+    }
+    const Scene& s = m_doc->scene();
+    const std::string key = assetKey(s.species[size_t(species)], s.sun, true);
+    if (key == m_inspectedKey) return;   // shown or loading
+    if (m_lightingJob) {
+        // The lighting job solves these grids right now: read them from the cache when it is done.
+        m_inspector->setMessage(tr("Waiting for the lighting job..."));
+        return;
+    }
+    inspectSpecies(species);
+}
+
+Job* MainWindow::inspectSpecies(int species)
+{
+    const Scene scene = m_doc->scene();
+    if (species < 0 || size_t(species) >= scene.species.size()) return nullptr;
+    const SpeciesDesc& sp = scene.species[size_t(species)];
+    const std::string key = assetKey(sp, scene.sun, true);
+    if (m_inspectorJob) m_inspectorJob->cancel();
+    m_inspectedKey = key;
+    const QString name = QString::fromStdString(sp.name);
+    m_inspector->setMessage(tr("Loading the grids of %1...").arg(name));
+    // The species' mesh when the viewport already holds it (no second import).
+    AssetsPtr held = m_assets.find(assetKey(sp, scene.sun, true));
+    if (!held) held = m_assets.find(assetKey(sp, scene.sun, false));
+    auto result = std::make_shared<std::shared_ptr<const SpeciesGrids>>();
+    GridCache* cache = m_cache.get();
+    m_inspectorJob = m_jobs->start(tr("Inspect %1").arg(name),
+                                   [scene, species, held, cache, result](Job& job, Progress& progress) {
+                                       JobLog log;
+                                       SpeciesGrids g = loadSpeciesGrids(scene, size_t(species), cache, &progress, &log,
+                                                                         held ? &held->mesh : nullptr);
+                                       const std::string& n = scene.species[size_t(species)].name;
+                                       for (const std::string& stage : log.stages)
+                                           job.log(QString::fromStdString(stage.rfind(n + ":", 0) == 0 ? stage : n + ": " + stage));
+                                       *result = std::make_shared<const SpeciesGrids>(std::move(g));
+                                   },
+                                   [this, key, name, result](Job* job) {
+                                       if (key != m_inspectedKey) return;   // the selection moved on
+                                       if (job->state() == Job::State::Succeeded) {
+                                           m_inspector->setGrids(name, *result);
+                                       } else {
+                                           m_inspectedKey.clear();
+                                           m_inspector->setMessage(job->state() == Job::State::Failed
+                                                                       ? tr("The grids of %1 could not be loaded: %2").arg(name, job->error())
+                                                                       : tr("Loading the grids of %1 was cancelled.").arg(name));
+                                       }
+                                       Q_EMIT inspectorUpdated();
+                                   });
+    return m_inspectorJob;
+}
 
 // ---- import, grow, lighting, export ----
 
@@ -560,6 +653,7 @@ Job* MainWindow::computeLighting(bool reload)
                                       } else {
                                           updateViewport();
                                       }
+                                      refreshInspector();
                                       Q_EMIT lightingFinished(ok);
                                   });
     return m_lightingJob;

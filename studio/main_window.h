@@ -15,6 +15,7 @@
 #include "studio/scene_document.h"
 
 class QComboBox;
+class QDockWidget;
 class QMenu;
 class QPlainTextEdit;
 class QTreeView;
@@ -28,6 +29,7 @@ class JobPanel;
 class OutlinerModel;
 class PropertyPanel;
 class Viewport;
+class VolumeInspector;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -45,6 +47,8 @@ public:
     JobPanel* jobPanel() const { return m_jobPanel; }
     AssetStore* assetStore() { return &m_assets; }
     QComboBox* modeSelector() const { return m_modeBox; }
+    VolumeInspector* inspector() const { return m_inspector; }
+    QDockWidget* inspectorDock() const { return m_inspectorDock; }
     QString logText() const;
     void clearLog();
 
@@ -77,10 +81,16 @@ public:
     Job* exportRender(const ExportSettings& settings);
     // Edit
     void deleteSelection();
+    // The species the outliner selection points at (a species row, or an instance's species); -1 if none.
+    int selectedSpecies() const;
+    // Lighting volume inspector: loads the species' density and lighting grids (the lighting job's
+    // calls, through the grid cache) in a job and shows them. Null when nothing needs loading.
+    Job* inspectSpecies(int species);
 
 Q_SIGNALS:
     void errorReported(const QString& title, const QString& message);
     void lightingFinished(bool succeeded);
+    void inspectorUpdated();   // the inspector shows new grids (or a message)
     void logLineAdded(const QString& line);
 
 protected:
@@ -102,6 +112,7 @@ private:
     void updateViewport();
     bool viewNeedsLighting() const;
     void onSelectionChanged();
+    void refreshInspector();
     void addSpecies(SpeciesDesc species, const Bounds3& bounds, const QString& undoText);
     void openDialog();
     bool saveAsDialog();
@@ -120,6 +131,10 @@ private:
     JobPanel* m_jobPanel;
     QPlainTextEdit* m_log;
     QComboBox* m_modeBox;
+    VolumeInspector* m_inspector = nullptr;
+    QDockWidget* m_inspectorDock = nullptr;
+    QPointer<Job> m_inspectorJob;
+    std::string m_inspectedKey;       // asset key of what the inspector shows (or is loading)
     QMenu* m_recentMenu = nullptr;
     QMenu* m_viewMenu = nullptr;
 

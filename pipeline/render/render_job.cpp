@@ -111,6 +111,29 @@ SpeciesAssets loadGeometry(const SpeciesDesc& sp, JobLog* log)
     return a;
 }
 
+// Voxelizes (or loads) and lights (or loads) one species' mesh; progress 0-20% density, then lighting.
+SpeciesGrids gridsForMesh(const Scene& scene, const SpeciesDesc& sp, const TriangleMesh& mesh, GridCache* cache,
+                          Progress* progress, JobLog* log, Backend* backend)
+{
+    SpeciesGrids g;
+    VoxelizeSettings vs;
+    vs.longestAxisNodes = sp.grid;
+    SubProgress densityPart(progress, 0.0, 0.2);
+    Progress densityProgress([&](double f, const std::string& msg) { densityPart.report(f, msg); });
+    if (progress && progress->isCancelled()) densityProgress.cancel();
+    g.density = densityForTriangles(mesh, vs, cache, &densityProgress, log);
+    g.params = sp.lighting;
+    g.params.sun = scene.sun.direction;
+    SubProgress lightPart(progress, 0.2, 1.0);
+    Progress lightProgress([&](double f, const std::string& msg) { lightPart.report(f, msg); });
+    if (progress && progress->isCancelled()) lightProgress.cancel();
+    g.lighting = lightingFor(g.density, g.params, cache, &lightProgress, log, backend);
+    const std::vector<float> f = lb::boundaryDistribution(g.params.sun);
+    const float free = std::accumulate(f.begin(), f.end(), 0.0f);
+    g.lightingNorm = g.params.intensity * free;
+    return g;
+}
+
 } // namespace
 
 const CieTable& bundledCieTable()
@@ -138,21 +161,24 @@ std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cach
         if (!needLighting) continue;
         Progress sub([&](double f, const std::string& msg) { part.report(0.05 + 0.95 * f, sp.name + ": " + msg); });
         if (progress && progress->isCancelled()) sub.cancel();
-        VoxelizeSettings vs;
-        vs.longestAxisNodes = sp.grid;
-        SubProgress densityPart(&sub, 0.0, 0.2);
-        Progress densityProgress([&](double f, const std::string& msg) { densityPart.report(f, msg); });
-        const DensityGrid density = densityForTriangles(out[s].mesh, vs, cache, &densityProgress, log);
-        lb::LbParams params = sp.lighting;
-        params.sun = scene.sun.direction;
-        SubProgress lightPart(&sub, 0.2, 1.0);
-        Progress lightProgress([&](double f, const std::string& msg) { lightPart.report(f, msg); });
-        out[s].lighting = lightingFor(density, params, cache, &lightProgress, log, backend);
-        const std::vector<float> f = lb::boundaryDistribution(params.sun);
-        const float free = std::accumulate(f.begin(), f.end(), 0.0f);
-        out[s].lightingNorm = params.intensity * free;
+        SpeciesGrids grids = gridsForMesh(scene, sp, out[s].mesh, cache, &sub, log, backend);
+        out[s].lighting = std::move(grids.lighting);
+        out[s].lightingNorm = grids.lightingNorm;
     }
     return out;
+}
+
+SpeciesGrids loadSpeciesGrids(const Scene& scene, size_t species, GridCache* cache, Progress* progress, JobLog* log,
+                              const TriangleMesh* mesh, Backend* backend)
+{
+    if (species >= scene.species.size())
+        throw Error("species " + std::to_string(species) + " does not exist (the scene has " +
+                    std::to_string(scene.species.size()) + ")");
+    const SpeciesDesc& sp = scene.species[species];
+    if (mesh) return gridsForMesh(scene, sp, *mesh, cache, progress, log, backend);
+    if (progress) progress->report(0.0, sp.name + ": geometry");
+    const SpeciesAssets geometry = loadGeometry(sp, log);
+    return gridsForMesh(scene, sp, geometry.mesh, cache, progress, log, backend);
 }
 
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend)

@@ -36,6 +36,20 @@ std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cach
                                              Progress* progress = nullptr, JobLog* log = nullptr,
                                              Backend* backend = nullptr);
 
+// The density and LB lighting grids of one species of a scene, through the same calls and cache keys
+// as loadSpeciesAssets (a species the scene has lit is a cache hit): what the studio's volume
+// inspector shows and its grid export writes.
+struct SpeciesGrids {
+    DensityGrid density;               // species frame (wood fraction included)
+    LightingGrid lighting;             // species frame, photon density per node and channel
+    lb::LbParams params;               // as solved: the species' parameters with the scene's sun
+    glm::vec3 lightingNorm{1.0f};      // photon density of unobstructed space per channel
+};
+// species: index into scene.species. mesh: the species' mesh when it is already in memory (else it is
+// grown or imported as loadSpeciesAssets does). Throws Error (bad index, unreadable mesh) or Cancelled.
+SpeciesGrids loadSpeciesGrids(const Scene& scene, size_t species, GridCache* cache, Progress* progress = nullptr,
+                              JobLog* log = nullptr, const TriangleMesh* mesh = nullptr, Backend* backend = nullptr);
+
 // Timings of one render, seconds.
 struct RenderTimings {
     double assets = 0.0, build = 0.0, trace = 0.0;

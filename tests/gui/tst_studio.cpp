@@ -3,6 +3,7 @@
 // reopen, export a PNG, the unsaved-changes prompt.
 #include <QAction>
 #include <QComboBox>
+#include <QDockWidget>
 #include <QDropEvent>
 #include <QMimeData>
 #include <QDoubleSpinBox>
@@ -19,6 +20,7 @@
 #include "studio/job_panel.h"
 #include "studio/outliner_model.h"
 #include "studio/property_panel.h"
+#include "studio/volume_inspector.h"
 #include "studio_test_util.h"
 
 using namespace sylva;
@@ -175,6 +177,32 @@ private Q_SLOTS:
 
     // A heavier solve (grid 96, about a second or two of LB on two cores) with a 10 ms timer on the GUI
     // thread: the longest time the event loop went without running is the UI's worst stall.
+    // View > Lighting Inspector on the selected species: its grids come from the grid cache and equal
+    // the lighting grid the lighting job gave the viewport; an instance shows its species.
+    void volumeInspectorShowsTheLitGrids()
+    {
+        select({OutlinerItem::Kind::Species, 0});
+        m_win->clearLog();
+        QSignalSpy updated(m_win.get(), &MainWindow::inspectorUpdated);
+        m_win->inspectorDock()->show();
+        QTRY_VERIFY_WITH_TIMEOUT(m_win->inspector()->grids() != nullptr, 30000);
+        const auto grids = m_win->inspector()->grids();
+        const Scene& s = scene();
+        const AssetsPtr lit = m_win->assetStore()->find(assetKey(s.species[0], s.sun, true));
+        QVERIFY(lit);
+        QCOMPARE(grids->lighting.geometry, lit->lighting.geometry);
+        QVERIFY(grids->lighting.rgb == lit->lighting.rgb);
+        QCOMPARE(grids->density.geometry, lit->lighting.geometry);
+        QVERIFY2(m_win->logText().contains("Tree_1: light (cache hit)"), qPrintable(m_win->logText()));
+        QCOMPARE(m_win->inspector()->species(), QStringLiteral("Tree_1"));
+        QVERIFY(!m_win->inspector()->view()->image().isNull());
+        // The instance: same species, nothing new to load.
+        select({OutlinerItem::Kind::Instance, 0});
+        QCOMPARE(m_win->selectedSpecies(), 0);
+        QCOMPARE(m_win->inspector()->grids(), grids);
+        m_win->inspectorDock()->hide();
+    }
+
     void eventLoopLatencyDuringLighting()
     {
         Scene s = scene();

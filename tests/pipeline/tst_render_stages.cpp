@@ -7,6 +7,7 @@
 
 #include <algorithm>
 
+#include "core/base/error.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
 
@@ -179,6 +180,39 @@ private Q_SLOTS:
         s.render.mode = RenderMode::Local;
         s.sun.direction = sunDirection(60.0, 10.0);
         QCOMPARE(run(s, "local"), (Stages{"shrub0: grow", "birch1: grow", "build", "trace"}));
+    }
+
+    // loadSpeciesGrids (the studio's inspector and grid export) goes through the same cache keys as a
+    // render: after a render its grids are cache hits, equal to the render's; with the mesh given it
+    // neither grows nor imports; a bad species index is an error naming it.
+    void speciesGridsAreTheRendersGrids()
+    {
+        const Scene s = forest(2, 2);
+        GridCache cache((m_dir + "/species-grids").toStdString());
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
+        JobLog log;
+        const SpeciesGrids g = loadSpeciesGrids(s, 1, &cache, nullptr, &log);
+        QCOMPARE(log.stages, (Stages{"birch1: grow", "voxelize (cache hit)", "light (cache hit)"}));
+        QCOMPARE(g.lighting.geometry, assets[1].lighting.geometry);
+        QVERIFY(g.lighting.rgb == assets[1].lighting.rgb);
+        QCOMPARE(g.lightingNorm, assets[1].lightingNorm);
+        QCOMPARE(g.density.geometry, g.lighting.geometry);
+        QCOMPARE(g.density.density.size(), g.density.geometry.nodeCount());
+        QCOMPARE(g.density.woodFraction.size(), g.density.geometry.nodeCount());
+        QVERIFY(*std::max_element(g.density.density.begin(), g.density.density.end()) > 0.0f);
+        QCOMPARE(g.params.sun, s.sun.direction);
+
+        JobLog withMesh;
+        const SpeciesGrids h = loadSpeciesGrids(s, 0, &cache, nullptr, &withMesh, &assets[0].mesh);
+        QCOMPARE(withMesh.stages, (Stages{"voxelize (cache hit)", "light (cache hit)"}));
+        QVERIFY(h.lighting.rgb == assets[0].lighting.rgb);
+
+        try {
+            loadSpeciesGrids(s, 2, &cache);
+            QFAIL("species 2 of 2 was accepted");
+        } catch (const Error& e) {
+            QVERIFY2(QString(e.what()).contains("species 2"), e.what());
+        }
     }
 };
 
