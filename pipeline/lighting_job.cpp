@@ -4,6 +4,7 @@
 #include "core/backend/backend.h"
 
 #include <span>
+#include <sstream>
 
 #include "core/lb/lb_solver.h"
 #include "core/mesh/triangle_mesh.h"
@@ -144,6 +145,34 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
         }
     }
     return grid;
+}
+
+std::string lightingParamsJson(const lb::LbParams& params, const std::string& preset, const glm::ivec3& dims)
+{
+    std::ostringstream extra;
+    extra.precision(9);
+    auto triple = [&](auto get) { extra << "[" << get(0) << "," << get(1) << "," << get(2) << "]"; };
+    std::string name;
+    for (char c : preset)
+        if (c != '"' && c != '\\' && static_cast<unsigned char>(c) >= 0x20) name += c;
+    extra << "{\"preset\":\"" << name << "\",\"sigma_a\":";
+    triple([&](int c) { return params.channels[size_t(c)].sigmaA; });
+    extra << ",\"sigma_s\":";
+    triple([&](int c) { return params.channels[size_t(c)].sigmaS; });
+    extra << ",\"g\":";
+    triple([&](int c) { return params.channels[size_t(c)].g; });
+    extra << ",\"sun\":";
+    triple([&](int c) { return params.sun[c]; });
+    extra << ",\"intensity\":";
+    triple([&](int c) { return params.intensity[c]; });
+    extra << ",\"zero_f0\":" << (params.zeroF0 ? "true" : "false") << ",\"storage\":\""
+          << (params.storage == lb::Storage::Fp16 ? "fp16" : "fp32") << "\"";
+    if (params.tolerance > 0.0) extra << ",\"tolerance\":" << params.tolerance;
+    else extra << ",\"steps\":" << (params.steps > 0 ? params.steps : lb::defaultSteps(dims));
+    extra << ",\"warm_start\":" << (params.warmStart ? "true" : "false");
+    if (params.coarseStart) extra << ",\"coarse_start\":true";
+    extra << "}";
+    return extra.str();
 }
 
 } // namespace sylva

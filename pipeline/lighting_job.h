@@ -46,4 +46,10 @@ std::string densityHash(const DensityGrid& density);
 LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache,
                          Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
 
+// The LB parameters of a solve as the JSON object a lighting sidecar stores under "parameters"
+// (`sylva light` and the studio's grid export): preset, per-channel sigma_a, sigma_s, g, intensity,
+// sun, zero_f0, storage, tolerance (or steps, the default for dims when params.steps is 0),
+// warm_start, and coarse_start when set.
+std::string lightingParamsJson(const lb::LbParams& params, const std::string& preset, const glm::ivec3& dims);
+
 } // namespace sylva

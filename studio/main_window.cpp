@@ -8,6 +8,7 @@
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
+#include <QDir>
 #include <QDockWidget>
 #include <QDragEnterEvent>
 #include <QDropEvent>
@@ -31,6 +32,7 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/import/mesh_import.h"
+#include "pipeline/io/npy.h"
 #include "pipeline/render/render_job.h"
 #include "studio/background_priority.h"
 #include "studio/job_manager.h"
@@ -251,6 +253,7 @@ void MainWindow::buildActions()
     add(file, tr("&Import Mesh..."), "actionImport", QKeySequence(Qt::CTRL | Qt::Key_I), [this] { importDialog(); });
     add(file, tr("&Grow Species..."), "actionGrow", QKeySequence(Qt::CTRL | Qt::Key_G), [this] { growDialog(); });
     add(file, tr("&Export Render..."), "actionExport", QKeySequence(Qt::CTRL | Qt::Key_E), [this] { exportDialog(); });
+    add(file, tr("Export Species &Grids..."), "actionExportGrids", QKeySequence(), [this] { exportGridsDialog(); });
     file->addSeparator();
     add(file, tr("&Quit"), "actionQuit", QKeySequence::Quit, [this] { close(); });
     updateRecentMenu();
@@ -701,6 +704,52 @@ Job* MainWindow::exportRender(const ExportSettings& settings)
                          });
 }
 
+QString MainWindow::gridFileBase(const QString& speciesName)
+{
+    QString out;
+    for (QChar c : speciesName)
+        out += (c.isLetterOrNumber() && c.unicode() < 128) || c == u'.' || c == u'-' || c == u'_' ? c : QChar(u'_');
+    return out.isEmpty() ? QStringLiteral("species") : out;
+}
+
+Job* MainWindow::exportSpeciesGrids(int species, const QString& folder)
+{
+    const Scene scene = m_doc->scene();
+    if (species < 0 || size_t(species) >= scene.species.size()) {
+        reportError(tr("Export failed"), tr("Select a species (or one of its instances) to export its grids."));
+        return nullptr;
+    }
+    const SpeciesDesc& sp = scene.species[size_t(species)];
+    const QString base = QDir(folder).filePath(gridFileBase(QString::fromStdString(sp.name)));
+    const std::string densityPath = (base + QStringLiteral(".density.npy")).toStdString();
+    const std::string lightingPath = (base + QStringLiteral(".lighting.npy")).toStdString();
+    AssetsPtr held = m_assets.find(assetKey(sp, scene.sun, true));
+    if (!held) held = m_assets.find(assetKey(sp, scene.sun, false));
+    GridCache* cache = m_cache.get();
+    appendLog(tr("exporting the grids of %1 to %2").arg(QString::fromStdString(sp.name), QDir::toNativeSeparators(folder)));
+    return m_jobs->start(tr("Export grids of %1").arg(QString::fromStdString(sp.name)),
+                         [scene, species, held, cache, densityPath, lightingPath](Job& job, Progress& progress) {
+                             const SpeciesDesc& d = scene.species[size_t(species)];
+                             SubProgress loadPart(&progress, 0.0, 0.9);
+                             Progress loadProgress([&](double f, const std::string& m) { loadPart.report(f, m); });
+                             JobLog log;
+                             const SpeciesGrids g = loadSpeciesGrids(scene, size_t(species), cache, &loadProgress, &log,
+                                                                     held ? &held->mesh : nullptr);
+                             for (const std::string& stage : log.stages)
+                                 job.log(QString::fromStdString(stage.rfind(d.name + ":", 0) == 0 ? stage : d.name + ": " + stage));
+                             progress.report(0.9, "writing");
+                             writeDensityGrid(densityPath, g.density);
+                             writeLightingGrid(lightingPath, g.lighting, lightingParamsJson(g.params, d.preset, g.lighting.geometry.dims));
+                             progress.report(1.0, "written");
+                         },
+                         [this, densityPath, lightingPath](Job* job) {
+                             if (job->state() == Job::State::Succeeded)
+                                 appendLog(tr("exported %1 and %2").arg(QString::fromStdString(densityPath), QString::fromStdString(lightingPath)));
+                             else if (job->state() == Job::State::Failed) reportError(tr("Export failed"), job->error());
+                             else appendLog(tr("grid export cancelled"));
+                         });
+}
+
 void MainWindow::deleteSelection()
 {
     const OutlinerItem it = m_model->itemAt(m_outliner->currentIndex());
@@ -765,6 +814,19 @@ void MainWindow::exportDialog()
     }
     ExportDialog d(initial, this);
     if (d.exec() == QDialog::Accepted) exportRender(d.settings());
+}
+
+void MainWindow::exportGridsDialog()
+{
+    const int species = selectedSpecies();
+    if (species < 0) {
+        reportError(tr("Export failed"), tr("Select a species (or one of its instances) to export its grids."));
+        return;
+    }
+    const QString folder = QFileDialog::getExistingDirectory(
+        this, tr("Export the grids of %1 to").arg(QString::fromStdString(m_doc->scene().species[size_t(species)].name)),
+        m_doc->filePath().isEmpty() ? QString() : QFileInfo(m_doc->filePath()).absolutePath());
+    if (!folder.isEmpty()) exportSpeciesGrids(species, folder);
 }
 
 // ---- window events ----

@@ -79,6 +79,12 @@ public:
     // first, so the grid cache answers). Returns the job, or null when everything is in memory.
     Job* computeLighting(bool reload = false);
     Job* exportRender(const ExportSettings& settings);
+    // Writes a species' grids (loadSpeciesGrids) into folder as NAME.density.npy (+ NAME.density.wood.npy)
+    // and NAME.lighting.npy, each with its JSON sidecar (CONTRACTS.md); NAME is the species name with
+    // characters other than letters, digits, '.', '-', '_' replaced by '_'. Null (and an error report)
+    // for a bad species index.
+    Job* exportSpeciesGrids(int species, const QString& folder);
+    static QString gridFileBase(const QString& speciesName);
     // Edit
     void deleteSelection();
     // The species the outliner selection points at (a species row, or an instance's species); -1 if none.
@@ -119,6 +125,7 @@ private:
     void importDialog();
     void growDialog();
     void exportDialog();
+    void exportGridsDialog();
 
     SceneDocument* m_doc;
     JobManager* m_jobs;

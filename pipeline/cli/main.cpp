@@ -476,29 +476,7 @@ int cmdLight(const Args& args)
     bar.finish(log.stages.back());
     for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     // The sidecar records what produced the grid: the optics actually used (after any overrides).
-    std::ostringstream extra;
-    extra.precision(9);
-    auto triple = [&](auto get) {
-        extra << "[" << get(0) << "," << get(1) << "," << get(2) << "]";
-    };
-    extra << "{\"preset\":\"" << args.get("--preset", "leaf") << "\",\"sigma_a\":";
-    triple([&](int c) { return params.channels[size_t(c)].sigmaA; });
-    extra << ",\"sigma_s\":";
-    triple([&](int c) { return params.channels[size_t(c)].sigmaS; });
-    extra << ",\"g\":";
-    triple([&](int c) { return params.channels[size_t(c)].g; });
-    extra << ",\"sun\":";
-    triple([&](int c) { return params.sun[c]; });
-    extra << ",\"intensity\":";
-    triple([&](int c) { return params.intensity[c]; });
-    extra << ",\"zero_f0\":" << (params.zeroF0 ? "true" : "false") << ",\"storage\":\""
-          << (params.storage == lb::Storage::Fp16 ? "fp16" : "fp32") << "\"";
-    if (params.tolerance > 0.0) extra << ",\"tolerance\":" << params.tolerance;
-    else extra << ",\"steps\":" << (params.steps > 0 ? params.steps : lb::defaultSteps(density.geometry.dims));
-    extra << ",\"warm_start\":" << (params.warmStart ? "true" : "false");
-    if (params.coarseStart) extra << ",\"coarse_start\":true";
-    extra << "}";
-    writeLightingGrid(out, light, extra.str());
+    writeLightingGrid(out, light, lightingParamsJson(params, args.get("--preset", "leaf"), density.geometry.dims));
     double maxV[3] = {0, 0, 0}, mean[3] = {0, 0, 0};
     for (size_t n = 0; n < light.rgb.size() / 3; ++n)
         for (int c = 0; c < 3; ++c) {

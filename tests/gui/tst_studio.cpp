@@ -8,7 +8,11 @@
 #include <QMimeData>
 #include <QDoubleSpinBox>
 #include <QElapsedTimer>
+#include <QDir>
 #include <QFile>
+#include <QJsonArray>
+#include <QJsonDocument>
+#include <QJsonObject>
 #include <QSettings>
 #include <QSpinBox>
 #include <QTimer>
@@ -16,6 +20,8 @@
 
 #include <memory>
 
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/io/npy.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/job_panel.h"
 #include "studio/outliner_model.h"
@@ -201,6 +207,47 @@ private Q_SLOTS:
         QCOMPARE(m_win->selectedSpecies(), 0);
         QCOMPARE(m_win->inspector()->grids(), grids);
         m_win->inspectorDock()->hide();
+    }
+
+    // File > Export Species Grids: the .npy files and sidecars read back equal the grids in the cache
+    // (the lighting the viewport uses; the density the voxelizer cached for this mesh and grid).
+    void exportSpeciesGrids()
+    {
+        const QString folder = m_dir.filePath("grids");
+        QVERIFY(QDir().mkpath(folder));
+        QVERIFY(waitForJob(m_win->exportSpeciesGrids(0, folder), 60000));
+        const Scene& s = scene();
+        const AssetsPtr lit = m_win->assetStore()->find(assetKey(s.species[0], s.sun, true));
+        QVERIFY(lit);
+        const LightingGrid light = readLightingGrid(QDir(folder).filePath("Tree_1.lighting.npy").toStdString());
+        QCOMPARE(light.geometry, lit->lighting.geometry);   // dims from the array, origin and spacing from the sidecar
+        QVERIFY(light.rgb == lit->lighting.rgb);
+        const std::string densityPath = QDir(folder).filePath("Tree_1.density.npy").toStdString();
+        QVERIFY(QFile::exists(QString::fromStdString(woodFractionPath(densityPath))));
+        const DensityGrid density = readDensityGrid(densityPath);
+        GridCache cache;   // the window's cache (XDG_CACHE_HOME of this test)
+        VoxelizeSettings vs;
+        vs.longestAxisNodes = s.species[0].grid;
+        JobLog log;
+        const DensityGrid cached = densityForTriangles(lit->mesh, vs, &cache, nullptr, &log);
+        QCOMPARE(log.stages, (std::vector<std::string>{"voxelize (cache hit)"}));
+        QCOMPARE(density.geometry, cached.geometry);
+        QVERIFY(density.density == cached.density);
+        QVERIFY(density.woodFraction == cached.woodFraction);
+        // The lighting sidecar names what produced the grid.
+        QFile side(QDir(folder).filePath("Tree_1.lighting.npy.json"));
+        QVERIFY(side.open(QIODevice::ReadOnly));
+        const QJsonObject o = QJsonDocument::fromJson(side.readAll()).object();
+        QCOMPARE(o["kind"].toString(), QStringLiteral("lighting"));
+        const QJsonObject p = o["parameters"].toObject();
+        QCOMPARE(p["preset"].toString(), QStringLiteral("leaf"));
+        const glm::vec3 sun = s.sun.direction;
+        for (int c = 0; c < 3; ++c) QCOMPARE(float(p["sun"].toArray()[c].toDouble()), sun[c]);
+        // No species: an error, no job.
+        m_errors.clear();
+        QVERIFY(!m_win->exportSpeciesGrids(5, folder));
+        QCOMPARE(m_errors.size(), 1);
+        QCOMPARE(MainWindow::gridFileBase("Tree 1 (2)/x"), QStringLiteral("Tree_1__2__x"));
     }
 
     void eventLoopLatencyDuringLighting()

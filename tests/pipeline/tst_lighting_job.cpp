@@ -1,6 +1,9 @@
 // The lighting pipeline with the cache: which stages run, and damaged cache entries are recomputed, never used.
 #include <QDir>
 #include <QFile>
+#include <QJsonArray>
+#include <QJsonDocument>
+#include <QJsonObject>
 #include <QTest>
 
 #include "core/lb/lb_solver.h"
@@ -106,6 +109,33 @@ private Q_SLOTS:
         const LightingGrid third = lightingFor(d, p, &cache, nullptr, &log2);
         QCOMPARE(log2.stages, (std::vector<std::string>{"light"}));
         QVERIFY(third.rgb == good.rgb);
+    }
+
+    // The sidecar parameters (`sylva light`, the studio's grid export) are valid JSON holding the
+    // parameters as given, steps or tolerance, and a preset name that cannot break the object.
+    void paramsJson()
+    {
+        lb::LbParams p = lb::paramsFromPreset(*lb::findPreset("dogrose"));
+        p.sun = glm::vec3(0.25f, -0.5f, 0.75f);
+        p.intensity = glm::vec3(1.0f, 0.5f, 2.0f);
+        p.tolerance = 0.0;
+        p.steps = 0;
+        const QJsonObject o = QJsonDocument::fromJson(QByteArray::fromStdString(lightingParamsJson(p, "dog\"rose", {9, 5, 7}))).object();
+        QVERIFY(!o.isEmpty());
+        QCOMPARE(o["preset"].toString(), QStringLiteral("dogrose"));
+        for (int c = 0; c < 3; ++c) {
+            QCOMPARE(float(o["sigma_a"].toArray()[c].toDouble()), p.channels[size_t(c)].sigmaA);
+            QCOMPARE(float(o["sigma_s"].toArray()[c].toDouble()), p.channels[size_t(c)].sigmaS);
+            QCOMPARE(float(o["g"].toArray()[c].toDouble()), p.channels[size_t(c)].g);
+            QCOMPARE(float(o["sun"].toArray()[c].toDouble()), p.sun[c]);
+            QCOMPARE(float(o["intensity"].toArray()[c].toDouble()), p.intensity[c]);
+        }
+        QCOMPARE(o["steps"].toInt(), lb::defaultSteps({9, 5, 7}));
+        QVERIFY(!o.contains("tolerance"));
+        p.tolerance = 1e-3;
+        const QJsonObject t = QJsonDocument::fromJson(QByteArray::fromStdString(lightingParamsJson(p, "leaf", {9, 5, 7}))).object();
+        QCOMPARE(t["tolerance"].toDouble(), 1e-3);
+        QVERIFY(!t.contains("steps"));
     }
 };
 
