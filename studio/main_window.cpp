@@ -16,11 +16,15 @@
 #include <QFileInfo>
 #include <QHBoxLayout>
 #include <QHeaderView>
+#include <QJsonDocument>
+#include <QJsonObject>
 #include <QLabel>
 #include <QMenuBar>
 #include <QMimeData>
 #include <QPlainTextEdit>
+#include <QSaveFile>
 #include <QSettings>
+#include <QStandardPaths>
 #include <QStatusBar>
 #include <QToolBar>
 #include <QTreeView>
@@ -34,6 +38,7 @@
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/scene/scene_file.h"
 #include "studio/background_priority.h"
 #include "studio/job_manager.h"
 #include "studio/job_panel.h"
@@ -150,6 +155,20 @@ MainWindow::MainWindow(QWidget* parent)
     connect(m_doc, &SceneDocument::modifiedChanged, this, [this] { updateTitle(); });
     connect(m_doc, &SceneDocument::filePathChanged, this, [this] { updateTitle(); });
     connect(m_jobs, &JobManager::logLine, this, &MainWindow::appendLog);
+    m_askRecover = [this](const QString& origin, const QDateTime& when) {
+        return QMessageBox::question(this, tr("Recover unsaved changes?"),
+                                     tr("Sylva Studio did not close cleanly. Recover the unsaved changes to %1 autosaved at %2?")
+                                         .arg(origin.isEmpty() ? tr("an untitled scene") : origin,
+                                              QLocale().toString(when, QLocale::ShortFormat)),
+                                     QMessageBox::Yes | QMessageBox::No, QMessageBox::Yes) == QMessageBox::Yes;
+    };
+    connect(m_doc, &SceneDocument::modifiedChanged, this, [this](bool modified) {
+        if (!modified) removeRecoveryFile();
+    });
+    connect(&m_autosaveTimer, &QTimer::timeout, this, [this] { autosaveNow(); });
+    setAutosaveInterval(QSettings().value("autosave/intervalSeconds", 60).toInt() * 1000);
+    m_recoveryPending = QFileInfo::exists(recoveryFilePath());
+    QTimer::singleShot(0, this, [this] { offerRecovery(); });
     updateTitle();
     updateViewport();
     statusBar()->showMessage(tr("Ready"));
@@ -165,6 +184,106 @@ MainWindow::~MainWindow()
     m_jobs->disconnect(this);
     m_viewport->disconnect(this);
     m_lightingTimer.stop();
+    m_autosaveTimer.stop();
+}
+
+// ---- autosave and crash recovery ----
+
+QString MainWindow::recoveryFilePath()
+{
+    return QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + QStringLiteral("/recovery/autosave.sylva.json");
+}
+
+namespace {
+QString recoveryInfoPath() { return QFileInfo(MainWindow::recoveryFilePath()).absolutePath() + QStringLiteral("/autosave.json"); }
+} // namespace
+
+void MainWindow::setAutosaveInterval(int milliseconds)
+{
+    if (milliseconds <= 0) {
+        m_autosaveTimer.stop();
+        return;
+    }
+    m_autosaveTimer.start(milliseconds);
+}
+
+bool MainWindow::autosaveNow()
+{
+    if (m_recoveryPending) return false;
+    const Scene& s = m_doc->scene();
+    if (!m_doc->isModified()) {
+        removeRecoveryFile();
+        return false;
+    }
+    if (m_doc->revision() == m_autosavedRevision && QFileInfo::exists(recoveryFilePath())) return false;
+    if (s.species.empty() || s.instances.empty()) {
+        removeRecoveryFile();   // not a scene file the reader accepts; an older autosave would mislead
+        return false;
+    }
+    try {
+        writeSceneFile(s, recoveryFilePath().toStdString());
+        QSaveFile info(recoveryInfoPath());
+        QJsonObject o;
+        o["file"] = m_doc->filePath();
+        o["saved"] = QDateTime::currentDateTimeUtc().toString(Qt::ISODate);
+        if (!info.open(QIODevice::WriteOnly) || info.write(QJsonDocument(o).toJson()) < 0 || !info.commit())
+            throw Error(info.fileName().toStdString() + ": " + info.errorString().toStdString());
+    } catch (const std::exception& e) {
+        appendLog(tr("autosave failed: %1").arg(QString::fromStdString(e.what())));
+        return false;
+    }
+    m_autosavedRevision = m_doc->revision();
+    Q_EMIT autosaved(recoveryFilePath());
+    return true;
+}
+
+void MainWindow::removeRecoveryFile()
+{
+    if (m_recoveryPending) return;
+    QFile::remove(recoveryFilePath());
+    QFile::remove(recoveryInfoPath());
+    m_autosavedRevision = 0;
+}
+
+bool MainWindow::offerRecovery()
+{
+    m_recoveryPending = false;
+    const QString path = recoveryFilePath();
+    if (!QFileInfo::exists(path)) return false;
+    QString origin;
+    QDateTime when = QFileInfo(path).lastModified();
+    QFile info(recoveryInfoPath());
+    if (info.open(QIODevice::ReadOnly)) {
+        const QJsonObject o = QJsonDocument::fromJson(info.readAll()).object();
+        origin = o["file"].toString();
+        const QDateTime t = QDateTime::fromString(o["saved"].toString(), Qt::ISODate);
+        if (t.isValid()) when = t.toLocalTime();
+    }
+    const bool recover = m_askRecover ? m_askRecover(origin, when) : false;
+    bool recovered = false;
+    if (recover) {
+        try {
+            const Scene scene = readSceneFile(path.toStdString());
+            // On top of the saved file (undo shows what was saved), else of an empty untitled scene.
+            bool based = false;
+            if (!origin.isEmpty() && QFileInfo::exists(origin)) {
+                try {
+                    m_doc->open(origin);
+                    based = true;
+                } catch (const std::exception& e) {
+                    appendLog(tr("recovery: %1 cannot be read (%2); recovering as untitled").arg(origin, QString::fromStdString(e.what())));
+                }
+            }
+            if (!based) m_doc->reset(Scene{}, QString());
+            m_doc->edit(scene, tr("Recover unsaved changes"));
+            appendLog(tr("recovered unsaved changes%1").arg(origin.isEmpty() ? QString() : tr(" to %1").arg(origin)));
+            recovered = true;
+        } catch (const std::exception& e) {
+            reportError(tr("Recovery failed"), QString::fromStdString(e.what()));
+        }
+    }
+    removeRecoveryFile();
+    return recovered;
 }
 
 void MainWindow::buildDocks()
@@ -839,6 +958,7 @@ void MainWindow::closeEvent(QCloseEvent* event)
     }
     m_jobs->cancelAll();
     m_jobs->waitForAll();
+    removeRecoveryFile();   // a clean close: nothing to recover
     event->accept();
 }
 

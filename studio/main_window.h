@@ -3,6 +3,8 @@
 #pragma once
 
 #include <functional>
+
+#include <QDateTime>
 #include <memory>
 
 #include <QMainWindow>
@@ -59,6 +61,26 @@ public:
     using SavePrompt = std::function<QMessageBox::StandardButton(const QString& documentName)>;
     void setSavePrompt(SavePrompt prompt) { m_askSave = std::move(prompt); }
 
+    // Crash recovery: the question asked when a recovery file is found (origin: the scene's file, empty
+    // when untitled; when: the autosave's time). Default: a modal question box. Answer true to recover.
+    using RecoveryPrompt = std::function<bool(const QString& origin, const QDateTime& when)>;
+    void setRecoveryPrompt(RecoveryPrompt prompt) { m_askRecover = std::move(prompt); }
+
+    // Autosave: every interval (default 60 s, settings key autosave/intervalSeconds; 0 = off) a modified
+    // scene goes to recoveryFilePath(); a clean save, a clean document or a close deletes it.
+    void setAutosaveInterval(int milliseconds);
+    int autosaveInterval() const { return m_autosaveTimer.isActive() ? m_autosaveTimer.interval() : 0; }
+    // Writes the recovery file now when the scene is modified and changed since the last autosave;
+    // true when it wrote one.
+    bool autosaveNow();
+    // Where autosave writes: QStandardPaths::AppDataLocation/recovery/autosave.sylva.json, with
+    // autosave.json beside it naming the scene's own file.
+    static QString recoveryFilePath();
+    // Offers the recovery file, if there is one (the window does this once, just after it is built):
+    // recovering replaces the document with the file's scene on top of the saved one (one undo step,
+    // modified); either way the recovery file is deleted. True when a scene was recovered.
+    bool offerRecovery();
+
     // Lighting starts by itself (debounced) when species, sun or mode change; off: Render > Compute Lighting.
     void setAutoLighting(bool on);
     bool autoLighting() const { return m_autoLighting; }
@@ -97,6 +119,7 @@ Q_SIGNALS:
     void errorReported(const QString& title, const QString& message);
     void lightingFinished(bool succeeded);
     void inspectorUpdated();   // the inspector shows new grids (or a message)
+    void autosaved(const QString& path);
     void logLineAdded(const QString& line);
 
 protected:
@@ -119,6 +142,7 @@ private:
     bool viewNeedsLighting() const;
     void onSelectionChanged();
     void refreshInspector();
+    void removeRecoveryFile();
     void addSpecies(SpeciesDesc species, const Bounds3& bounds, const QString& undoText);
     void openDialog();
     bool saveAsDialog();
@@ -147,6 +171,10 @@ private:
 
     ErrorReporter m_reportError;
     SavePrompt m_askSave;
+    RecoveryPrompt m_askRecover;
+    QTimer m_autosaveTimer;
+    quint64 m_autosavedRevision = 0;
+    bool m_recoveryPending = false;   // a recovery file waits to be offered: neither overwrite nor delete it
     bool m_autoLighting = true;
     QTimer m_lightingTimer;
     QPointer<Job> m_lightingJob;

@@ -5,6 +5,8 @@
 #include <cmath>
 
 #include <QApplication>
+#include <QDir>
+#include <QFileInfo>
 #include <QImage>
 #include <QSettings>
 #include <QSignalSpy>
@@ -34,6 +36,8 @@ inline void isolate(const QTemporaryDir& dir)
     QApplication::setOrganizationName("SylvaTest");
     QApplication::setApplicationName("sylva-studio-test");
     QSettings().clear();   // test mode keeps its files between runs (~/.qttest)
+    // No crash recovery left over from an earlier run (its question would block the test).
+    QDir(QFileInfo(MainWindow::recoveryFilePath()).absolutePath()).removeRecursively();
     qputenv("XDG_CACHE_HOME", dir.filePath("cache").toLocal8Bit());
     QApplication::setStyle("Fusion");
 }

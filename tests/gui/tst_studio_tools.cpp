@@ -1,0 +1,160 @@
+// The studio's editing tools under Xvfb: autosave and crash recovery.
+#include <QDir>
+#include <QFile>
+
+#include <memory>
+
+#include "pipeline/scene/scene_file.h"
+#include "studio/scene_document.h"
+#include "studio_test_util.h"
+
+using namespace sylva;
+using namespace sylva::test;
+
+namespace {
+
+std::string json(const Scene& s) { return sceneToJson(s, "/"); }
+
+} // namespace
+
+class TstStudioTools : public QObject {
+    Q_OBJECT
+
+    QTemporaryDir m_dir;
+
+    // A window as the tests want it: no automatic lighting, no blocking questions.
+    std::unique_ptr<MainWindow> window(std::function<bool(const QString&, const QDateTime&)> recover = {})
+    {
+        auto w = std::make_unique<MainWindow>();
+        w->setAutoLighting(false);
+        w->setErrorReporter([](const QString&, const QString& m) { qWarning("error: %s", qPrintable(m)); });
+        w->setSavePrompt([](const QString&) { return QMessageBox::Discard; });
+        w->setRecoveryPrompt(recover ? recover : [](const QString&, const QDateTime&) { return false; });
+        return w;
+    }
+
+    // A small scene: one grown shrub, two instances.
+    static void compose(MainWindow& w)
+    {
+        w.growSpecies(GrowSpec{"shrub", 3, 2000, 0.0f});
+        Scene s = w.document()->scene();
+        InstanceDesc in = s.instances[0];
+        in.position = {2.5, 0.0, -1.0};
+        in.rotationDeg.y = 30.0f;
+        s.instances.push_back(in);
+        w.document()->edit(s, "add");
+    }
+
+private Q_SLOTS:
+    void initTestCase()
+    {
+        SYLVA_SKIP_WITHOUT_X();
+        QVERIFY(m_dir.isValid());
+        isolate(m_dir);
+    }
+
+    // Modified untitled scene -> autosave -> the window goes without closing (a crash) -> a new window
+    // offers the recovery and gets the modified scene back, modified, one undo step above an empty
+    // scene; a clean save deletes the recovery file.
+    void autosaveAndRecoverUntitled()
+    {
+        const QString rec = MainWindow::recoveryFilePath();
+        std::string want;
+        {
+            auto a = window();
+            QTest::qWait(1);   // let the start-up recovery check run (nothing to offer)
+            compose(*a);
+            QVERIFY(a->document()->isModified());
+            QVERIFY(!QFile::exists(rec));
+            QSignalSpy saved(a.get(), &MainWindow::autosaved);
+            a->setAutosaveInterval(50);
+            QVERIFY(saved.wait(5000));
+            QCOMPARE(saved.at(0).at(0).toString(), rec);
+            QVERIFY(QFile::exists(rec));
+            // Unchanged since: no second write.
+            QVERIFY(!a->autosaveNow());
+            want = json(a->document()->scene());
+            a->setAutosaveInterval(0);
+        }   // destroyed without a close: what a crash leaves behind
+        QVERIFY(QFile::exists(rec));
+
+        int offered = 0;
+        QString origin = "unset";
+        auto b = window([&](const QString& o, const QDateTime& when) {
+            ++offered;
+            origin = o;
+            return when.isValid();
+        });
+        QTRY_COMPARE(offered, 1);
+        QVERIFY(origin.isEmpty());
+        QCOMPARE(json(b->document()->scene()), want);
+        QVERIFY(b->document()->isModified());
+        QVERIFY(b->document()->filePath().isEmpty());
+        QCOMPARE(b->document()->undoStack()->count(), 1);
+        QVERIFY(!QFile::exists(rec));   // offered once
+
+        // It autosaves again; a clean save removes the file.
+        QVERIFY(b->autosaveNow());
+        QVERIFY(QFile::exists(rec));
+        QVERIFY(b->saveFile(m_dir.filePath("recovered.sylva.json")));
+        QVERIFY(!QFile::exists(rec));
+        b->document()->undoStack()->setClean();
+    }
+
+    // A saved file, then edits: recovery reopens the file and puts the edits on top (undo shows the
+    // saved scene); declining deletes the recovery and leaves the window empty.
+    void recoverOnTopOfTheSavedFile()
+    {
+        const QString rec = MainWindow::recoveryFilePath();
+        const QString file = m_dir.filePath("forest.sylva.json");
+        std::string saved, modified;
+        {
+            auto a = window();
+            QTest::qWait(1);
+            compose(*a);
+            QVERIFY(a->saveFile(file));
+            saved = json(a->document()->scene());
+            Scene s = a->document()->scene();
+            s.instances[1].scale = 1.7f;
+            s.sun.direction = sunDirection(25.0, 140.0);
+            a->document()->edit(s, "edit");
+            QVERIFY(a->autosaveNow());
+            modified = json(a->document()->scene());
+        }
+        QVERIFY(QFile::exists(rec));
+        QString origin;
+        auto b = window([&](const QString& o, const QDateTime&) {
+            origin = o;
+            return true;
+        });
+        QTRY_COMPARE(origin, QFileInfo(file).absoluteFilePath());
+        QCOMPARE(json(b->document()->scene()), modified);
+        QCOMPARE(b->document()->filePath(), QFileInfo(file).absoluteFilePath());
+        QVERIFY(b->document()->isModified());
+        b->document()->undoStack()->undo();
+        QCOMPARE(json(b->document()->scene()), saved);
+        QVERIFY(!b->document()->isModified());
+
+        // Declined: gone, nothing loaded.
+        b->document()->undoStack()->redo();
+        QVERIFY(b->autosaveNow());
+        b.reset();
+        QVERIFY(QFile::exists(rec));
+        bool asked = false;
+        auto c = window([&](const QString&, const QDateTime&) { return !(asked = true); });
+        QTRY_VERIFY(asked);
+        QVERIFY(!QFile::exists(rec));
+        QVERIFY(c->document()->scene().species.empty());
+        QVERIFY(!c->document()->isModified());
+        // A clean close deletes a recovery file too.
+        compose(*c);
+        QVERIFY(c->autosaveNow());
+        QVERIFY(QFile::exists(rec));
+        c->show();
+        QVERIFY(c->close());
+        QVERIFY(!QFile::exists(rec));
+    }
+};
+
+QTEST_MAIN(TstStudioTools)
+#include "tst_studio_tools.moc"
