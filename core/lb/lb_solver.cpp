@@ -61,12 +61,20 @@ struct CompactOmega8 {
 // Storage conversion of n contiguous values.
 inline void loadRow(const float* src, float* dst, int n) { std::memcpy(dst, src, size_t(n) * sizeof(float)); }
 inline void storeRow(const float* src, float* dst, int n) { std::memcpy(dst, src, size_t(n) * sizeof(float)); }
+// With n >= 8 a ragged end is one more vector ending at n, overlapping the last full one: the overlap
+// rewrites the same values, so no element takes the (slow) scalar conversion.
 inline void loadRow(const uint16_t* src, float* dst, int n)
 {
     int k = 0;
 #ifdef SYLVA_LB_F16C
-    for (; k + 8 <= n; k += 8)
-        _mm256_storeu_ps(dst + k, _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + k))));
+    auto one = [&](int at) {
+        _mm256_storeu_ps(dst + at, _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(src + at))));
+    };
+    for (; k + 8 <= n; k += 8) one(k);
+    if (k < n && n >= 8) {
+        one(n - 8);
+        k = n;
+    }
 #endif
     for (; k < n; ++k) dst[k] = halfToFloat(src[k]);
 }
@@ -74,9 +82,14 @@ inline void storeRow(const float* src, uint16_t* dst, int n)
 {
     int k = 0;
 #ifdef SYLVA_LB_F16C
-    for (; k + 8 <= n; k += 8)
-        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + k),
-                         _mm256_cvtps_ph(_mm256_loadu_ps(src + k), _MM_FROUND_TO_NEAREST_INT));
+    auto one = [&](int at) {
+        _mm_storeu_si128(reinterpret_cast<__m128i*>(dst + at), _mm256_cvtps_ph(_mm256_loadu_ps(src + at), _MM_FROUND_TO_NEAREST_INT));
+    };
+    for (; k + 8 <= n; k += 8) one(k);
+    if (k < n && n >= 8) {
+        one(n - 8);
+        k = n;
+    }
 #endif
     for (; k < n; ++k) dst[k] = floatToHalf(src[k]);
 }
@@ -225,8 +238,11 @@ public:
                                           Scratch& sc = m_scratch.local();
                                           if (sc.buf.size() != size_t(kDirections) * size_t(m_Zp))
                                               sc.buf.assign(size_t(kDirections) * size_t(m_Zp), 0.0f);
-                                          for (size_t j = range.begin(); j != range.end(); ++j)
-                                              processRow(size_t(x) * size_t(m_Y) + j, c, src, dst, sc, outMode);
+                                          for (size_t j = range.begin(); j != range.end(); ++j) {
+                                              const size_t r = size_t(x) * size_t(m_Y) + j;
+                                              if (j + 2 < range.end()) prefetchRow(r + 2, src, dst);   // two rows ahead: measured better than one
+                                              processRow(r, c, src, dst, sc, outMode);
+                                          }
                                       });
                 }
             }
@@ -246,6 +262,46 @@ public:
     {
         const double slab = double(m_Y) * m_Z * kDirections * sizeof(S);
         return std::clamp(int(12.0e6 / (2.0 * slab)) - 3, 1, 16);
+    }
+
+    // Starts every channel solve from the current state of `coarse`, the same solves on coarsen() of this
+    // grid: interior nodes interpolate the coarse distributions trilinearly at (i/2, j/2, k/2) (bilinear in
+    // x and y per coarse row, then linear in z); boundary nodes keep the boundary condition the
+    // constructor set. Only the current copy's interior is written: the first step overwrites the other
+    // copy's interior and its boundary already holds the boundary condition.
+    void prolongateFrom(const Solver<S>& coarse)
+    {
+        const int cX = coarse.m_X, cY = coarse.m_Y, cZ = coarse.m_Z;
+        for (size_t c = 0; c < m_fields.size(); ++c) {
+            const ChannelField<S>& cf = *coarse.m_fields[c];
+            const S* cs = cf.flip ? cf.b.data() : cf.a.data();
+            ChannelField<S>& field = *m_fields[c];
+            field.flip = false;
+            S* dst = field.a.data();
+            tbb::parallel_for(1, m_X - 1, [&](int i) {
+                std::vector<float> rows(4 * size_t(cZ), 0.0f), xy(size_t(cZ), 0.0f), out(size_t(m_Z), 0.0f);
+                const int I0 = std::min(i / 2, cX - 2);
+                const float fx = float(i) / 2.0f - float(I0);
+                for (int j = 1; j < m_Y - 1; ++j) {
+                    const int J0 = std::min(j / 2, cY - 2);
+                    const float fy = float(j) / 2.0f - float(J0);
+                    const float w[4] = {(1.0f - fx) * (1.0f - fy), (1.0f - fx) * fy, fx * (1.0f - fy), fx * fy};
+                    for (int m = 0; m < kDirections; ++m) {
+                        for (int q = 0; q < 4; ++q)
+                            loadRow(cs + coarse.dindex(I0 + (q >> 1), J0 + (q & 1), 0, m), rows.data() + size_t(q) * size_t(cZ), cZ);
+                        for (size_t K = 0; K < size_t(cZ); ++K)
+                            xy[K] = w[0] * rows[K] + w[1] * rows[size_t(cZ) + K] + w[2] * rows[2 * size_t(cZ) + K] +
+                                    w[3] * rows[3 * size_t(cZ) + K];
+                        for (int k = 1; k < m_Z - 1; ++k) {
+                            const int K0 = std::min(k / 2, cZ - 2);
+                            const float fz = float(k) / 2.0f - float(K0);
+                            out[size_t(k)] = (1.0f - fz) * xy[size_t(K0)] + fz * xy[size_t(K0) + 1];
+                        }
+                        storeRow(out.data() + 1, dst + dindex(i, j, 1, m), m_Z - 2);
+                    }
+                }
+            });
+        }
     }
 
     // Raw access to the current state of channel solve c (storage order, fp32 values).
@@ -291,10 +347,41 @@ private:
         return ((size_t(i) * size_t(m_Y) + size_t(j)) * kDirections + size_t(m)) * size_t(m_Z) + size_t(k);
     }
 
+    // Asks for the cache lines the next row will read (its 19 contiguous source rows) and write (one
+    // row segment in each neighbour): the stores miss the private caches otherwise and stall the loop.
+    void prefetchRow(size_t r, const S* src, S* dst) const
+    {
+        const int i = int(r / size_t(m_Y)), j = int(r % size_t(m_Y));
+        const char* s = reinterpret_cast<const char*>(src + dindex(i, j, 0, 0));
+        const size_t rowBytes = size_t(kDirections) * size_t(m_Z) * sizeof(S);
+        for (size_t b = 0; b < rowBytes; b += 64) __builtin_prefetch(s + b, 0, 3);
+        const size_t segBytes = size_t(m_Z) * sizeof(S);
+        for (int m = 0; m < kDirections; ++m) {
+            const int ti = i + kC[m][0], tj = j + kC[m][1];
+            if (ti < 1 || ti > m_X - 2 || tj < 1 || tj > m_Y - 2) continue;
+            const char* d = reinterpret_cast<const char*>(dst + dindex(ti, tj, 0, m));
+            for (size_t b = 0; b < segBytes; b += 64) __builtin_prefetch(d + b, 1, 3);
+        }
+    }
+
     void processRow(size_t r, size_t c, const S* src, S* dst, Scratch& s, int outMode)
     {
         ChannelField<S>& field = *m_fields[c];
         const int i = int(r / size_t(m_Y)), j = int(r % size_t(m_Y));
+        if (outMode == 0 && !m_rowActive[r]) {
+            // No medium in the row and no totals wanted: the values stream unchanged (f_0 zeroed), so
+            // they are copied in storage form, which is exactly what converting and back would give.
+            for (int m = 0; m < kDirections; ++m) {
+                const int ti = i + kC[m][0], tj = j + kC[m][1], cz = kC[m][2];
+                if (ti < 1 || ti > m_X - 2 || tj < 1 || tj > m_Y - 2) continue;
+                const int k0 = std::max(0, 1 - cz), k1 = std::min(m_Z - 1, m_Z - 2 - cz);
+                if (k1 < k0) continue;
+                S* d = dst + dindex(ti, tj, k0 + cz, m);
+                if (m == 0 && m_params.zeroF0) std::fill(d, d + (k1 - k0 + 1), toStorage<S>(0.0f));
+                else std::memcpy(d, src + dindex(i, j, k0, m), size_t(k1 - k0 + 1) * sizeof(S));
+            }
+            return;
+        }
         float* buf = s.buf.data();
         const size_t Zp = size_t(m_Zp);
         // 1. Load the row's 19 directions (z contiguous), padding to a multiple of 8 with zeros.
@@ -412,42 +499,6 @@ DensityGrid coarsen(const DensityGrid& fine)
     return c;
 }
 
-// Fine state from a coarse one: interior nodes interpolate the coarse distributions trilinearly at
-// (i/2, j/2, k/2); boundary nodes keep the boundary condition.
-std::vector<float> prolongate(const std::vector<float>& coarse, const glm::ivec3& cd, const glm::ivec3& fd,
-                              const std::vector<float>& bc)
-{
-    std::vector<float> fine(size_t(fd.x) * fd.y * fd.z * kDirections);
-    auto cidx = [&](int I, int J, int K, int m) {
-        return ((size_t(I) * size_t(cd.y) + size_t(J)) * kDirections + size_t(m)) * size_t(cd.z) + size_t(K);
-    };
-    tbb::parallel_for(0, fd.x, [&](int i) {
-        for (int j = 0; j < fd.y; ++j)
-            for (int m = 0; m < kDirections; ++m) {
-                float* row = &fine[((size_t(i) * size_t(fd.y) + size_t(j)) * kDirections + size_t(m)) * size_t(fd.z)];
-                const bool edgeRow = i == 0 || j == 0 || i == fd.x - 1 || j == fd.y - 1;
-                const int I0 = std::min(i / 2, cd.x - 2), J0 = std::min(j / 2, cd.y - 2);
-                const float fx = float(i) / 2.0f - float(I0), fy = float(j) / 2.0f - float(J0);
-                for (int k = 0; k < fd.z; ++k) {
-                    if (edgeRow || k == 0 || k == fd.z - 1) {
-                        row[k] = bc[size_t(m)];
-                        continue;
-                    }
-                    const int K0 = std::min(k / 2, cd.z - 2);
-                    const float fz = float(k) / 2.0f - float(K0);
-                    float v = 0.0f;
-                    for (int corner = 0; corner < 8; ++corner) {
-                        const int dx = corner >> 2, dy = (corner >> 1) & 1, dz = corner & 1;
-                        const float w = (dx ? fx : 1.0f - fx) * (dy ? fy : 1.0f - fy) * (dz ? fz : 1.0f - fz);
-                        v += w * coarse[cidx(I0 + dx, J0 + dy, K0 + dz, m)];
-                    }
-                    row[k] = v;
-                }
-            }
-    });
-    return fine;
-}
-
 struct StepResult {
     int steps = 0;
     bool converged = false;
@@ -488,30 +539,21 @@ StepResult runSteps(Solver<S>& solver, const LbParams& params, int steps, SolveS
     return r;
 }
 
-// The starting states of a coarse start for `solves` on `fine`: solved (to the tolerance) on the
-// coarsened grid, itself coarse-started while it has at least 32 nodes on its longest edge.
+// Coarse start: sets the state of `solver` (the `solves` on `fine`) from the same solves run to the
+// tolerance on the coarsened grid, itself coarse-started while it has at least 32 nodes on its
+// longest edge.
 template <typename S>
-std::vector<std::vector<float>> coarseStates(const DensityGrid& fine, const LbParams& params,
-                                             const std::vector<ChannelParams>& solves, SolveStats& stats)
+void coarseStart(Solver<S>& solver, const DensityGrid& fine, const LbParams& params, const std::vector<ChannelParams>& solves,
+                 SolveStats& stats)
 {
     const DensityGrid coarse = coarsen(fine);
-    Solver<S> solver(coarse, params, solves);
-    if (coarse.geometry.longestEdge() >= 32) {
-        const auto init = coarseStates<S>(coarse, params, solves, stats);
-        for (size_t s = 0; s < solves.size(); ++s) solver.setState(s, init[s]);
-    }
+    Solver<S> coarseSolver(coarse, params, solves);
+    if (coarse.geometry.longestEdge() >= 32) coarseStart(coarseSolver, coarse, params, solves, stats);
     SolveStats coarseStats;
     const int maxSteps = params.maxSteps > 0 ? params.maxSteps : 4 * coarse.geometry.longestEdge();
-    const StepResult r = runSteps(solver, params, maxSteps, coarseStats, [](int) {});
+    const StepResult r = runSteps(coarseSolver, params, maxSteps, coarseStats, [](int) {});
     stats.coarseSteps += r.steps + coarseStats.coarseSteps;
-    const std::vector<float> bc = boundaryDistribution(params.sun);
-    std::vector<std::vector<float>> out(solves.size());
-    std::vector<float> state;
-    for (size_t s = 0; s < solves.size(); ++s) {
-        solver.getState(s, state);
-        out[s] = prolongate(state, coarse.geometry.dims, fine.geometry.dims, bc);
-    }
-    return out;
+    solver.prolongateFrom(coarseSolver);
 }
 
 template <typename S>
@@ -568,10 +610,7 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
         const std::vector<ChannelParams> these(solves.begin() + long(g0), solves.begin() + long(std::min(solves.size(), g0 + group)));
         Solver<S> solver(density, params, these);
         solver.m_progress = progress;
-        if (params.coarseStart && tolMode && longest >= 32) {
-            const auto init = coarseStates<S>(density, params, these, stats);
-            for (size_t s = 0; s < these.size(); ++s) solver.setState(s, init[s]);
-        }
+        if (params.coarseStart && tolMode && longest >= 32) coarseStart(solver, density, params, these, stats);
         const double groupIndex = double(g0 / group);
         const StepResult r = runSteps(solver, params, steps, stats, [&](int done) {
             if (progress)
