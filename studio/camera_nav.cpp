@@ -56,6 +56,42 @@ CameraDesc zoomCamera(const CameraDesc& camera, double steps, double factor)
     return c;
 }
 
+CameraDesc flyLook(const CameraDesc& camera, double yawDeg, double pitchDeg)
+{
+    CameraDesc c = camera;
+    const glm::dvec3 view = c.target - c.position;
+    const double dist = glm::length(view);
+    if (!(dist > 0.0)) return c;
+    // Spherical angles of the view direction: yaw from +Z toward +X, pitch above the horizon. The
+    // camera's right is cross(view, up), i.e. toward decreasing yaw.
+    double yaw = std::atan2(view.x, view.z);
+    double pitch = std::asin(std::clamp(view.y / dist, -1.0, 1.0));
+    yaw -= yawDeg * kDegToRad;
+    pitch = std::clamp(pitch + pitchDeg * kDegToRad, -89.0 * kDegToRad, 89.0 * kDegToRad);
+    const glm::dvec3 dir(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+    c.target = c.position + dist * dir;
+    c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    return c;
+}
+
+CameraDesc flyMove(const CameraDesc& camera, double right, double up, double forward)
+{
+    CameraDesc c = camera;
+    const glm::dvec3 view = c.target - c.position;
+    const double dist = glm::length(view);
+    if (!(dist > 0.0)) return c;
+    const glm::dvec3 f = view / dist;
+    glm::dvec3 r = glm::cross(f, glm::dvec3(0.0, 1.0, 0.0));
+    // Looking straight up or down: the right axis from the camera's own up vector.
+    if (!(glm::length(r) > 1e-9)) r = glm::cross(f, glm::dvec3(c.up));
+    if (!(glm::length(r) > 1e-9)) return c;
+    r = glm::normalize(r);
+    const glm::dvec3 move = right * r + up * glm::dvec3(0.0, 1.0, 0.0) + forward * f;
+    c.position += move;
+    c.target += move;
+    return c;
+}
+
 void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg)
 {
     const glm::dvec3 d = glm::normalize(glm::dvec3(direction));

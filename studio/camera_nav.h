@@ -17,6 +17,15 @@ CameraDesc panCamera(const CameraDesc& camera, double dx, double dy, double view
 // stays above 1 cm.
 CameraDesc zoomCamera(const CameraDesc& camera, double steps, double factor = 0.85);
 
+// Fly navigation: turns the view about the eye. yawDeg > 0 turns toward the camera's right (about
+// world +Y), pitchDeg > 0 looks up; the pitch stays within 1 degree of the poles. The eye stays put,
+// the target stays at the same distance ahead of it.
+CameraDesc flyLook(const CameraDesc& camera, double yawDeg, double pitchDeg);
+
+// Fly navigation: moves eye and target together by `right` metres along the camera's right axis
+// (horizontal), `up` metres along world +Y and `forward` metres along the view direction.
+CameraDesc flyMove(const CameraDesc& camera, double right, double up, double forward);
+
 // Elevation and azimuth (degrees, scene.h's convention) of a direction toward the sun.
 void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg);
 

@@ -403,6 +403,19 @@ void MainWindow::buildActions()
 
     m_viewMenu = menuBar()->addMenu(tr("&View"));
     for (QDockWidget* d : findChildren<QDockWidget*>()) m_viewMenu->addAction(d->toggleViewAction());
+    m_viewMenu->addSeparator();
+    // F in the viewport toggles it too (a window-wide F shortcut would eat the key in text fields).
+    QAction* fly = m_viewMenu->addAction(tr("&Fly Navigation (F in the viewport)"));
+    fly->setObjectName("actionFly");
+    fly->setCheckable(true);
+    connect(fly, &QAction::toggled, m_viewport, &Viewport::setFlyMode);
+    connect(m_viewport, &Viewport::flyModeChanged, this, [this, fly](bool on) {
+        const QSignalBlocker block(fly);
+        fly->setChecked(on);
+        statusBar()->showMessage(on ? tr("Fly: W/S forward/back, A/D left/right, Q/E down/up (Shift: faster), drag to look; F: back to orbit")
+                                    : tr("Orbit: drag to orbit, Shift+drag or middle drag to pan, wheel to zoom"),
+                                 on ? 0 : 4000);
+    });
 
     QMenu* help = menuBar()->addMenu(tr("&Help"));
     add(help, tr("&About Sylva Studio"), "actionAbout", QKeySequence(), [this] {

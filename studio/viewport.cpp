@@ -2,6 +2,7 @@
 #include "studio/viewport.h"
 
 #include <QDateTime>
+#include <QKeyEvent>
 #include <QMouseEvent>
 #include <QOpenGLContext>
 #include <QOpenGLShaderProgram>
@@ -177,7 +178,7 @@ void Viewport::mousePressEvent(QMouseEvent* event)
     const bool pan = event->button() == Qt::MiddleButton ||
                      (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ShiftModifier));
     if (pan) m_drag = Drag::Pan;
-    else if (event->button() == Qt::LeftButton) m_drag = Drag::Orbit;
+    else if (event->button() == Qt::LeftButton) m_drag = m_fly ? Drag::Look : Drag::Orbit;
     else return;
     m_dragStart = event->position().toPoint();
     m_dragCamera = m_scene.camera;
@@ -189,8 +190,12 @@ void Viewport::mouseMoveEvent(QMouseEvent* event)
 {
     if (m_drag == Drag::None) return;
     const QPoint d = event->position().toPoint() - m_dragStart;
-    CameraDesc c = m_drag == Drag::Orbit ? orbitCamera(m_dragCamera, -0.4 * d.x(), 0.4 * d.y())
-                                         : panCamera(m_dragCamera, d.x(), d.y(), height());
+    CameraDesc c;
+    switch (m_drag) {
+    case Drag::Orbit: c = orbitCamera(m_dragCamera, -0.4 * d.x(), 0.4 * d.y()); break;
+    case Drag::Look: c = flyLook(m_dragCamera, 0.3 * d.x(), -0.3 * d.y()); break;
+    default: c = panCamera(m_dragCamera, d.x(), d.y(), height()); break;
+    }
     Q_EMIT cameraEdited(c, m_dragKey);
     event->accept();
 }
@@ -211,6 +216,51 @@ void Viewport::wheelEvent(QWheelEvent* event)
     if (m_wheelKey == 0 || now - m_lastWheelMs > 500) m_wheelKey = SceneDocument::newMergeKey();
     m_lastWheelMs = now;
     Q_EMIT cameraEdited(zoomCamera(m_scene.camera, steps), m_wheelKey);
+    event->accept();
+}
+
+} // namespace sylva
+
+namespace sylva {
+
+void Viewport::setFlyMode(bool on)
+{
+    if (m_fly == on) return;
+    m_fly = on;
+    m_flyKey = 0;
+    Q_EMIT flyModeChanged(on);
+}
+
+double Viewport::flyStep() const { return std::max(0.05, 0.05 * glm::length(m_scene.camera.target - m_scene.camera.position)); }
+
+void Viewport::keyPressEvent(QKeyEvent* event)
+{
+    const Qt::KeyboardModifiers mods = event->modifiers() & ~(Qt::KeypadModifier | Qt::ShiftModifier);
+    if (event->key() == Qt::Key_F && mods == Qt::NoModifier && !event->isAutoRepeat()) {
+        setFlyMode(!m_fly);
+        event->accept();
+        return;
+    }
+    double right = 0.0, up = 0.0, forward = 0.0;
+    switch (event->key()) {
+    case Qt::Key_W: forward = 1.0; break;
+    case Qt::Key_S: forward = -1.0; break;
+    case Qt::Key_D: right = 1.0; break;
+    case Qt::Key_A: right = -1.0; break;
+    case Qt::Key_E: up = 1.0; break;
+    case Qt::Key_Q: up = -1.0; break;
+    default: break;
+    }
+    if (!m_fly || mods != Qt::NoModifier || (right == 0.0 && up == 0.0 && forward == 0.0)) {
+        QOpenGLWidget::keyPressEvent(event);
+        return;
+    }
+    const double step = flyStep() * ((event->modifiers() & Qt::ShiftModifier) ? 5.0 : 1.0);
+    // Presses (and auto-repeats) less than half a second apart are one undo step.
+    const qint64 now = QDateTime::currentMSecsSinceEpoch();
+    if (m_flyKey == 0 || now - m_lastFlyMs > 500) m_flyKey = SceneDocument::newMergeKey();
+    m_lastFlyMs = now;
+    Q_EMIT cameraEdited(flyMove(m_scene.camera, right * step, up * step, forward * step), m_flyKey);
     event->accept();
 }
 

@@ -44,11 +44,19 @@ public:
 
     QSize sizeHint() const override { return {800, 450}; }
 
+    // Fly navigation (toggle: F in the viewport): W/S forward/back, A/D left/right, Q/E down/up, each
+    // press flyStep() metres (Shift: 5x); left drag looks around the eye. Off: left drag orbits.
+    bool flyMode() const { return m_fly; }
+    void setFlyMode(bool on);
+    // Metres per key press: 5% of the eye-target distance, at least 5 cm.
+    double flyStep() const;
+
 Q_SIGNALS:
     // Navigation changed the camera; consecutive events of one gesture share mergeKey.
     void cameraEdited(const sylva::CameraDesc& camera, int mergeKey);
     void imageShown(int pass, bool last, double seconds);
     void renderFailed(const QString& message);
+    void flyModeChanged(bool on);
 
 protected:
     void initializeGL() override;
@@ -58,6 +66,7 @@ protected:
     void mouseMoveEvent(QMouseEvent* event) override;
     void mouseReleaseEvent(QMouseEvent* event) override;
     void wheelEvent(QWheelEvent* event) override;
+    void keyPressEvent(QKeyEvent* event) override;
 
 private:
     void cleanupGL();
@@ -77,13 +86,16 @@ private:
     bool m_awaitingFirst = false;
 
     // navigation
-    enum class Drag { None, Orbit, Pan };
+    enum class Drag { None, Orbit, Pan, Look };
     Drag m_drag = Drag::None;
     QPoint m_dragStart;
     CameraDesc m_dragCamera;
     int m_dragKey = 0;
     int m_wheelKey = 0;
     qint64 m_lastWheelMs = 0;
+    bool m_fly = false;
+    int m_flyKey = 0;
+    qint64 m_lastFlyMs = 0;
 
     // GL (hellogl2 pattern: created in initializeGL, freed on aboutToBeDestroyed)
     QOpenGLShaderProgram* m_program = nullptr;

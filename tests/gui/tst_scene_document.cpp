@@ -241,6 +241,47 @@ private Q_SLOTS:
         sunAngles(sunDirection(35.0, 250.0), &el, &az);
         QVERIFY(std::abs(el - 35.0) < 1e-4 && std::abs(az - 250.0) < 1e-4);
     }
+
+    // Fly navigation: looking turns the view about a fixed eye, moving carries eye and target along
+    // the camera's own axes. Expected values worked out by hand for a camera at (1, 2, -10) looking
+    // down +Z (its right is -X: right = view x up).
+    void flyNavigation()
+    {
+        CameraDesc c;
+        c.position = {1.0, 2.0, -10.0};
+        c.target = {1.0, 2.0, -6.0};   // 4 m ahead along +Z
+        auto near = [](const glm::dvec3& a, const glm::dvec3& b) { return glm::length(a - b) < 1e-9; };
+
+        // Turn right 90 degrees: now looking down -X, same eye, same distance.
+        const CameraDesc r = flyLook(c, 90.0, 0.0);
+        QVERIFY(near(r.position, c.position));
+        QVERIFY2(near(r.target, {-3.0, 2.0, -10.0}), qPrintable(QString("%1 %2 %3").arg(r.target.x).arg(r.target.y).arg(r.target.z)));
+        // Turn left 90: +X.
+        QVERIFY(near(flyLook(c, -90.0, 0.0).target, {5.0, 2.0, -10.0}));
+        // Look up 30 degrees: the target rises by 4 sin 30 and comes in to 4 cos 30.
+        const CameraDesc u = flyLook(c, 0.0, 30.0);
+        QVERIFY(near(u.target, {1.0, 2.0 + 2.0, -10.0 + 4.0 * std::cos(30.0 * 3.14159265358979323846 / 180.0)}));
+        // Never over the pole.
+        const CameraDesc top = flyLook(c, 0.0, 500.0);
+        const glm::dvec3 v = glm::normalize(top.target - top.position);
+        QVERIFY(std::abs(std::asin(v.y) * 180.0 / 3.14159265358979323846 - 89.0) < 1e-9);
+        // Look is reversible.
+        QVERIFY(near(flyLook(flyLook(c, 37.0, 0.0), -37.0, 0.0).target, c.target));
+
+        // Forward 2 m, right 1 m, up 0.5 m: eye and target by the same vector.
+        const CameraDesc m = flyMove(c, 1.0, 0.5, 2.0);
+        QVERIFY(near(m.position, {0.0, 2.5, -8.0}));
+        QVERIFY(near(m.target - m.position, c.target - c.position));
+        // Looking up 30 degrees, forward goes up the view line; up stays world up.
+        const CameraDesc mu = flyMove(u, 0.0, 1.0, 2.0);
+        QVERIFY(near(mu.position - u.position, 2.0 * glm::normalize(u.target - u.position) + glm::dvec3(0.0, 1.0, 0.0)));
+        // Straight down: the right axis comes from the camera's up vector, nothing degenerates.
+        CameraDesc down = c;
+        down.target = c.position + glm::dvec3(0.0, -3.0, 0.0);
+        down.up = glm::vec3(0.0f, 0.0f, 1.0f);
+        const CameraDesc md = flyMove(down, 1.0, 0.0, 0.0);
+        QVERIFY(std::abs(glm::length(md.position - down.position) - 1.0) < 1e-9);
+    }
 };
 
 QTEST_MAIN(TstSceneDocument)

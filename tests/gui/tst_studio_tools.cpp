@@ -1,10 +1,12 @@
-// The studio's editing tools under Xvfb: autosave and crash recovery.
+// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation.
+#include <QAction>
 #include <QDir>
 #include <QFile>
 
 #include <memory>
 
 #include "pipeline/scene/scene_file.h"
+#include "studio/camera_nav.h"
 #include "studio/scene_document.h"
 #include "studio_test_util.h"
 
@@ -153,6 +155,63 @@ private Q_SLOTS:
         c->show();
         QVERIFY(c->close());
         QVERIFY(!QFile::exists(rec));
+    }
+
+    // F toggles fly mode in the viewport; W/A/S/D/Q/E move by flyStep along the camera's axes (a burst
+    // of presses is one undo step); a left drag looks around the fixed eye; F again: orbit.
+    void flyNavigationInTheViewport()
+    {
+        auto w = window();
+        w->resize(900, 600);
+        w->show();
+        QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+        compose(*w);
+        Viewport* v = w->viewport();
+        v->setFocus();
+        const auto cam = [&] { return w->document()->scene().camera; };
+        auto near = [](const glm::dvec3& a, const glm::dvec3& b) { return glm::length(a - b) < 1e-9; };
+        QAction* flyAction = w->findChild<QAction*>("actionFly");
+        QVERIFY(flyAction && !flyAction->isChecked());
+        QTest::keyClick(v, Qt::Key_F);
+        QVERIFY(v->flyMode());
+        QVERIFY(flyAction->isChecked());
+
+        const CameraDesc c0 = cam();
+        const int index0 = w->document()->undoStack()->index();
+        const double step = v->flyStep();
+        QCOMPARE(step, std::max(0.05, 0.05 * glm::length(c0.target - c0.position)));
+        QTest::keyClick(v, Qt::Key_W);
+        QTest::keyClick(v, Qt::Key_W);
+        QTest::keyClick(v, Qt::Key_D);
+        QTest::keyClick(v, Qt::Key_E, Qt::ShiftModifier);
+        const CameraDesc want = flyMove(flyMove(flyMove(flyMove(c0, 0, 0, step), 0, 0, step), step, 0, 0), 0, 5 * step, 0);
+        QVERIFY(near(cam().position, want.position));
+        QVERIFY(near(cam().target, want.target));
+        QCOMPARE(w->document()->undoStack()->index(), index0 + 1);   // one burst, one step
+        w->document()->undoStack()->undo();
+        QCOMPARE(cam().position, c0.position);
+        QCOMPARE(cam().target, c0.target);
+
+        // Mouse look: 60 px right turns 18 degrees right about the eye.
+        const QPoint at = v->rect().center();
+        QTest::mousePress(v, Qt::LeftButton, {}, at);
+        QTest::mouseMove(v, at + QPoint(30, 0));
+        QTest::mouseRelease(v, Qt::LeftButton, {}, at + QPoint(60, 0));
+        QCOMPARE(cam().position, c0.position);
+        QVERIFY(near(cam().target, flyLook(c0, 18.0, 0.0).target));
+        QCOMPARE(w->document()->undoStack()->index(), index0 + 1);
+
+        // Back to orbit (through the menu action): keys move nothing, a drag moves the eye.
+        flyAction->trigger();
+        QVERIFY(!v->flyMode());
+        const CameraDesc c1 = cam();
+        QTest::keyClick(v, Qt::Key_W);
+        QCOMPARE(cam().position, c1.position);
+        QTest::mousePress(v, Qt::LeftButton, {}, at);
+        QTest::mouseRelease(v, Qt::LeftButton, {}, at + QPoint(40, 0));
+        QVERIFY(cam().position != c1.position);
+        QCOMPARE(cam().target, c1.target);
+        w->document()->undoStack()->setClean();
     }
 };
 
