@@ -1,6 +1,7 @@
 // GrowDialog and ExportDialog: forms over GrowSpec and the export settings.
 #include "studio/dialogs.h"
 
+#include <QCheckBox>
 #include <QComboBox>
 #include <QDialogButtonBox>
 #include <QDoubleSpinBox>
@@ -88,6 +89,81 @@ ExportDialog::ExportDialog(const ExportSettings& initial, QWidget* parent) : QDi
 ExportSettings ExportDialog::settings() const
 {
     return {m_path->text(), m_width->value(), m_height->value(), m_spp->value()};
+}
+
+ScatterDialog::ScatterDialog(const QStringList& speciesNames, const ScatterSpec& initial, QWidget* parent)
+    : QDialog(parent), m_height(initial.height)
+{
+    setWindowTitle(tr("Scatter Instances"));
+    auto* form = new QFormLayout(this);
+    m_species = new QComboBox;
+    m_species->addItems(speciesNames);
+    m_species->setCurrentIndex(std::min<int>(int(initial.species), int(speciesNames.size()) - 1));
+    m_count = new QSpinBox;
+    m_count->setRange(1, 100000);
+    m_count->setValue(std::max(1, initial.count));
+    auto metres = [](double v) {
+        auto* b = new QDoubleSpinBox;
+        b->setRange(-1e6, 1e6);
+        b->setDecimals(2);
+        b->setSuffix(QObject::tr(" m"));
+        b->setValue(v);
+        return b;
+    };
+    m_x0 = metres(initial.min.x);
+    m_x1 = metres(initial.max.x);
+    m_z0 = metres(initial.min.y);
+    m_z1 = metres(initial.max.y);
+    auto pair = [](QWidget* a, QWidget* b) {
+        auto* w = new QWidget;
+        auto* l = new QHBoxLayout(w);
+        l->setContentsMargins(0, 0, 0, 0);
+        l->addWidget(a);
+        l->addWidget(b);
+        return w;
+    };
+    m_rotate = new QCheckBox(tr("random rotation about the up axis"));
+    m_rotate->setChecked(initial.randomRotation);
+    auto scale = [](float v) {
+        auto* b = new QDoubleSpinBox;
+        b->setRange(0.01, 100.0);
+        b->setDecimals(2);
+        b->setSingleStep(0.05);
+        b->setValue(double(v));
+        return b;
+    };
+    m_s0 = scale(initial.scaleMin);
+    m_s1 = scale(initial.scaleMax);
+    m_seed = new QSpinBox;
+    m_seed->setRange(0, 1 << 30);
+    m_seed->setValue(int(std::min<uint64_t>(initial.seed, 1u << 30)));
+    form->addRow(tr("Species"), m_species);
+    form->addRow(tr("Count"), m_count);
+    form->addRow(tr("X from / to"), pair(m_x0, m_x1));
+    form->addRow(tr("Z from / to"), pair(m_z0, m_z1));
+    form->addRow(tr("Rotation"), m_rotate);
+    form->addRow(tr("Scale from / to"), pair(m_s0, m_s1));
+    form->addRow(tr("Seed"), m_seed);
+    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
+    connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
+    connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
+    form->addRow(buttons);
+}
+
+ScatterSpec ScatterDialog::spec() const
+{
+    ScatterSpec s;
+    s.species = uint32_t(std::max(0, m_species->currentIndex()));
+    s.count = m_count->value();
+    // Corners in either order; scale range likewise.
+    s.min = {std::min(m_x0->value(), m_x1->value()), std::min(m_z0->value(), m_z1->value())};
+    s.max = {std::max(m_x0->value(), m_x1->value()), std::max(m_z0->value(), m_z1->value())};
+    s.height = m_height;
+    s.randomRotation = m_rotate->isChecked();
+    s.scaleMin = float(std::min(m_s0->value(), m_s1->value()));
+    s.scaleMax = float(std::max(m_s0->value(), m_s1->value()));
+    s.seed = uint64_t(m_seed->value());
+    return s;
 }
 
 } // namespace sylva

@@ -1,10 +1,12 @@
-// Small modal dialogs: grow a species, export a render.
+// Small modal dialogs: grow a species, export a render, scatter instances.
 #pragma once
 
 #include <QDialog>
 
 #include "core/scene/scene.h"
+#include "pipeline/scene/scatter.h"
 
+class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLineEdit;
@@ -45,6 +47,33 @@ private:
     QSpinBox* m_width;
     QSpinBox* m_height;
     QSpinBox* m_spp;
+};
+
+// Scatter tool: species, count, rectangle (x and z ranges), random rotation about up, scale range, seed.
+class ScatterDialog : public QDialog {
+    Q_OBJECT
+
+public:
+    // speciesNames: the scene's species in order; initial: the form's starting values.
+    ScatterDialog(const QStringList& speciesNames, const ScatterSpec& initial, QWidget* parent = nullptr);
+    ScatterSpec spec() const;
+
+    QComboBox* speciesBox() const { return m_species; }
+    QSpinBox* countBox() const { return m_count; }
+    QSpinBox* seedBox() const { return m_seed; }
+
+private:
+    QComboBox* m_species;
+    QSpinBox* m_count;
+    QDoubleSpinBox* m_x0;
+    QDoubleSpinBox* m_x1;
+    QDoubleSpinBox* m_z0;
+    QDoubleSpinBox* m_z1;
+    QCheckBox* m_rotate;
+    QDoubleSpinBox* m_s0;
+    QDoubleSpinBox* m_s1;
+    QSpinBox* m_seed;
+    double m_height;
 };
 
 } // namespace sylva

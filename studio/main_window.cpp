@@ -388,6 +388,7 @@ void MainWindow::buildActions()
     edit->addAction(redo);
     edit->addSeparator();
     add(edit, tr("&Delete"), "actionDelete", QKeySequence::Delete, [this] { deleteSelection(); });
+    add(edit, tr("&Scatter Instances..."), "actionScatter", QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_T), [this] { scatterDialog(); });
 
     QMenu* render = menuBar()->addMenu(tr("&Render"));
     add(render, tr("Compute &Lighting"), "actionLight", QKeySequence(Qt::CTRL | Qt::Key_L), [this] { computeLighting(); });
@@ -880,6 +881,72 @@ Job* MainWindow::exportSpeciesGrids(int species, const QString& folder)
                              else if (job->state() == Job::State::Failed) reportError(tr("Export failed"), job->error());
                              else appendLog(tr("grid export cancelled"));
                          });
+}
+
+ScatterSpec MainWindow::defaultScatter() const
+{
+    const Scene& s = m_doc->scene();
+    ScatterSpec spec;
+    spec.species = uint32_t(std::max(0, selectedSpecies()));
+    spec.count = 100;
+    spec.height = s.ground.height;
+    spec.scaleMin = 0.8f;
+    spec.scaleMax = 1.2f;
+    if (!s.instances.empty()) {
+        glm::dvec2 lo(1e300), hi(-1e300);
+        for (const InstanceDesc& in : s.instances) {
+            lo = glm::min(lo, glm::dvec2(in.position.x, in.position.z));
+            hi = glm::max(hi, glm::dvec2(in.position.x, in.position.z));
+        }
+        const glm::dvec2 pad(10.0);
+        spec.min = lo - pad;
+        spec.max = hi + pad;
+    }
+    return spec;
+}
+
+bool MainWindow::scatter(const ScatterSpec& spec)
+{
+    Scene s = m_doc->scene();
+    if (spec.species >= s.species.size()) {
+        reportError(tr("Scatter failed"), tr("Species %1 does not exist; grow or import one first.").arg(spec.species));
+        return false;
+    }
+    std::vector<InstanceDesc> added;
+    try {
+        added = scatterInstances(spec);
+    } catch (const std::exception& e) {
+        reportError(tr("Scatter failed"), QString::fromStdString(e.what()));
+        return false;
+    }
+    if (added.empty()) return false;
+    const bool first = s.instances.empty();
+    s.instances.insert(s.instances.end(), added.begin(), added.end());
+    if (first) {
+        Bounds3 b;
+        b.extend({float(spec.min.x), float(spec.height), float(spec.min.y)});
+        b.extend({float(spec.max.x), float(spec.height) + 5.0f, float(spec.max.y)});
+        s.camera = framingCamera(s.camera, b);
+    }
+    m_doc->edit(s, tr("Scatter %n instance(s) of %1", nullptr, spec.count).arg(QString::fromStdString(s.species[spec.species].name)));
+    appendLog(tr("scattered %1 instances of %2 (seed %3)")
+                  .arg(spec.count)
+                  .arg(QString::fromStdString(s.species[spec.species].name))
+                  .arg(spec.seed));
+    return true;
+}
+
+void MainWindow::scatterDialog()
+{
+    const Scene& s = m_doc->scene();
+    if (s.species.empty()) {
+        reportError(tr("Scatter failed"), tr("The scene has no species: grow or import one first."));
+        return;
+    }
+    QStringList names;
+    for (const SpeciesDesc& sp : s.species) names << QString::fromStdString(sp.name);
+    ScatterDialog d(names, defaultScatter(), this);
+    if (d.exec() == QDialog::Accepted) scatter(d.spec());
 }
 
 void MainWindow::deleteSelection()

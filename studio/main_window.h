@@ -109,6 +109,12 @@ public:
     static QString gridFileBase(const QString& speciesName);
     // Edit
     void deleteSelection();
+    // Adds spec.count instances of a species scattered over a rectangle (scatterInstances) as one undo
+    // step; false (and an error report) for a bad spec or species.
+    bool scatter(const ScatterSpec& spec);
+    // The scatter form's starting values: the selected species, 100 instances over the instances'
+    // footprint (20 m around the origin when there are none) on the ground.
+    ScatterSpec defaultScatter() const;
     // The species the outliner selection points at (a species row, or an instance's species); -1 if none.
     int selectedSpecies() const;
     // Lighting volume inspector: loads the species' density and lighting grids (the lighting job's
@@ -150,6 +156,7 @@ private:
     void growDialog();
     void exportDialog();
     void exportGridsDialog();
+    void scatterDialog();
 
     SceneDocument* m_doc;
     JobManager* m_jobs;

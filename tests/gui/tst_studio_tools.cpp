@@ -1,9 +1,10 @@
-// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation.
+// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation, scatter.
 #include <QAction>
 #include <QDir>
 #include <QFile>
 
 #include <memory>
+#include <set>
 
 #include "pipeline/scene/scene_file.h"
 #include "studio/camera_nav.h"
@@ -211,6 +212,94 @@ private Q_SLOTS:
         QTest::mouseRelease(v, Qt::LeftButton, {}, at + QPoint(40, 0));
         QVERIFY(cam().position != c1.position);
         QCOMPARE(cam().target, c1.target);
+        w->document()->undoStack()->setClean();
+    }
+
+    // Edit > Scatter: count instances inside the rectangle, on the ground, rotations and scales in
+    // range, as ONE undo step; the same seed gives the same instances, another seed others; a bad
+    // spec changes nothing; the dialog's form gives back what it was given.
+    void scatterIsOneUndoStep()
+    {
+        auto w = window();
+        QStringList errors;
+        w->setErrorReporter([&](const QString&, const QString& m) { errors << m; });
+        compose(*w);
+        Scene base = w->document()->scene();
+        base.ground.height = -0.5;
+        w->document()->edit(base, "ground");
+        const std::string before = json(base);
+        const int index0 = w->document()->undoStack()->index();
+
+        ScatterSpec spec;
+        spec.species = 0;
+        spec.count = 250;
+        spec.min = {-20.0, 5.0};
+        spec.max = {30.0, 9.0};
+        spec.height = base.ground.height;
+        spec.scaleMin = 0.7f;
+        spec.scaleMax = 1.3f;
+        spec.seed = 11;
+        QVERIFY(w->scatter(spec));
+        const Scene after = w->document()->scene();
+        QCOMPARE(after.instances.size(), base.instances.size() + 250);
+        QCOMPARE(w->document()->undoStack()->index(), index0 + 1);
+        for (size_t i = 0; i < base.instances.size(); ++i) QCOMPARE(after.instances[i].position, base.instances[i].position);
+        double minX = 1e9, maxX = -1e9;
+        std::set<float> rotations;
+        for (size_t i = base.instances.size(); i < after.instances.size(); ++i) {
+            const InstanceDesc& in = after.instances[i];
+            QCOMPARE(in.species, 0u);
+            QVERIFY(in.position.x >= -20.0 && in.position.x <= 30.0);
+            QVERIFY(in.position.z >= 5.0 && in.position.z <= 9.0);
+            QCOMPARE(in.position.y, -0.5);
+            QVERIFY(in.scale >= 0.7f && in.scale <= 1.3f);
+            QVERIFY(in.rotationDeg.y >= 0.0f && in.rotationDeg.y < 360.0f);
+            minX = std::min(minX, in.position.x);
+            maxX = std::max(maxX, in.position.x);
+            rotations.insert(in.rotationDeg.y);
+        }
+        QVERIFY(maxX - minX > 40.0);   // spread over the area, not piled up
+        QVERIFY(rotations.size() > 200);
+
+        // One undo removes all 250; the same seed again gives the same scene.
+        w->document()->undoStack()->undo();
+        QCOMPARE(json(w->document()->scene()), before);
+        QVERIFY(w->scatter(spec));
+        QCOMPARE(json(w->document()->scene()), json(after));
+        w->document()->undoStack()->undo();
+        spec.seed = 12;
+        QVERIFY(w->scatter(spec));
+        QVERIFY(json(w->document()->scene()) != json(after));
+        QCOMPARE(w->document()->scene().instances.size(), after.instances.size());
+        w->document()->undoStack()->undo();
+
+        // Bad specs: an error, no change.
+        ScatterSpec bad = spec;
+        bad.scaleMin = 0.0f;
+        QVERIFY(!w->scatter(bad));
+        bad = spec;
+        bad.species = 3;
+        QVERIFY(!w->scatter(bad));
+        QCOMPARE(errors.size(), 2);
+        QCOMPARE(json(w->document()->scene()), before);
+        QCOMPARE(w->document()->undoStack()->index(), index0);
+
+        // The form: what it is given comes back; corners typed in either order.
+        ScatterSpec init = w->defaultScatter();
+        QCOMPARE(init.height, -0.5);
+        QVERIFY(init.min.x < -1.0 && init.max.x > 1.0);   // around the instances
+        init.count = 33;
+        init.seed = 99;
+        init.min = {8.0, -3.0};
+        init.max = {2.0, 4.0};
+        ScatterDialog d({"shrub 3", "other"}, init);
+        const ScatterSpec got = d.spec();
+        QCOMPARE(got.count, 33);
+        QCOMPARE(got.seed, uint64_t(99));
+        QCOMPARE(got.species, 0u);
+        QCOMPARE(got.min, glm::dvec2(2.0, -3.0));
+        QCOMPARE(got.max, glm::dvec2(8.0, 4.0));
+        QCOMPARE(got.height, -0.5);
         w->document()->undoStack()->setClean();
     }
 };

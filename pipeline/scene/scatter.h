@@ -1,0 +1,29 @@
+// Scatter: many instances of one species placed at random over a rectangle of the ground, for
+// approximate instancing (the studio's scatter tool). Deterministic per seed on every platform.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/scene/scene.h"
+
+namespace sylva {
+
+struct ScatterSpec {
+    uint32_t species = 0;                  // index into Scene::species
+    int count = 100;                       // instances to add, >= 0
+    glm::dvec2 min{-10.0, -10.0};          // world x, z of the rectangle's corners, metres (min <= max)
+    glm::dvec2 max{10.0, 10.0};
+    double height = 0.0;                   // world y of every instance (the ground's height)
+    bool randomRotation = true;            // rotation about +Y uniform in [0, 360) degrees; off: 0
+    float scaleMin = 1.0f, scaleMax = 1.0f;   // uniform scale in [scaleMin, scaleMax], 0 < min <= max
+    uint64_t seed = 1;
+};
+
+// The instances a spec describes: x uniform in [min.x, max.x], z in [min.y, max.y], y = height,
+// rotation (0, r, 0), scale as given. The same spec gives the same instances (splitmix64, no
+// standard-library distributions). Throws Error naming the bad field (negative count, min > max,
+// a scale <= 0 or min > max, non-finite values).
+std::vector<InstanceDesc> scatterInstances(const ScatterSpec& spec);
+
+} // namespace sylva
