@@ -5,6 +5,7 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QCheckBox>
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
@@ -123,6 +124,18 @@ MainWindow::MainWindow(QWidget* parent)
         m_modeBox->addItem(QString::fromLatin1(renderModeName(m)), int(m));
     m_modeBox->setToolTip(tr("full = sun + LB indirect; local = sun only; ambient = sun + constant; lb = indirect only"));
     bar->addWidget(m_modeBox);
+    bar->addSeparator();
+    m_compareToggle = new QCheckBox(tr("Compare with"));
+    m_compareToggle->setObjectName("compareToggle");
+    m_compareToggle->setToolTip(tr("Side by side: the left half in the mode on the left, the right half in this mode, from one trace"));
+    bar->addWidget(m_compareToggle);
+    m_compareBox = new QComboBox;
+    m_compareBox->setObjectName("compareMode");
+    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
+        m_compareBox->addItem(QString::fromLatin1(renderModeName(m)), int(m));
+    m_compareBox->setCurrentIndex(m_compareBox->findData(int(RenderMode::Lb)));
+    m_compareBox->setEnabled(false);
+    bar->addWidget(m_compareBox);
     cl->addWidget(bar);
     m_viewport = new Viewport;
     cl->addWidget(m_viewport, 1);
@@ -132,6 +145,8 @@ MainWindow::MainWindow(QWidget* parent)
         s.render.mode = RenderMode(m_modeBox->itemData(index).toInt());
         m_doc->edit(s, tr("Render mode %1").arg(m_modeBox->itemText(index)));
     });
+    connect(m_compareToggle, &QCheckBox::toggled, this, [this] { updateCompare(); });
+    connect(m_compareBox, &QComboBox::currentIndexChanged, this, [this] { updateCompare(); });
     connect(m_viewport, &Viewport::cameraEdited, this, [this](const CameraDesc& camera, int key) {
         Scene s = m_doc->scene();
         s.camera = camera;
@@ -552,7 +567,21 @@ void MainWindow::onDocumentChanged(ScenePart parts)
         refreshInspector();
 }
 
-bool MainWindow::viewNeedsLighting() const { return modeNeedsLighting(m_doc->scene().render.mode); }
+bool MainWindow::viewNeedsLighting() const
+{
+    const std::optional<RenderMode> compare = m_viewport->compare();
+    return modeNeedsLighting(m_doc->scene().render.mode) || (compare && modeNeedsLighting(*compare));
+}
+
+void MainWindow::updateCompare()
+{
+    m_compareBox->setEnabled(m_compareToggle->isChecked());
+    const std::optional<RenderMode> mode =
+        m_compareToggle->isChecked() ? std::optional<RenderMode>(RenderMode(m_compareBox->currentData().toInt())) : std::nullopt;
+    if (mode == m_viewport->compare()) return;
+    m_viewport->setCompare(mode);
+    updateViewport();   // the second mode may need lighting the first does not
+}
 
 void MainWindow::updateViewport()
 {

@@ -6,6 +6,7 @@
 
 #include <QDateTime>
 #include <memory>
+#include <optional>
 
 #include <QMainWindow>
 #include <QMessageBox>
@@ -16,6 +17,7 @@
 #include "studio/dialogs.h"
 #include "studio/scene_document.h"
 
+class QCheckBox;
 class QComboBox;
 class QDockWidget;
 class QMenu;
@@ -49,6 +51,9 @@ public:
     JobPanel* jobPanel() const { return m_jobPanel; }
     AssetStore* assetStore() { return &m_assets; }
     QComboBox* modeSelector() const { return m_modeBox; }
+    // Side-by-side compare: the toggle and the second mode (the right half of the viewport).
+    QCheckBox* compareToggle() const { return m_compareToggle; }
+    QComboBox* compareSelector() const { return m_compareBox; }
     VolumeInspector* inspector() const { return m_inspector; }
     QDockWidget* inspectorDock() const { return m_inspectorDock; }
     QString logText() const;
@@ -145,6 +150,7 @@ private:
     void updateTitle();
     void onDocumentChanged(ScenePart parts);
     void updateViewport();
+    void updateCompare();
     bool viewNeedsLighting() const;
     void onSelectionChanged();
     void refreshInspector();
@@ -169,6 +175,8 @@ private:
     JobPanel* m_jobPanel;
     QPlainTextEdit* m_log;
     QComboBox* m_modeBox;
+    QCheckBox* m_compareToggle;
+    QComboBox* m_compareBox;
     VolumeInspector* m_inspector = nullptr;
     QDockWidget* m_inspectorDock = nullptr;
     QPointer<Job> m_inspectorJob;

@@ -1,6 +1,8 @@
 // RenderWorker: progressive passes with restart, the species part of the frame kept across camera moves.
 #include "studio/render_worker.h"
 
+#include <cstring>
+
 #include <QMutexLocker>
 
 #include "core/base/error.h"
@@ -27,6 +29,27 @@ QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float 
     return out;
 }
 
+QImage compareImage(const Film& film, RenderMode left, RenderMode right, const glm::vec3& sky, float exposureKey)
+{
+    QImage out = filmImage(film, left, sky, exposureKey);
+    if (out.isNull() || right == left) return out;
+    const QImage r = filmImage(film, right, sky, exposureKey);
+    const int split = film.width / 2;
+    for (int y = 0; y < film.height; ++y)
+        std::memcpy(out.scanLine(y) + size_t(split) * 4, r.constScanLine(y) + size_t(split) * 4, size_t(film.width - split) * 4);
+    return out;
+}
+
+namespace {
+
+QImage picture(const Film& film, const Scene& scene, const std::optional<RenderMode>& compare)
+{
+    return compare ? compareImage(film, scene.render.mode, *compare, scene.sky, scene.render.exposureKey)
+                   : filmImage(film, scene.render.mode, scene.sky, scene.render.exposureKey);
+}
+
+} // namespace
+
 RenderWorker::RenderWorker(QObject* parent) : QThread(parent), m_passes(defaultPasses()) {}
 
 RenderWorker::~RenderWorker()
@@ -47,12 +70,13 @@ void RenderWorker::setPasses(std::vector<RenderPass> passes)
     m_passes = std::move(passes);
 }
 
-void RenderWorker::request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size)
+void RenderWorker::request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size, std::optional<RenderMode> compare)
 {
     QMutexLocker lock(&m_mutex);
     m_request.scene = scene;
     m_request.assets = std::move(assets);
     m_request.size = size;
+    m_request.compare = compare;
     ++m_request.serial;
     m_hasRequest = true;
     m_sinceRequest.start();
@@ -112,13 +136,13 @@ void RenderWorker::process(const Request& req, Progress& progress)
         return double(m_sinceRequest.nsecsElapsed()) * 1e-9;
     };
 
-    // A change of mode or exposure alone: the film already holds every mode's parts.
+    // A change of mode, compare mode or exposure alone: the film already holds every mode's parts.
     if (m_lastScene && m_frameAssets == req.assets && m_lastSize == req.size && m_lastPass == int(passes.size()) - 1) {
         Scene a = *m_lastScene, b = scene;
         a.render.mode = b.render.mode;
         a.render.exposureKey = b.render.exposureKey;
         if (changedParts(a, b) == ScenePart::None) {
-            const QImage img = filmImage(m_lastFilm, scene.render.mode, scene.sky, scene.render.exposureKey);
+            const QImage img = picture(m_lastFilm, scene, req.compare);
             m_lastScene = scene;
             Q_EMIT imageReady(img, m_lastPass, true, elapsed());
             return;
@@ -140,7 +164,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
         placeViewFrame(*m_frame, scene, sun, pw, ph, passes[p].spp);
         Film film = renderFilm(m_frame->rs.view(), &progress);
         if (interrupted()) throw Cancelled();
-        const QImage img = filmImage(film, scene.render.mode, scene.sky, scene.render.exposureKey);
+        const QImage img = picture(film, scene, req.compare);
         m_lastFilm = std::move(film);
         m_lastScene = scene;
         m_lastSize = req.size;

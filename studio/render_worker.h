@@ -30,6 +30,10 @@ struct RenderPass {
 // Tone-mapped sRGB picture of a film in a render mode (composeMode + toneMapped), as a QImage.
 QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float exposureKey);
 
+// Side-by-side compare (seed 000 Figure 2) of one film: columns [0, width/2) from filmImage(film,
+// left), the rest from filmImage(film, right); each half is exactly that mode's own picture.
+QImage compareImage(const Film& film, RenderMode left, RenderMode right, const glm::vec3& sky, float exposureKey);
+
 class RenderWorker : public QThread {
     Q_OBJECT
 
@@ -44,7 +48,10 @@ public:
     // Renders `scene` with `assets` (one per species, in order) at `size` pixels. Cancels the frame in
     // progress. Same assets as the last request: only the top level is re-placed (fast); a change of
     // the render mode alone recomposes the last film without tracing.
-    void request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size);
+    // compare: a second mode for the right half of the picture (compareImage); a change of it alone
+    // recomposes like a mode change.
+    void request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size,
+                 std::optional<RenderMode> compare = std::nullopt);
     // Stops the frame in progress and forgets the request (e.g. assets are being recomputed).
     void clear();
 
@@ -61,6 +68,7 @@ private:
         Scene scene;
         std::vector<AssetsPtr> assets;
         QSize size;
+        std::optional<RenderMode> compare;
         quint64 serial = 0;
     };
     void process(const Request& req, Progress& progress);

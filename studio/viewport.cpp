@@ -88,7 +88,7 @@ void Viewport::requestRender()
     }
     setStatus(QString());
     m_awaitingFirst = true;
-    m_worker->request(m_scene, m_assets, renderSize());
+    m_worker->request(m_scene, m_assets, renderSize(), m_compare);
 }
 
 void Viewport::onImage(const QImage& image, int pass, bool last, double seconds)
@@ -166,6 +166,15 @@ void Viewport::paintGL()
         m_texture->release();
         m_program->release();
     }
+    if (m_compare && m_texture && !m_image.isNull()) {
+        // The split the worker made (column width / 2 of the picture), and which mode is where.
+        QPainter p(this);
+        const int x = int(double(width()) * double(m_image.width() / 2) / double(m_image.width()));
+        p.setPen(QColor(255, 255, 255, 200));
+        p.drawLine(x, 0, x, height());
+        p.drawText(QRect(8, 8, x - 16, 20), Qt::AlignLeft | Qt::AlignTop, QString::fromLatin1(renderModeName(m_scene.render.mode)));
+        p.drawText(QRect(x + 8, 8, width() - x - 16, 20), Qt::AlignLeft | Qt::AlignTop, QString::fromLatin1(renderModeName(*m_compare)));
+    }
     if (!m_status.isEmpty()) {
         QPainter p(this);
         p.setPen(QColor(230, 230, 230));
@@ -229,6 +238,13 @@ void Viewport::setFlyMode(bool on)
     m_fly = on;
     m_flyKey = 0;
     Q_EMIT flyModeChanged(on);
+}
+
+void Viewport::setCompare(std::optional<RenderMode> mode)
+{
+    if (m_compare == mode) return;
+    m_compare = mode;
+    requestRender();
 }
 
 double Viewport::flyStep() const { return std::max(0.05, 0.05 * glm::length(m_scene.camera.target - m_scene.camera.position)); }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 
 #include <QImage>
 #include <QOpenGLBuffer>
@@ -43,6 +44,10 @@ public:
     RenderWorker* worker() const { return m_worker; }
 
     QSize sizeHint() const override { return {800, 450}; }
+
+    // Side-by-side compare: the right half of the picture in a second mode, from the same trace.
+    void setCompare(std::optional<RenderMode> mode);
+    std::optional<RenderMode> compare() const { return m_compare; }
 
     // Fly navigation (toggle: F in the viewport): W/S forward/back, A/D left/right, Q/E down/up, each
     // press flyStep() metres (Shift: 5x); left drag looks around the eye. Off: left drag orbits.
@@ -94,6 +99,7 @@ private:
     int m_wheelKey = 0;
     qint64 m_lastWheelMs = 0;
     bool m_fly = false;
+    std::optional<RenderMode> m_compare;
     int m_flyKey = 0;
     qint64 m_lastFlyMs = 0;
 

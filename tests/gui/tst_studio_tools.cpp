@@ -1,5 +1,7 @@
-// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation, scatter.
+// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation, scatter, side-by-side compare.
 #include <QAction>
+#include <QCheckBox>
+#include <QComboBox>
 #include <QDir>
 #include <QFile>
 
@@ -8,6 +10,7 @@
 
 #include "pipeline/scene/scene_file.h"
 #include "studio/camera_nav.h"
+#include "studio/render_worker.h"
 #include "studio/scene_document.h"
 #include "studio_test_util.h"
 
@@ -302,6 +305,59 @@ private Q_SLOTS:
         QCOMPARE(got.height, -0.5);
         w->document()->undoStack()->setClean();
     }
+
+    // The compare toggle and second mode in the viewport's bar: with the scene in full and compare on
+    // lb, the viewport's picture is full's picture on the left and lb's on the right (the same film
+    // recomposed, so exactly); off again: full's picture.
+    void compareToggleInTheViewport()
+    {
+        auto w = window();
+        w->resize(900, 600);
+        w->show();
+        QVERIFY(QTest::qWaitForWindowExposed(w.get()));
+        compose(*w);
+        Scene s = w->document()->scene();
+        s.species[0].grid = 12;
+        w->document()->edit(s, "grid");
+        Viewport* v = w->viewport();
+        v->worker()->setPasses({{2, 1}});
+        QSignalSpy lit(w.get(), &MainWindow::lightingFinished);
+        QVERIFY(w->computeLighting());
+        QVERIFY(lit.wait(60000));
+        QVERIFY(lit.at(0).at(0).toBool());
+        QVERIFY(waitForFinalImage(v, 60000));
+        const QImage full = v->lastImage();
+        s = w->document()->scene();
+        s.render.mode = RenderMode::Lb;
+        w->document()->edit(s, "lb");
+        QVERIFY(waitForFinalImage(v, 60000));
+        const QImage lb = v->lastImage();
+        QVERIFY(lb != full);
+        w->document()->undoStack()->undo();
+        QVERIFY(waitForFinalImage(v, 60000));
+        QCOMPARE(v->lastImage(), full);
+
+        const int steps = w->document()->undoStack()->index();
+        QVERIFY(!w->compareSelector()->isEnabled());
+        QCOMPARE(w->compareSelector()->currentText(), QStringLiteral("lb"));
+        w->compareToggle()->setChecked(true);
+        QVERIFY(w->compareSelector()->isEnabled());
+        QCOMPARE(v->compare(), std::optional<RenderMode>(RenderMode::Lb));
+        QVERIFY(waitForFinalImage(v, 60000));
+        const QImage cmp = v->lastImage();
+        QCOMPARE(cmp.size(), full.size());
+        const int split = cmp.width() / 2;
+        QCOMPARE(cmp.copy(0, 0, split, cmp.height()), full.copy(0, 0, split, full.height()));
+        QCOMPARE(cmp.copy(split, 0, cmp.width() - split, cmp.height()), lb.copy(split, 0, lb.width() - split, lb.height()));
+        QCOMPARE(w->document()->undoStack()->index(), steps);   // a view setting, not a scene edit
+
+        w->compareToggle()->setChecked(false);
+        QVERIFY(!v->compare());
+        QVERIFY(waitForFinalImage(v, 60000));
+        QCOMPARE(v->lastImage(), full);
+        w->document()->undoStack()->setClean();
+    }
+
 };
 
 QTEST_MAIN(TstStudioTools)

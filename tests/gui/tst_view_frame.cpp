@@ -137,6 +137,85 @@ private Q_SLOTS:
         worker.request(s, assets, QSize(64, 36));
         QTRY_VERIFY_WITH_TIMEOUT(!images.isEmpty() && images.last().at(2).toBool(), 20000);
     }
+
+    // Side-by-side compare (seed 000 Figure 2): both halves come from one trace. Turning compare on
+    // (or changing its mode) recomposes the last film without tracing: the left half equals the
+    // mode-A picture and the right half the mode-B picture of that same film, pixel for pixel. A
+    // fresh trace with compare on matches the two pictures of a headless buildRenderScene frame.
+    void compareHalvesComeFromOneTrace()
+    {
+        Scene s = treeScene();
+        s.render.mode = RenderMode::Full;
+        std::vector<AssetsPtr> assets{std::make_shared<const SpeciesAssets>(m_assets[0])};
+        RenderWorker worker;
+        worker.setPasses({{1, 1}});
+        QSignalSpy images(&worker, &RenderWorker::imageReady);
+        const QSize size(96, 64);
+        worker.request(s, assets, size);
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 1, 20000);
+        const QImage full = images.at(0).at(0).value<QImage>();
+        Scene lb = s;
+        lb.render.mode = RenderMode::Lb;
+        worker.request(lb, assets, size);
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 2, 20000);
+        const QImage lbImage = images.at(1).at(0).value<QImage>();
+        QVERIFY(lbImage != full);
+
+        auto halvesMatch = [](const QImage& got, const QImage& left, const QImage& right, int tolerance) {
+            if (got.size() != left.size() || got.size() != right.size()) return QString("sizes differ");
+            const int split = got.width() / 2;
+            for (int y = 0; y < got.height(); ++y)
+                for (int x = 0; x < got.width(); ++x) {
+                    const QRgb g = got.pixel(x, y), w = (x < split ? left : right).pixel(x, y);
+                    if (std::abs(qRed(g) - qRed(w)) > tolerance || std::abs(qGreen(g) - qGreen(w)) > tolerance ||
+                        std::abs(qBlue(g) - qBlue(w)) > tolerance)
+                        return QString("pixel (%1, %2) differs from the %3 picture").arg(x).arg(y).arg(x < split ? "left" : "right");
+                }
+            return QString();
+        };
+
+        // Compare on: one recomposed image (no new pass), left = full, right = lb, exactly.
+        images.clear();
+        worker.request(s, assets, size, RenderMode::Lb);
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 1, 20000);
+        QTest::qWait(50);
+        QCOMPARE(images.count(), 1);
+        const QImage cmp = images.at(0).at(0).value<QImage>();
+        const QString mismatch = halvesMatch(cmp, full, lbImage, 0);
+        QVERIFY2(mismatch.isEmpty(), qPrintable(mismatch));
+        QVERIFY(cmp != full && cmp != lbImage);
+        // The mode on the left changes: local | lb, still the same film.
+        images.clear();
+        Scene local = s;
+        local.render.mode = RenderMode::Local;
+        worker.request(local, assets, size);
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 1, 20000);
+        const QImage localImage = images.at(0).at(0).value<QImage>();
+        images.clear();
+        worker.request(local, assets, size, RenderMode::Lb);
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 1, 20000);
+        QVERIFY(halvesMatch(images.at(0).at(0).value<QImage>(), localImage, lbImage, 0).isEmpty());
+
+        // A new camera with compare on traces once; the halves match the headless frame's pictures
+        // (to one level of 8-bit rounding: the re-placed frame agrees to float rounding).
+        Scene moved = s;
+        moved.camera.position = {-4.0, 4.0, -12.0};
+        images.clear();
+        worker.request(moved, assets, size, RenderMode::Ambient);
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 1, 20000);
+        moved.render.width = size.width();
+        moved.render.height = size.height();
+        moved.render.spp = 1;
+        const RenderScene fresh = buildRenderScene(moved, m_assets, sunRadiance(moved.sun));
+        const Film film = renderFilm(fresh.view());
+        const QImage want = compareImage(film, RenderMode::Full, RenderMode::Ambient, moved.sky, moved.render.exposureKey);
+        const QString m2 = halvesMatch(images.at(0).at(0).value<QImage>(), filmImage(film, RenderMode::Full, moved.sky, moved.render.exposureKey),
+                                       filmImage(film, RenderMode::Ambient, moved.sky, moved.render.exposureKey), 1);
+        QVERIFY2(m2.isEmpty(), qPrintable(m2));
+        QVERIFY(halvesMatch(want, filmImage(film, RenderMode::Full, moved.sky, moved.render.exposureKey),
+                            filmImage(film, RenderMode::Ambient, moved.sky, moved.render.exposureKey), 0)
+                    .isEmpty());
+    }
 };
 
 QTEST_MAIN(TstViewFrame)
