@@ -10,7 +10,10 @@
 #include <QHBoxLayout>
 #include <QLineEdit>
 #include <QPushButton>
+#include <QLabel>
 #include <QSpinBox>
+#include <QTreeWidget>
+#include <QVBoxLayout>
 
 #include "pipeline/grow/tree_grower.h"
 
@@ -164,6 +167,84 @@ ScatterSpec ScatterDialog::spec() const
     s.scaleMax = float(std::max(m_s0->value(), m_s1->value()));
     s.seed = uint64_t(m_seed->value());
     return s;
+}
+
+MaterialDialog::MaterialDialog(const QString& species, const std::vector<MaterialChoice>& materials, QWidget* parent)
+    : QDialog(parent), m_materials(materials)
+{
+    setWindowTitle(tr("Materials of %1").arg(species));
+    auto* layout = new QVBoxLayout(this);
+    auto* note = new QLabel(tr("Leaf materials become thin translucent foliage in the LB grid (density with "
+                               "the leaf optics); wood is opaque. Changing them revoxelizes and relights the species."));
+    note->setWordWrap(true);
+    layout->addWidget(note);
+    m_table = new QTreeWidget;
+    m_table->setObjectName("materialTable");
+    m_table->setRootIsDecorated(false);
+    m_table->setHeaderLabels({tr("Material"), tr("Leaf"), tr("Wood")});
+    for (const MaterialChoice& m : m_materials) {
+        auto* item = new QTreeWidgetItem(m_table);
+        item->setText(NameColumn, m.name);
+        item->setToolTip(NameColumn, m.leafByRules ? tr("leaf by the importer's rules") : tr("wood by the importer's rules"));
+        item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
+        item->setCheckState(LeafColumn, m.leaf ? Qt::Checked : Qt::Unchecked);
+        item->setCheckState(WoodColumn, m.leaf ? Qt::Unchecked : Qt::Checked);
+    }
+    m_table->resizeColumnToContents(NameColumn);
+    layout->addWidget(m_table, 1);
+    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
+    QPushButton* rules = buttons->addButton(tr("Importer's Rules"), QDialogButtonBox::ResetRole);
+    m_ok = buttons->button(QDialogButtonBox::Ok);
+    connect(rules, &QPushButton::clicked, this, &MaterialDialog::resetToRules);
+    connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
+    connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
+    connect(m_table, &QTreeWidget::itemChanged, this, &MaterialDialog::onItemChanged);
+    layout->addWidget(buttons);
+    onItemChanged(nullptr, 0);
+}
+
+bool MaterialDialog::isLeaf(int row) const
+{
+    const QTreeWidgetItem* item = m_table->topLevelItem(row);
+    return item && item->checkState(LeafColumn) == Qt::Checked;
+}
+
+void MaterialDialog::setLeaf(int row, bool leaf)
+{
+    if (QTreeWidgetItem* item = m_table->topLevelItem(row)) item->setCheckState(leaf ? LeafColumn : WoodColumn, Qt::Checked);
+}
+
+void MaterialDialog::resetToRules()
+{
+    for (int r = 0; r < int(m_materials.size()); ++r) setLeaf(r, m_materials[size_t(r)].leafByRules);
+}
+
+void MaterialDialog::onItemChanged(QTreeWidgetItem* item, int column)
+{
+    if (m_updating) return;
+    m_updating = true;
+    if (item && (column == LeafColumn || column == WoodColumn)) {
+        // Leaf and Wood exclude each other: checking one unchecks the other, unchecking one checks it.
+        const bool checked = item->checkState(column) == Qt::Checked;
+        item->setCheckState(column == LeafColumn ? WoodColumn : LeafColumn, checked ? Qt::Unchecked : Qt::Checked);
+    }
+    bool anyLeaf = false;
+    for (int r = 0; r < m_table->topLevelItemCount(); ++r) anyLeaf = anyLeaf || isLeaf(r);
+    m_ok->setEnabled(anyLeaf);
+    m_ok->setToolTip(anyLeaf ? QString() : tr("At least one material must be leaf"));
+    m_updating = false;
+}
+
+std::vector<std::string> MaterialDialog::leafMaterials() const
+{
+    bool asRules = true;
+    std::vector<std::string> out;
+    for (int r = 0; r < int(m_materials.size()); ++r) {
+        if (isLeaf(r) != m_materials[size_t(r)].leafByRules) asRules = false;
+        if (isLeaf(r)) out.push_back(m_materials[size_t(r)].name.toStdString());
+    }
+    if (asRules) out.clear();
+    return out;
 }
 
 } // namespace sylva

@@ -1,4 +1,4 @@
-// Small modal dialogs: grow a species, export a render, scatter instances.
+// Small modal dialogs: grow a species, export a render, scatter instances, leaf/wood materials.
 #pragma once
 
 #include <QDialog>
@@ -10,7 +10,10 @@ class QCheckBox;
 class QComboBox;
 class QDoubleSpinBox;
 class QLineEdit;
+class QPushButton;
 class QSpinBox;
+class QTreeWidget;
+class QTreeWidgetItem;
 
 namespace sylva {
 
@@ -74,6 +77,42 @@ private:
     QDoubleSpinBox* m_s1;
     QSpinBox* m_seed;
     double m_height;
+};
+
+// One material of a species' mesh for the material dialog: its name, what the importer's rules make
+// of it (leaf when it has an opacity texture or cut-out alpha, or a leaf-like name; else wood) and
+// what it is now (the species' leaf_materials when set, else the rules).
+struct MaterialChoice {
+    QString name;
+    bool leafByRules = false;
+    bool leaf = false;
+};
+
+// Leaf/wood assignment of a species' materials: a row per material with Leaf and Wood check boxes
+// (exactly one checked), and a button back to the importer's rules. leafMaterials() is what the
+// species' leaf_materials should become: empty when the choice equals the rules (the importer
+// decides), else the names checked Leaf. At least one material must be leaf (an empty list means
+// "the rules"), so OK is disabled without one.
+class MaterialDialog : public QDialog {
+    Q_OBJECT
+
+public:
+    MaterialDialog(const QString& species, const std::vector<MaterialChoice>& materials, QWidget* parent = nullptr);
+    std::vector<std::string> leafMaterials() const;
+    bool isLeaf(int row) const;
+    void setLeaf(int row, bool leaf);
+    void resetToRules();
+    QTreeWidget* table() const { return m_table; }
+    QPushButton* okButton() const { return m_ok; }
+
+    enum Column { NameColumn = 0, LeafColumn = 1, WoodColumn = 2 };
+
+private:
+    void onItemChanged(QTreeWidgetItem* item, int column);
+    std::vector<MaterialChoice> m_materials;
+    QTreeWidget* m_table;
+    QPushButton* m_ok;
+    bool m_updating = false;
 };
 
 } // namespace sylva

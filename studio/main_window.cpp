@@ -2,6 +2,7 @@
 #include "studio/main_window.h"
 
 #include <cmath>
+#include <numeric>
 
 #include <QAction>
 #include <QApplication>
@@ -180,6 +181,10 @@ MainWindow::MainWindow(QWidget* parent)
     connect(m_doc, &SceneDocument::modifiedChanged, this, [this](bool modified) {
         if (!modified) removeRecoveryFile();
     });
+    m_editMaterials = [this](const QString& species, const std::vector<MaterialChoice>& materials) {
+        MaterialDialog d(species, materials, this);
+        return d.exec() == QDialog::Accepted ? std::optional<std::vector<std::string>>(d.leafMaterials()) : std::nullopt;
+    };
     connect(&m_autosaveTimer, &QTimer::timeout, this, [this] { autosaveNow(); });
     setAutosaveInterval(QSettings().value("autosave/intervalSeconds", 60).toInt() * 1000);
     m_recoveryPending = QFileInfo::exists(recoveryFilePath());
@@ -403,6 +408,7 @@ void MainWindow::buildActions()
     edit->addAction(redo);
     edit->addSeparator();
     add(edit, tr("&Delete"), "actionDelete", QKeySequence::Delete, [this] { deleteSelection(); });
+    add(edit, tr("Species &Materials..."), "actionMaterials", QKeySequence(), [this] { editMaterials(selectedSpecies()); });
     add(edit, tr("&Scatter Instances..."), "actionScatter", QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_T), [this] { scatterDialog(); });
 
     QMenu* render = menuBar()->addMenu(tr("&Render"));
@@ -909,6 +915,70 @@ Job* MainWindow::exportSpeciesGrids(int species, const QString& folder)
                                  appendLog(tr("exported %1 and %2").arg(QString::fromStdString(densityPath), QString::fromStdString(lightingPath)));
                              else if (job->state() == Job::State::Failed) reportError(tr("Export failed"), job->error());
                              else appendLog(tr("grid export cancelled"));
+                         });
+}
+
+bool MainWindow::setLeafMaterials(int species, const std::vector<std::string>& names)
+{
+    Scene s = m_doc->scene();
+    if (species < 0 || size_t(species) >= s.species.size() || s.species[size_t(species)].leafMaterials == names) return false;
+    SpeciesDesc& sp = s.species[size_t(species)];
+    sp.leafMaterials = names;
+    m_doc->edit(s, tr("Materials of %1").arg(QString::fromStdString(sp.name)));
+    appendLog(names.empty() ? tr("%1: leaf materials by the importer's rules").arg(QString::fromStdString(sp.name))
+                            : tr("%1: leaf materials %2")
+                                  .arg(QString::fromStdString(sp.name),
+                                       QString::fromStdString(std::accumulate(std::next(names.begin()), names.end(), names.front(),
+                                                                              [](std::string a, const std::string& b) { return a + ", " + b; }))));
+    return true;
+}
+
+Job* MainWindow::editMaterials(int species)
+{
+    const Scene& scene = m_doc->scene();
+    if (species < 0 || size_t(species) >= scene.species.size()) {
+        reportError(tr("Materials"), tr("Select a species (or one of its instances) to assign its materials."));
+        return nullptr;
+    }
+    const SpeciesDesc sp = scene.species[size_t(species)];
+    if (sp.meshPath.empty()) {
+        reportError(tr("Materials"), tr("%1 is grown: the grower marks its leaves and wood itself.").arg(QString::fromStdString(sp.name)));
+        return nullptr;
+    }
+    auto result = std::make_shared<std::vector<MaterialChoice>>();
+    return m_jobs->start(tr("Materials of %1").arg(QString::fromStdString(sp.name)),
+                         [sp, result](Job&, Progress& progress) {
+                             progress.report(0.0, "reading");
+                             // The rules alone (no override), then what the species' list makes of them.
+                             const TriangleMesh mesh = sylva::importMesh(sp.meshPath, ImportOptions{});
+                             for (const Material& m : mesh.materials) {
+                                 MaterialChoice c;
+                                 c.name = QString::fromStdString(m.name);
+                                 c.leafByRules = m.isLeaf;
+                                 c.leaf = m.isLeaf;
+                                 if (!sp.leafMaterials.empty()) {
+                                     c.leaf = false;
+                                     for (const std::string& n : sp.leafMaterials)
+                                         c.leaf = c.leaf || QString::fromStdString(n).compare(c.name, Qt::CaseInsensitive) == 0;
+                                 }
+                                 result->push_back(c);
+                             }
+                             progress.report(1.0, "read");
+                         },
+                         [this, species, sp, result](Job* job) {
+                             if (job->state() == Job::State::Failed) {
+                                 reportError(tr("Materials"), job->error());
+                                 return;
+                             }
+                             if (job->state() != Job::State::Succeeded) return;
+                             // The species may have changed or gone meanwhile.
+                             const Scene& now = m_doc->scene();
+                             if (size_t(species) >= now.species.size() || now.species[size_t(species)].name != sp.name ||
+                                 now.species[size_t(species)].meshPath != sp.meshPath)
+                                 return;
+                             const std::optional<std::vector<std::string>> names =
+                                 m_editMaterials ? m_editMaterials(QString::fromStdString(sp.name), *result) : std::nullopt;
+                             if (names) setLeafMaterials(species, *names);
                          });
 }
 

@@ -86,6 +86,12 @@ public:
     // modified); either way the recovery file is deleted. True when a scene was recovered.
     bool offerRecovery();
 
+    // How the leaf/wood question reaches the user: the species' materials in, its new leaf_materials
+    // out (nullopt: cancelled). Default: MaterialDialog, modal.
+    using MaterialEditor =
+        std::function<std::optional<std::vector<std::string>>(const QString& species, const std::vector<MaterialChoice>& materials)>;
+    void setMaterialEditor(MaterialEditor editor) { m_editMaterials = std::move(editor); }
+
     // Lighting starts by itself (debounced) when species, sun or mode change; off: Render > Compute Lighting.
     void setAutoLighting(bool on);
     bool autoLighting() const { return m_autoLighting; }
@@ -120,6 +126,12 @@ public:
     // The scatter form's starting values: the selected species, 100 instances over the instances'
     // footprint (20 m around the origin when there are none) on the ground.
     ScatterSpec defaultScatter() const;
+    // Edit > Species Materials: reads the species' mesh in a job (its materials, what the importer's
+    // rules make of each, what leaf_materials makes of them now), asks the MaterialEditor, and writes
+    // the answer with setLeafMaterials. Null (and an error report) for a grown species or a bad index.
+    Job* editMaterials(int species);
+    // Sets a species' leaf_materials (empty: the importer's rules) as one undo step; false when unchanged.
+    bool setLeafMaterials(int species, const std::vector<std::string>& names);
     // The species the outliner selection points at (a species row, or an instance's species); -1 if none.
     int selectedSpecies() const;
     // Lighting volume inspector: loads the species' density and lighting grids (the lighting job's
@@ -187,6 +199,7 @@ private:
     ErrorReporter m_reportError;
     SavePrompt m_askSave;
     RecoveryPrompt m_askRecover;
+    MaterialEditor m_editMaterials;
     QTimer m_autosaveTimer;
     quint64 m_autosavedRevision = 0;
     bool m_recoveryPending = false;   // a recovery file waits to be offered: neither overwrite nor delete it

@@ -1,10 +1,13 @@
-// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation, scatter, side-by-side compare.
+// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation, scatter, side-by-side compare, leaf/wood materials.
 #include <QAction>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QDir>
 #include <QFile>
+#include <QPushButton>
+#include <QTreeWidget>
 
+#include <algorithm>
 #include <memory>
 #include <set>
 
@@ -358,6 +361,79 @@ private Q_SLOTS:
         w->document()->undoStack()->setClean();
     }
 
+    // Edit > Species Materials on the imported Tree_1 (Tree_1.mtl: "Bark" and "Tree_Leaves"; by the
+    // importer's rules the leaf-named one is leaf, bark is wood): the dialog starts from the rules,
+    // Leaf and Wood exclude each other, the answer becomes the species' leaf_materials in one undo
+    // step, the next opening starts from that list, "Importer's Rules" writes an empty list again.
+    void materialAssignment()
+    {
+        auto w = window();
+        QStringList errors;
+        w->setErrorReporter([&](const QString&, const QString& m) { errors << m; });
+        QVERIFY(waitForJob(w->importMesh(sharedTree()), 30000));
+        QVERIFY(w->document()->scene().species[0].leafMaterials.empty());
+        std::vector<MaterialChoice> seen;
+        w->setMaterialEditor([&](const QString& species, const std::vector<MaterialChoice>& m) {
+            seen = m;
+            MaterialDialog d(species, m);
+            const int bark = m[0].name == "Bark" ? 0 : 1;
+            // The user ticks Leaf on the bark: its Wood box clears.
+            d.table()->topLevelItem(bark)->setCheckState(MaterialDialog::LeafColumn, Qt::Checked);
+            if (d.table()->topLevelItem(bark)->checkState(MaterialDialog::WoodColumn) != Qt::Unchecked) return std::optional<std::vector<std::string>>();
+            return std::optional(d.leafMaterials());
+        });
+        const int index0 = w->document()->undoStack()->index();
+        QVERIFY(waitForJob(w->editMaterials(0), 30000));
+        QCOMPARE(seen.size(), size_t(2));
+        QStringList names{seen[0].name, seen[1].name};
+        names.sort();
+        QCOMPARE(names, (QStringList{"Bark", "Tree_Leaves"}));
+        for (const MaterialChoice& c : seen) {
+            QCOMPARE(c.leafByRules, c.name == "Tree_Leaves");
+            QCOMPARE(c.leaf, c.leafByRules);
+        }
+        std::vector<std::string> got = w->document()->scene().species[0].leafMaterials;
+        std::sort(got.begin(), got.end());
+        QCOMPARE(got, (std::vector<std::string>{"Bark", "Tree_Leaves"}));
+        QCOMPARE(w->document()->undoStack()->index(), index0 + 1);
+        QVERIFY(QString::fromStdString(sceneToJson(w->document()->scene(), "/")).contains("leaf_materials"));
+
+        // Again: the dialog starts from the list; back to the importer's rules = an empty list.
+        w->setMaterialEditor([&](const QString& species, const std::vector<MaterialChoice>& m) {
+            seen = m;
+            MaterialDialog d(species, m);
+            d.resetToRules();
+            return std::optional(d.leafMaterials());
+        });
+        QVERIFY(waitForJob(w->editMaterials(0), 30000));
+        for (const MaterialChoice& c : seen) QVERIFY(c.leaf);
+        QVERIFY(w->document()->scene().species[0].leafMaterials.empty());
+        QCOMPARE(w->document()->undoStack()->index(), index0 + 2);
+        w->document()->undoStack()->undo();
+        QCOMPARE(w->document()->scene().species[0].leafMaterials.size(), size_t(2));
+        w->document()->undoStack()->undo();
+        QVERIFY(w->document()->scene().species[0].leafMaterials.empty());
+
+        // Cancelled: nothing changes.
+        w->setMaterialEditor([](const QString&, const std::vector<MaterialChoice>&) { return std::optional<std::vector<std::string>>(); });
+        QVERIFY(waitForJob(w->editMaterials(0), 30000));
+        QCOMPARE(w->document()->undoStack()->index(), index0);
+
+        // No leaf at all cannot be said (an empty list means the rules): OK is disabled.
+        MaterialDialog d("Tree_1", {{"Bark", false, false}, {"Tree_Leaves", true, true}});
+        QVERIFY(d.okButton()->isEnabled());
+        d.table()->topLevelItem(1)->setCheckState(MaterialDialog::WoodColumn, Qt::Checked);
+        QVERIFY(!d.isLeaf(1));
+        QCOMPARE(d.table()->topLevelItem(1)->checkState(MaterialDialog::LeafColumn), Qt::Unchecked);
+        QVERIFY(!d.okButton()->isEnabled());
+
+        // A grown species has no materials to assign.
+        w->growSpecies(GrowSpec{"shrub", 1, 2000, 0.0f});
+        QVERIFY(!w->editMaterials(1));
+        QCOMPARE(errors.size(), 1);
+        QVERIFY(errors[0].contains("grown"));
+        w->document()->undoStack()->setClean();
+    }
 };
 
 QTEST_MAIN(TstStudioTools)
