@@ -1,7 +1,9 @@
-// MemAvailable from /proc/meminfo.
+// MemAvailable from /proc/meminfo, capped by SYLVA_MEMORY_LIMIT_MB.
 #include "core/base/memory.h"
 
+#include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 
 namespace sylva {
 
@@ -14,7 +16,13 @@ double availableMemoryBytes()
     while (std::fgets(line, sizeof line, f))
         if (std::sscanf(line, "MemAvailable: %lf kB", &kb) == 1) break;
     std::fclose(f);
-    return kb * 1024.0;
+    double bytes = kb * 1024.0;
+    if (const char* limit = std::getenv("SYLVA_MEMORY_LIMIT_MB")) {
+        char* end = nullptr;
+        const double mb = std::strtod(limit, &end);
+        if (end != limit && mb > 0.0) bytes = bytes > 0.0 ? std::min(bytes, mb * 1e6) : mb * 1e6;
+    }
+    return bytes;
 }
 
 } // namespace sylva

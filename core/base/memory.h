@@ -3,7 +3,8 @@
 
 namespace sylva {
 
-// MemAvailable from /proc/meminfo in bytes; 0 when unknown (the callers then skip their check).
+// MemAvailable from /proc/meminfo in bytes; 0 when unknown (the callers then skip their check). The
+// environment variable SYLVA_MEMORY_LIMIT_MB caps it (a machine shared with other work; the tests).
 double availableMemoryBytes();
 
 } // namespace sylva

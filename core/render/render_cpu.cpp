@@ -2,21 +2,28 @@
 #include "core/render/render_cpu.h"
 
 #include <atomic>
+#include <string>
 
 #include <tbb/parallel_for.h>
 
+#include "core/base/error.h"
 #include "core/render/tonemap.h"
 
 namespace sylva {
 
-Film renderFilm(const RenderView& v, Progress* progress)
+Film renderFilm(const RenderView& v, Progress* progress) { return renderFilmRows(v, 0, v.height, progress); }
+
+Film renderFilmRows(const RenderView& v, int y0Frame, int y1Frame, Progress* progress)
 {
+    if (y0Frame < 0 || y1Frame > v.height || y0Frame > y1Frame)
+        throw Error("renderFilmRows: rows " + std::to_string(y0Frame) + " to " + std::to_string(y1Frame) + " are outside the " +
+                    std::to_string(v.height) + "-row frame");
     Film film;
     film.width = v.width;
-    film.height = v.height;
-    film.pixels.resize(size_t(v.width) * size_t(v.height));
+    film.height = y1Frame - y0Frame;
+    film.pixels.resize(size_t(v.width) * size_t(film.height));
     constexpr int kTile = 8;
-    const int tilesX = (v.width + kTile - 1) / kTile, tilesY = (v.height + kTile - 1) / kTile;
+    const int tilesX = (v.width + kTile - 1) / kTile, tilesY = (film.height + kTile - 1) / kTile;
     const int tiles = tilesX * tilesY;
     std::atomic<int> done{0};
     std::atomic<bool> cancelled{false};
@@ -24,9 +31,10 @@ Film renderFilm(const RenderView& v, Progress* progress)
         if (cancelled.load(std::memory_order_relaxed)) return;
         for (int tile = r.begin(); tile < r.end(); ++tile) {
             const int x0 = (tile % tilesX) * kTile, y0 = (tile / tilesX) * kTile;
-            const int x1 = std::min(x0 + kTile, v.width), y1 = std::min(y0 + kTile, v.height);
+            const int x1 = std::min(x0 + kTile, v.width), y1 = std::min(y0 + kTile, film.height);
             for (int y = y0; y < y1; ++y)
-                for (int x = x0; x < x1; ++x) film.pixels[size_t(y) * size_t(v.width) + size_t(x)] = shadePixel(v, x, y);
+                for (int x = x0; x < x1; ++x)
+                    film.pixels[size_t(y) * size_t(v.width) + size_t(x)] = shadePixel(v, x, y0Frame + y);
         }
         const int d = done.fetch_add(int(r.size())) + int(r.size());
         if (progress && (d % std::max(1, tiles / 100) < int(r.size()) || d == tiles)) {
@@ -41,19 +49,24 @@ Film renderFilm(const RenderView& v, Progress* progress)
     return film;
 }
 
+// Mean luminance of full = mean of local + a * albedo  =>  a = mean(lum(indirect)) / mean(lum(albedo)).
+void addAmbientSums(const Film& film, double* indirect, double* albedo)
+{
+    for (const SampleParts& p : film.pixels) {
+        *indirect += luminance(p.indirect);
+        *albedo += luminance(p.albedo);
+    }
+}
+
 std::vector<glm::vec3> composeMode(const Film& film, RenderMode mode, const glm::vec3& sky, float* ambientOut)
 {
     const size_t n = film.pixels.size();
     std::vector<glm::vec3> out(n);
     float ambient = 0.0f;
     if (mode == RenderMode::Ambient) {
-        // Mean luminance of full = mean of local + a * albedo  =>  a = mean(lum(indirect)) / mean(lum(albedo)).
         double ind = 0.0, alb = 0.0;
-        for (const SampleParts& p : film.pixels) {
-            ind += luminance(p.indirect);
-            alb += luminance(p.albedo);
-        }
-        ambient = alb > 0.0 ? float(ind / alb) : 0.0f;
+        addAmbientSums(film, &ind, &alb);
+        ambient = ambientConstant(ind, alb);
     }
     for (size_t i = 0; i < n; ++i) out[i] = composeSample(film.pixels[i], mode, sky, ambient);
     if (ambientOut) *ambientOut = ambient;

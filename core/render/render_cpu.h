@@ -19,6 +19,16 @@ struct Film {
 // Reports progress per tile row; throws Cancelled when cancelled.
 Film renderFilm(const RenderView& v, Progress* progress = nullptr);
 
+// Rows y0 (inclusive) to y1 (exclusive) of the same frame: exactly the pixels renderFilm computes for
+// those rows (a frame too large to hold whole is rendered in bands). film.height = y1 - y0.
+Film renderFilmRows(const RenderView& v, int y0, int y1, Progress* progress = nullptr);
+
+// The sums ambient mode matches (luminance of indirect and of albedo over the film's pixels, in pixel
+// order), added to *indirect and *albedo so a frame in bands sums exactly as the whole film does.
+void addAmbientSums(const Film& film, double* indirect, double* albedo);
+// The ambient constant from those sums over the whole frame.
+inline float ambientConstant(double indirect, double albedo) { return albedo > 0.0 ? float(indirect / albedo) : 0.0f; }
+
 // Linear RGB of a render mode: full = local + indirect, local = sun light only, ambient = local + a
 // constant ambient x albedo with the constant chosen so the mean luminance equals that of full,
 // lb = indirect only; the sky is added where samples saw it. ambientOut receives the constant.

@@ -58,10 +58,33 @@ struct ToneMapParams {
 // Throws sylva::Error when strideFloats < 3 or rgb is null while pixelCount > 0.
 float logAverageLuminance(const float* rgb, size_t pixelCount, size_t strideFloats);
 
+// logAverageLuminance of an image fed in pieces, in pixel order (a frame rendered in bands): the sum
+// runs over fixed chunks of pixels counted from the image's first pixel, so feeding the same pixels in
+// any split gives exactly the same result as logAverageLuminance over the whole image.
+class LogAverageAccumulator {
+public:
+    // Adds the next pixelCount pixels (layout as logAverageLuminance). Throws Error as it does.
+    void add(const float* rgb, size_t pixelCount, size_t strideFloats);
+    // The log-average of every pixel added so far (0 when none was finite).
+    float value() const;
+
+private:
+    double m_total = 0.0;        // sum over the completed chunks, in chunk order
+    size_t m_count = 0;          // finite pixels in the completed chunks
+    double m_partial = 0.0;      // the chunk being filled
+    size_t m_partialCount = 0, m_partialPixels = 0;
+};
+
 // Tone maps `pixels` linear RGB pixels (3 floats each) into outRgb01 (3 floats each, sRGB-encoded, in [0,1]):
 // scale = key / logAverageLuminance(image), reinhard(rgb, scale), srgbEncode per channel. Parallel over
 // pixels; in and out may be the same buffer. Throws sylva::Error when key is not finite and > 0, or a
 // buffer is null while pixels > 0.
 void toneMapToSrgb(const float* linearRgb, size_t pixels, float* outRgb01, ToneMapParams params = {});
+
+// The two halves of toneMapToSrgb, for an image tone-mapped in pieces: the exposure scale from the
+// image's log-average luminance (key / average, 0 for a black image; Error on a bad key), and the
+// per-pixel Reinhard + sRGB pass with that scale.
+float toneMapScale(float logAverage, ToneMapParams params = {});
+void toneMapScaled(const float* linearRgb, size_t pixels, float* outRgb01, float scale);
 
 } // namespace sylva

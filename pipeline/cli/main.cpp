@@ -199,6 +199,7 @@ std::vector<Command> commands()
                      {"--alpha-distance", "M", "skip leaf cut-out tests beyond M metres from the camera (0: off, default)"},
                      {"--prune-distance", "M", "prune leaves of plants beyond M metres, area-preserving (0: off, default)"},
                      {"--backend", "auto|cpu|cuda", "compute backend (default auto)"},
+                     {"--band-rows", "N", "trace and write the frame in bands of N rows (default: only when the whole frame does not fit in memory)"},
                      {"--stats", "", "print timings and acceleration structure sizes"},
                      kOutput, kCache, kNoCache, kThreads, kQuiet},
                     0, 1});
@@ -648,23 +649,44 @@ int cmdRender(const Args& args)
     if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff")
         throw UsageError("output " + out + ": unknown image extension (use .png, .exr, .tif or .tiff)");
     requireReplaceableFile(out);
+    int bandRows = 0;   // 0: the whole frame at once
+    if (args.has("--band-rows")) bandRows = int(parseInteger("--band-rows", args.get("--band-rows"), 1, 32768));
+    else if (!frameFitsMemory(r)) bandRows = bandRowsFor(r);
+    if (bandRows >= r.height) bandRows = 0;
     auto compute = selectBackend(backend, [](const std::string& note) { std::fprintf(stderr, "note: %s\n", note.c_str()); });
     auto cache = openCache(args);
     JobLog log;
-    ProgressPrinter bar("render", args.has("--quiet"));
-    const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get());
-    bar.finish();
-    for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    AccelStats st;
+    RenderTimings timings;
     float ambient = 0.0f;
-    const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, scene.sky, &ambient);
-    writeRender(out, linear, r.width, r.height, r.exposureKey);
-    const AccelStats& st = result.stats;
+    std::string device = compute->name();
+    if (bandRows > 0) {
+        const int bands = (r.height + bandRows - 1) / bandRows;
+        std::fprintf(stderr, "note: tracing the %dx%d frame in %d bands of %d rows%s\n", r.width, r.height, bands, bandRows,
+                     args.has("--band-rows") ? "" : " (the whole frame does not fit in the available memory)");
+        if (device != "cpu") std::fprintf(stderr, "note: a frame in bands is traced on the CPU (the LB solves still run on %s)\n", device.c_str());
+        ProgressPrinter bar("render", args.has("--quiet"));
+        const BandedRender result = renderSceneInBands(scene, out, bandRows, cache.get(), &bar.progress(), &log);
+        bar.finish();
+        st = result.stats;
+        timings = result.timings;
+        ambient = result.ambient;
+        device = "cpu, " + std::to_string(bands) + " bands";
+    } else {
+        ProgressPrinter bar("render", args.has("--quiet"));
+        const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get());
+        bar.finish();
+        const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, scene.sky, &ambient);
+        writeRender(out, linear, r.width, r.height, r.exposureKey);
+        st = result.stats;
+        timings = result.timings;
+    }
+    for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     std::printf("rendered %dx%d, %d spp, mode %s, %zu instances of %zu species (%.0f instanced triangles) on %s\nwrote %s\n",
                 r.width, r.height, r.spp, renderModeName(r.mode), st.instances, scene.species.size(), st.instancedTriangles,
-                compute->name().c_str(), out.c_str());
+                device.c_str(), out.c_str());
     if (args.has("--stats")) {
-        std::printf("time: assets %.3f s, build %.3f s, trace %.3f s\n", result.timings.assets, result.timings.build,
-                    result.timings.trace);
+        std::printf("time: assets %.3f s, build %.3f s, trace %.3f s\n", timings.assets, timings.build, timings.trace);
         const double accelBytes = double(st.tlasBytes + st.instanceBytes + st.blasBytes + st.triangleBytes);
         std::printf("acceleration structures: %.1f MB (tlas %zu B, instances %zu B, blas %zu B, triangles %zu B); "
                     "%.4f B per instanced triangle, %.1f B per instance; depth tlas %d, blas %d\n",

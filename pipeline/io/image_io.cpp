@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -94,6 +95,59 @@ void writeImage(const std::string& path, const ImageRgba& image, int channels)
     if (!out->open(file.tempPath(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data.data()) || !out->close())
         throw Error(path + ": cannot write image (" + out->geterror() + ")");
     file.commit();
+}
+
+struct RowImageWriter::Impl {
+    explicit Impl(const std::string& path) : file(path) {}
+    ReplacingFile file;
+    std::unique_ptr<OIIO::ImageOutput> out;
+    int width = 0, height = 0, next = 0;
+    bool isFloat = false, open = false;
+    std::vector<float> clamped;
+};
+
+RowImageWriter::RowImageWriter(const std::string& path, int width, int height) : m(std::make_unique<Impl>(path))
+{
+    if (width < 1 || height < 1) throw Error(path + ": refusing to write an empty image");
+    const std::string ext = lowerExtension(path);
+    m->isFloat = ext == ".exr" || ext == ".hdr";
+    m->width = width;
+    m->height = height;
+    m->out = OIIO::ImageOutput::create(m->file.tempPath());
+    if (!m->out) throw Error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
+    OIIO::ImageSpec spec(width, height, 3, m->isFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
+    if (!m->out->open(m->file.tempPath(), spec)) throw Error(path + ": cannot write image (" + m->out->geterror() + ")");
+    m->open = true;
+}
+
+RowImageWriter::~RowImageWriter()
+{
+    if (m && m->out && m->open) m->out->close();   // the temporary file is removed by ReplacingFile
+}
+
+void RowImageWriter::writeRows(const float* rgb, int rows)
+{
+    if (rows <= 0) return;
+    if (m->next + rows > m->height)
+        throw Error(m->file.target() + ": " + std::to_string(m->next + rows) + " rows written to a " + std::to_string(m->height) + "-row image");
+    const float* data = rgb;
+    if (!m->isFloat) {
+        m->clamped.assign(rgb, rgb + size_t(m->width) * size_t(rows) * 3);
+        for (float& v : m->clamped) v = std::clamp(v, 0.0f, 1.0f);
+        data = m->clamped.data();
+    }
+    if (!m->out->write_scanlines(m->next, m->next + rows, 0, OIIO::TypeDesc::FLOAT, data))
+        throw Error(m->file.target() + ": cannot write image (" + m->out->geterror() + ")");
+    m->next += rows;
+}
+
+void RowImageWriter::finish()
+{
+    if (m->next != m->height)
+        throw Error(m->file.target() + ": only " + std::to_string(m->next) + " of " + std::to_string(m->height) + " rows were written");
+    m->open = false;
+    if (!m->out->close()) throw Error(m->file.target() + ": cannot write image (" + m->out->geterror() + ")");
+    m->file.commit();
 }
 
 } // namespace sylva

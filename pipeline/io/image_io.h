@@ -1,6 +1,7 @@
 // Image files through OpenImageIO: read any format it knows as RGBA float, write atomically.
 #pragma once
 
+#include <memory>
 #include <string>
 
 #include "core/image/image.h"
@@ -17,5 +18,24 @@ bool imageHasAlpha(const std::string& path);
 // Writes straight-alpha RGBA; the format follows the extension (.png/.tif 8-bit, .exr half float).
 // Written to a temporary file in the same folder, then renamed. Throws Error naming the file.
 void writeImage(const std::string& path, const ImageRgba& image, int channels = 4);
+
+// An RGB image written a band of rows at a time, top row first (a frame too large to hold whole):
+// .png/.tif/.tiff 8-bit (values clamped to [0,1]), .exr half float. Like writeImage it writes a
+// temporary file beside the target and renames it in finish(); a writer destroyed before finish()
+// leaves the target untouched. Throws Error naming the file.
+class RowImageWriter {
+public:
+    RowImageWriter(const std::string& path, int width, int height);
+    ~RowImageWriter();
+    RowImageWriter(const RowImageWriter&) = delete;
+    RowImageWriter& operator=(const RowImageWriter&) = delete;
+    // The next `rows` rows, width * rows * 3 floats.
+    void writeRows(const float* rgb, int rows);
+    void finish();
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> m;
+};
 
 } // namespace sylva

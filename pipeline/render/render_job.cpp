@@ -5,6 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <numeric>
+#include <memory>
+
+#include <stdlib.h>
+#include <unistd.h>
 
 #include <QFile>
 
@@ -20,6 +24,14 @@
 #include "pipeline/scene/scene_file.h"
 
 namespace sylva {
+
+bool frameFitsMemory(const RenderSettings& r)
+{
+    const double needed = double(r.width) * double(r.height) * double(kFrameBytesPerPixel);
+    const double available = availableMemoryBytes();
+    return !(available > 0.0 && needed > 0.8 * available);
+}
+
 namespace {
 
 std::string readResource(const char* name)
@@ -43,7 +55,7 @@ void checkFrameMemory(const RenderSettings& r)
     const double pixels = double(r.width) * double(r.height);
     const double needed = pixels * double(kFrameBytesPerPixel);
     const double available = availableMemoryBytes();
-    if (available > 0.0 && needed > 0.8 * available) {
+    if (!frameFitsMemory(r)) {
         char msg[320];
         std::snprintf(msg, sizeof msg,
                       "render: a %dx%d image needs %.1f GB for its film and composed picture (%d bytes per pixel) but "
@@ -181,33 +193,205 @@ SpeciesGrids loadSpeciesGrids(const Scene& scene, size_t species, GridCache* cac
     return gridsForMesh(scene, sp, geometry.mesh, cache, progress, log, backend);
 }
 
-RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend)
+namespace {
+
+// Assets (0-60% of progress) and acceleration structures (60-70%) of a frame.
+RenderScene prepareFrame(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend,
+                         RenderTimings& timings)
 {
-    checkFrameMemory(scene.render);
-    RenderOutput out;
     auto t0 = std::chrono::steady_clock::now();
     SubProgress assetsPart(progress, 0.0, 0.6);
     Progress assetsProgress([&](double f, const std::string& m) { assetsPart.report(f, m); });
     if (progress && progress->isCancelled()) assetsProgress.cancel();
     const std::vector<SpeciesAssets> assets =
         loadSpeciesAssets(scene, cache, modeNeedsLighting(scene.render.mode), &assetsProgress, log, backend);
-    out.timings.assets = secondsSince(t0);
+    timings.assets = secondsSince(t0);
 
     t0 = std::chrono::steady_clock::now();
     SubProgress buildPart(progress, 0.6, 0.7);
     Progress buildProgress([&](double f, const std::string& m) { buildPart.report(f, m); });
-    const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun), &buildProgress);
+    RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun), &buildProgress);
     if (log) log->stages.push_back("build");
-    out.stats = rs.stats();
-    out.timings.build = secondsSince(t0);
+    timings.build = secondsSince(t0);
+    return rs;
+}
 
-    t0 = std::chrono::steady_clock::now();
+} // namespace
+
+RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend)
+{
+    checkFrameMemory(scene.render);
+    RenderOutput out;
+    const RenderScene rs = prepareFrame(scene, cache, progress, log, backend, out.timings);
+    out.stats = rs.stats();
+
+    const auto t0 = std::chrono::steady_clock::now();
     SubProgress tracePart(progress, 0.7, 1.0);
     Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
     if (progress && progress->isCancelled()) traceProgress.cancel();
     out.film = backend ? backend->render(rs, &traceProgress) : renderFilm(rs.view(), &traceProgress);
     if (log) log->stages.push_back("trace");
     out.timings.trace = secondsSince(t0);
+    return out;
+}
+
+int bandRowsFor(const RenderSettings& r)
+{
+    // A band's film, composed picture and tone-mapped rows: the parts plus two RGB floats per pixel.
+    const double rowBytes = double(r.width) * double(sizeof(SampleParts) + 2 * sizeof(glm::vec3));
+    const double available = availableMemoryBytes();
+    const double budget = std::min(256e6, available > 0.0 ? 0.25 * available : 256e6);
+    const int rows = int(std::clamp(budget / rowBytes, 8.0, double(std::max(8, r.height))));
+    return rows / 8 * 8;
+}
+
+namespace {
+
+struct FileCloser {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+};
+
+} // namespace
+
+BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, int bandRows, GridCache* cache,
+                                Progress* progress, JobLog* log)
+{
+    const RenderSettings& r = scene.render;
+    if (bandRows < 1) throw Error("render: rows per band must be at least 1, got " + std::to_string(bandRows));
+    std::string ext = std::filesystem::path(outPath).extension().string();
+    for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext != ".png" && ext != ".tif" && ext != ".tiff" && ext != ".exr")
+        throw Error(outPath + ": unknown image extension '" + ext + "' (use .png, .tif, .tiff or .exr)");
+    const bool linearOut = ext == ".exr";
+    const bool ambientMode = r.mode == RenderMode::Ambient;
+    // Between the passes each pixel waits on disk: its composed linear RGB, or for ambient (whose
+    // constant needs the whole frame) local, albedo and sky cover.
+    const size_t floatsPerPixel = ambientMode ? 7 : 3;
+    const size_t width = size_t(r.width), height = size_t(r.height);
+    const double tempBytes = double(width * height * floatsPerPixel * sizeof(float));
+    std::filesystem::path dir = std::filesystem::absolute(outPath).parent_path();
+    std::filesystem::create_directories(dir);
+    std::error_code ec;
+    const std::filesystem::space_info space = std::filesystem::space(dir, ec);
+    if (!ec && double(space.available) < 1.05 * tempBytes + double(width * height * (linearOut ? 6 : 3))) {
+        char msg[400];
+        std::snprintf(msg, sizeof msg,
+                      "render: the %dx%d frame is rendered in bands through a temporary file of %.1f GB in %s, but only "
+                      "%.1f GB is free there",
+                      r.width, r.height, tempBytes / 1e9, dir.string().c_str(), double(space.available) / 1e9);
+        throw Error(msg);
+    }
+    std::string tmpl = (dir / ".sylva-bands-XXXXXX").string();
+    const int fd = mkstemp(tmpl.data());
+    if (fd < 0) throw Error(dir.string() + ": cannot create a temporary file for the bands");
+    std::filesystem::remove(tmpl, ec);   // unlinked at once: the data goes when the file closes, crash or not
+    std::unique_ptr<std::FILE, FileCloser> temp(fdopen(fd, "w+b"));
+    if (!temp) {
+        ::close(fd);
+        throw Error(dir.string() + ": cannot open the temporary file for the bands");
+    }
+    auto io = [&](bool write, float* data, size_t count) {
+        const size_t done = write ? std::fwrite(data, sizeof(float), count, temp.get()) : std::fread(data, sizeof(float), count, temp.get());
+        if (done != count)
+            throw Error(dir.string() + (write ? ": cannot write the temporary band file (disk full?)" : ": cannot read the temporary band file back"));
+    };
+
+    BandedRender out;
+    const RenderScene rs = prepareFrame(scene, cache, progress, log, nullptr, out.timings);
+    out.stats = rs.stats();
+    const RenderView view = rs.view();
+    const int bands = (r.height + bandRows - 1) / bandRows;
+    out.bands = bands;
+    out.bandRows = bandRows;
+
+    // Pass 1: trace each band (70-95%), keep what pass 2 needs, sum what the whole frame decides.
+    auto t0 = std::chrono::steady_clock::now();
+    SubProgress tracePart(progress, 0.7, 0.95);
+    double indirectSum = 0.0, albedoSum = 0.0;
+    LogAverageAccumulator logAverage;
+    std::vector<float> buf;
+    for (int b = 0; b < bands; ++b) {
+        const int y0 = b * bandRows, y1 = std::min(r.height, y0 + bandRows);
+        Progress bandProgress([&](double f, const std::string&) {
+            tracePart.report((double(b) + f) / double(bands), "tracing band " + std::to_string(b + 1) + "/" + std::to_string(bands));
+        });
+        if (progress && progress->isCancelled()) bandProgress.cancel();
+        const Film film = renderFilmRows(view, y0, y1, &bandProgress);
+        buf.resize(film.pixels.size() * floatsPerPixel);
+        if (ambientMode) {
+            addAmbientSums(film, &indirectSum, &albedoSum);
+            for (size_t p = 0; p < film.pixels.size(); ++p) {
+                const SampleParts& s = film.pixels[p];
+                float* d = &buf[p * 7];
+                for (int c = 0; c < 3; ++c) {
+                    d[c] = s.local[c];
+                    d[3 + c] = s.albedo[c];
+                }
+                d[6] = s.skyCover;
+            }
+        } else {
+            for (size_t p = 0; p < film.pixels.size(); ++p) {
+                const glm::vec3 c = composeSample(film.pixels[p], r.mode, scene.sky, 0.0f);
+                for (int k = 0; k < 3; ++k) buf[p * 3 + size_t(k)] = c[k];
+            }
+            if (!linearOut) logAverage.add(buf.data(), film.pixels.size(), 3);
+        }
+        io(true, buf.data(), buf.size());
+    }
+    if (log) log->stages.push_back("trace");
+    out.timings.trace = secondsSince(t0);
+    out.ambient = ambientMode ? ambientConstant(indirectSum, albedoSum) : 0.0f;
+
+    // Reads band b back as composed linear RGB into rgb.
+    std::vector<float> rgb;
+    auto readBand = [&](int b) {
+        const int y0 = b * bandRows, y1 = std::min(r.height, y0 + bandRows);
+        const size_t pixels = size_t(y1 - y0) * width;
+        buf.resize(pixels * floatsPerPixel);
+        io(false, buf.data(), buf.size());
+        rgb.resize(pixels * 3);
+        if (!ambientMode) {
+            rgb = buf;
+            return pixels;
+        }
+        for (size_t p = 0; p < pixels; ++p) {
+            const float* d = &buf[p * 7];
+            SampleParts s;
+            s.local = glm::vec3(d[0], d[1], d[2]);
+            s.albedo = glm::vec3(d[3], d[4], d[5]);
+            s.skyCover = d[6];
+            const glm::vec3 c = composeSample(s, RenderMode::Ambient, scene.sky, out.ambient);
+            for (int k = 0; k < 3; ++k) rgb[p * 3 + size_t(k)] = c[k];
+        }
+        return pixels;
+    };
+    // Ambient to a tone-mapped file: the log-average needs the composed frame, one more read.
+    if (ambientMode && !linearOut) {
+        std::rewind(temp.get());
+        for (int b = 0; b < bands; ++b) {
+            const size_t pixels = readBand(b);
+            logAverage.add(rgb.data(), pixels, 3);
+        }
+    }
+    // Pass 2 (95-100%): compose, tone map, write the rows.
+    const float scale = linearOut ? 1.0f : toneMapScale(logAverage.value(), ToneMapParams{r.exposureKey});
+    std::rewind(temp.get());
+    SubProgress writePart(progress, 0.95, 1.0);
+    RowImageWriter writer(outPath, r.width, r.height);
+    std::vector<float> mapped;
+    for (int b = 0; b < bands; ++b) {
+        if (progress) progress->throwIfCancelled();
+        const size_t pixels = readBand(b);
+        if (linearOut) {
+            writer.writeRows(rgb.data(), int(pixels / width));
+        } else {
+            mapped.resize(pixels * 3);
+            toneMapScaled(rgb.data(), pixels, mapped.data(), scale);
+            writer.writeRows(mapped.data(), int(pixels / width));
+        }
+        writePart.report(double(b + 1) / double(bands), "writing");
+    }
+    writer.finish();
     return out;
 }
 

@@ -69,6 +69,30 @@ inline constexpr size_t kFrameBytesPerPixel = sizeof(SampleParts) + sizeof(glm::
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr,
                          Backend* backend = nullptr);
 
+// Whether a whole frame (film and composed picture, kFrameBytesPerPixel per pixel) fits in 80% of the
+// available memory (core/base/memory.h; true when unknown).
+bool frameFitsMemory(const RenderSettings& r);
+
+// Rows per band for renderSceneInBands: a band's film and pictures in about 256 MB (at most a quarter
+// of the available memory), a multiple of 8, at least 8.
+int bandRowsFor(const RenderSettings& r);
+
+struct BandedRender {
+    AccelStats stats;
+    RenderTimings timings;
+    float ambient = 0.0f;   // the ambient mode's constant (0 in other modes)
+    int bands = 0, bandRows = 0;
+};
+// A frame too large to hold whole, traced on the CPU in bands of bandRows rows and written to outPath
+// (.png/.tif/.tiff tone-mapped, .exr linear) band by band: memory holds one band, and between the
+// passes the pixels wait in an unlinked temporary file beside outPath (12 bytes per pixel, 28 in
+// ambient mode; refused up front, naming the sizes, when the disk lacks the room). The picture is
+// exactly the one renderScene + composeMode + writeRender produce: the ambient constant and the
+// log-average luminance sum the bands in the whole frame's order. Throws Error or Cancelled; the
+// target file is only replaced at the end.
+BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, int bandRows, GridCache* cache,
+                                Progress* progress = nullptr, JobLog* log = nullptr);
+
 // Tone-mapped (Reinhard, log-average key) sRGB picture of linear RGB pixels, alpha 1.
 ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key);
 

@@ -158,6 +158,36 @@ private Q_SLOTS:
         for (int i = 0; i < 5; ++i) QCOMPARE(logAverageLuminance(img.data(), 300000, 3), a);
     }
 
+    // A frame rendered in bands feeds the accumulator piece by piece: any split, chunk-aligned or not
+    // (pieces of 1 pixel, within a chunk, across several chunks), gives the whole image's bits; and the
+    // value is the geometric mean computed independently in long double.
+    void logAverageInPiecesEqualsWhole()
+    {
+        const size_t n = 100003;
+        const std::vector<float> img = randomImage(n, 3, true);
+        const float whole = logAverageLuminance(img.data(), n, 3);
+        long double sum = 0.0L;
+        size_t count = 0;
+        for (size_t i = 0; i < n; ++i) {
+            const float l = luminance(glm::vec3(img[i * 3], img[i * 3 + 1], img[i * 3 + 2]));
+            if (!std::isfinite(l)) continue;
+            sum += std::log(1e-4L + (l > 0.0f ? l : 0.0f));
+            ++count;
+        }
+        QVERIFY(std::fabs(double(whole) - double(std::exp(sum / count))) <= 1e-6 * double(whole));
+        std::mt19937 rng(7);
+        for (size_t piece : {size_t(1), size_t(7), size_t(16384), size_t(20000), size_t(50001), size_t(0)}) {
+            LogAverageAccumulator acc;
+            size_t at = 0;
+            while (at < n) {
+                const size_t len = std::min(n - at, piece ? piece : size_t(1 + rng() % 40000));
+                acc.add(img.data() + at * 3, len, 3);
+                at += len;
+            }
+            QCOMPARE(acc.value(), whole);
+        }
+    }
+
     void constantGreyMapsToReinhardOfKey()
     {
         // logAverage = L + delta, so scale * L = key * L / (L + delta) and the output is its Reinhard value.
