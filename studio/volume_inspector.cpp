@@ -1,6 +1,8 @@
 // VolumeInspector: slice controls, the slice picture with its legend, the value under the cursor.
 #include "studio/volume_inspector.h"
 
+#include "studio/volume_view.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -11,6 +13,7 @@
 #include <QMouseEvent>
 #include <QPainter>
 #include <QSlider>
+#include <QTabWidget>
 #include <QVBoxLayout>
 
 namespace sylva {
@@ -104,12 +107,47 @@ VolumeInspector::VolumeInspector(QWidget* parent) : QWidget(parent)
     legendRow->addWidget(m_min);
     legendRow->addWidget(m_legend, 1);
     legendRow->addWidget(m_max);
+    auto* slices = new QWidget;
+    auto* sl = new QVBoxLayout(slices);
+    sl->setContentsMargins(0, 0, 0, 0);
+    sl->addLayout(controls);
+    sl->addWidget(m_view, 1);
+    sl->addLayout(legendRow);
+    sl->addWidget(m_value);
+
+    // 3D: lighting choice and extinction over the volume view (made on first show).
+    m_volumePage = new QWidget;
+    auto* vl = new QVBoxLayout(m_volumePage);
+    vl->setContentsMargins(0, 0, 0, 0);
+    auto* vc = new QGridLayout;
+    m_volumeLighting = new QComboBox;
+    m_volumeLighting->setObjectName("volumeLighting");
+    m_volumeLighting->addItem(tr("single scattering of the sun"));
+    m_volumeLighting->addItem(tr("LB lighting"));
+    m_volumeLighting->setToolTip(tr("Single scattering: the sun's light marched through the density (seed 003); "
+                                    "LB lighting: each sample lit by the LB grid's luminance"));
+    m_extinction = new QSlider(Qt::Horizontal);
+    m_extinction->setObjectName("volumeExtinction");
+    m_extinction->setRange(1, 60);
+    m_extinction->setValue(12);
+    m_extinction->setToolTip(tr("Extinction of density 1 per grid length"));
+    vc->addWidget(new QLabel(tr("Light")), 0, 0);
+    vc->addWidget(m_volumeLighting, 0, 1);
+    vc->addWidget(new QLabel(tr("Opacity")), 1, 0);
+    vc->addWidget(m_extinction, 1, 1);
+    vl->addLayout(vc);
+    vl->addStretch(1);
+
+    m_tabs = new QTabWidget;
+    m_tabs->addTab(slices, tr("Slices"));
+    m_tabs->addTab(m_volumePage, tr("3D"));
+    connect(m_tabs, &QTabWidget::currentChanged, this, [this](int index) {
+        if (index == 1) show3D();
+    });
+
     auto* layout = new QVBoxLayout(this);
     layout->addWidget(m_title);
-    layout->addLayout(controls);
-    layout->addWidget(m_view, 1);
-    layout->addLayout(legendRow);
-    layout->addWidget(m_value);
+    layout->addWidget(m_tabs, 1);
 
     connect(m_axis, &QComboBox::currentIndexChanged, this, [this] {
         updateDepthRange();
@@ -120,6 +158,24 @@ VolumeInspector::VolumeInspector(QWidget* parent) : QWidget(parent)
     connect(m_view, &SliceView::hovered, this, &VolumeInspector::showValue);
     updateChannels();
     setMessage(tr("Select a species (or one of its instances) to inspect its lighting grids."));
+}
+
+void VolumeInspector::show3D()
+{
+    if (!m_volume) {
+        m_volume = new VolumeView;
+        auto* vl = static_cast<QVBoxLayout*>(m_volumePage->layout());
+        vl->insertWidget(1, m_volume, 1);
+        vl->takeAt(2);   // the stretch that held the place
+        connect(m_volumeLighting, &QComboBox::currentIndexChanged, m_volume, [this](int i) {
+            m_volume->setLighting(i == 1 ? VolumeView::Lighting::Lb : VolumeView::Lighting::SingleScattering);
+        });
+        connect(m_extinction, &QSlider::valueChanged, m_volume, [this](int v) { m_volume->setExtinction(float(v)); });
+        m_volume->setExtinction(float(m_extinction->value()));
+        m_volume->setLighting(m_volumeLighting->currentIndex() == 1 ? VolumeView::Lighting::Lb : VolumeView::Lighting::SingleScattering);
+        m_volume->setGrids(m_grids);
+    }
+    m_tabs->setCurrentIndex(1);
 }
 
 QString VolumeInspector::valueText(const glm::ivec3& node, float value)
@@ -143,6 +199,7 @@ void VolumeInspector::setGrids(const QString& species, std::shared_ptr<const Spe
     updateChannels();
     updateDepthRange();
     updateSlice();
+    if (m_volume) m_volume->setGrids(m_grids);
 }
 
 void VolumeInspector::setMessage(const QString& message)
@@ -153,6 +210,7 @@ void VolumeInspector::setMessage(const QString& message)
     updateChannels();
     updateDepthRange();
     updateSlice();
+    if (m_volume) m_volume->setGrids(nullptr);
 }
 
 const GridGeometry& VolumeInspector::geometry() const

@@ -12,6 +12,7 @@
 class QComboBox;
 class QLabel;
 class QSlider;
+class QTabWidget;
 
 namespace sylva {
 
@@ -42,6 +43,8 @@ private:
     QImage m_image;
 };
 
+class VolumeView;
+
 class VolumeInspector : public QWidget {
     Q_OBJECT
 
@@ -71,6 +74,11 @@ public:
     QLabel* minLabel() const { return m_min; }
     QLabel* maxLabel() const { return m_max; }
     QLabel* titleLabel() const { return m_title; }
+    // The "Slices" and "3D" pages; the 3D view (a QOpenGLWidget) is made when its page is first shown.
+    QTabWidget* tabs() const { return m_tabs; }
+    VolumeView* volumeView() const { return m_volume; }
+    QComboBox* volumeLightingBox() const { return m_volumeLighting; }
+    void show3D();
 
     // "node (i, j, k) = value" as the value label shows it.
     static QString valueText(const glm::ivec3& node, float value);
@@ -98,6 +106,11 @@ private:
     QLabel* m_min;
     QLabel* m_max;
     QLabel* m_value;
+    QTabWidget* m_tabs;
+    QWidget* m_volumePage;
+    QComboBox* m_volumeLighting;
+    QSlider* m_extinction;
+    VolumeView* m_volume = nullptr;
 };
 
 } // namespace sylva

@@ -1,20 +1,25 @@
-// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation, scatter, side-by-side compare, leaf/wood materials.
+// The studio's editing tools under Xvfb: autosave and crash recovery, fly navigation, scatter, side-by-side compare, leaf/wood materials, the inspector's 3D view.
 #include <QAction>
 #include <QCheckBox>
 #include <QComboBox>
 #include <QDir>
 #include <QFile>
 #include <QPushButton>
+#include <QTabWidget>
 #include <QTreeWidget>
 
 #include <algorithm>
 #include <memory>
 #include <set>
 
+#include "core/lb/lb_params.h"
+#include "pipeline/cache/grid_cache.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/camera_nav.h"
 #include "studio/render_worker.h"
 #include "studio/scene_document.h"
+#include "studio/volume_inspector.h"
+#include "studio/volume_view.h"
 #include "studio_test_util.h"
 
 using namespace sylva;
@@ -433,6 +438,77 @@ private Q_SLOTS:
         QCOMPARE(errors.size(), 1);
         QVERIFY(errors[0].contains("grown"));
         w->document()->undoStack()->setClean();
+    }
+
+    // The inspector's 3D view under Xvfb (Mesa): a grown shrub's density ray marched with single
+    // scattering draws the plant over the background; an empty grid draws only the background; the
+    // picture follows the light (sun above vs below) and the LB lighting mode draws too.
+    void volumeViewRendersTheGrid()
+    {
+        Scene one;
+        SpeciesDesc sp;
+        sp.name = "shrub";
+        sp.grow = GrowSpec{"shrub", 7, 3000, 0.0f};
+        sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+        sp.grid = 16;
+        one.species.push_back(sp);
+        GridCache cache(m_dir.filePath("cache-3d").toStdString());
+        auto grids = std::make_shared<const SpeciesGrids>(loadSpeciesGrids(one, 0, &cache));
+
+        VolumeInspector insp;
+        insp.resize(420, 560);
+        insp.setGrids("shrub", grids);
+        insp.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&insp));
+        QVERIFY(!insp.volumeView());   // made on first use only
+        insp.tabs()->setCurrentIndex(1);
+        VolumeView* v = insp.volumeView();
+        QVERIFY(v);
+        QTRY_VERIFY(v->isValid());
+        const QColor bg = VolumeView::background();
+        auto stats = [&](const QImage& img, int* differing) {
+            *differing = 0;
+            for (int y = 0; y < img.height(); ++y)
+                for (int x = 0; x < img.width(); ++x) {
+                    const QRgb p = img.pixel(x, y);
+                    if (std::abs(qRed(p) - bg.red()) + std::abs(qGreen(p) - bg.green()) + std::abs(qBlue(p) - bg.blue()) > 6) ++*differing;
+                }
+        };
+        v->setView(30.0f, 15.0f, 2.4f);
+        v->setSunDirection({0.3f, 1.0f, 0.2f});
+        const QImage above = v->grabFramebuffer();
+        QVERIFY2(v->problem().isEmpty(), qPrintable(v->problem()));
+        QVERIFY(above.width() > 100);
+        int differing = 0;
+        stats(above, &differing);
+        const double share = double(differing) / double(above.width() * above.height());
+        QVERIFY2(share > 0.02 && share < 0.9, qPrintable(QString("%1 of the pixels show the plant").arg(share)));
+        double mean = 0.0, sd = 0.0;
+        lumaStats(above, &mean, &sd);
+        QVERIFY2(sd > 3.0, qPrintable(QString::number(sd)));
+        const QRgb corner = above.pixel(2, 2);
+        QVERIFY(std::abs(qRed(corner) - bg.red()) <= 2 && std::abs(qBlue(corner) - bg.blue()) <= 2);
+        QImage shot = above;
+        shot.save(QString(SYLVA_TEST_OUTPUT) + "/gui_volume_view.png");
+
+        // The light matters: from below, the plant is lit differently.
+        v->setSunDirection({0.3f, -1.0f, 0.2f});
+        const QImage below = v->grabFramebuffer();
+        QVERIFY(below != above);
+        // LB lighting draws too, and differently.
+        insp.volumeLightingBox()->setCurrentIndex(1);
+        QCOMPARE(v->lighting(), VolumeView::Lighting::Lb);
+        const QImage lbPicture = v->grabFramebuffer();
+        stats(lbPicture, &differing);
+        QVERIFY(differing > above.width() * above.height() / 50);
+        QVERIFY(lbPicture != above);
+
+        // No medium: the background only.
+        auto empty = std::make_shared<SpeciesGrids>(*grids);
+        std::fill(empty->density.density.begin(), empty->density.density.end(), 0.0f);
+        insp.setGrids("empty", empty);
+        stats(v->grabFramebuffer(), &differing);
+        QCOMPARE(differing, 0);
     }
 };
 
