@@ -203,6 +203,7 @@ public:
             field->b = field->a;
             m_fields.push_back(std::move(field));
         }
+        m_skipF0 = params.zeroF0 && bc[0] == 0.0f;
     }
 
     size_t bytesPerStep() const { return m_fields.size() * size_t(m_X) * m_Y * m_Z * kDirections * sizeof(S) * 2; }
@@ -307,6 +308,7 @@ public:
     // Raw access to the current state of channel solve c (storage order, fp32 values).
     void setState(size_t c, const std::vector<float>& f)
     {
+        m_skipF0 = false;   // the given state may hold f_0
         ChannelField<S>& field = *m_fields[c];
         const size_t chunk = size_t(m_Z) * kDirections;   // one (i, j) row of all directions
         tbb::parallel_for(size_t(0), f.size() / chunk, [&](size_t r) {
@@ -356,7 +358,7 @@ private:
         const size_t rowBytes = size_t(kDirections) * size_t(m_Z) * sizeof(S);
         for (size_t b = 0; b < rowBytes; b += 64) __builtin_prefetch(s + b, 0, 3);
         const size_t segBytes = size_t(m_Z) * sizeof(S);
-        for (int m = 0; m < kDirections; ++m) {
+        for (int m = m_skipF0 ? 1 : 0; m < kDirections; ++m) {
             const int ti = i + kC[m][0], tj = j + kC[m][1];
             if (ti < 1 || ti > m_X - 2 || tj < 1 || tj > m_Y - 2) continue;
             const char* d = reinterpret_cast<const char*>(dst + dindex(ti, tj, 0, m));
@@ -377,6 +379,7 @@ private:
                 const int k0 = std::max(0, 1 - cz), k1 = std::min(m_Z - 1, m_Z - 2 - cz);
                 if (k1 < k0) continue;
                 S* d = dst + dindex(ti, tj, k0 + cz, m);
+                if (m == 0 && m_skipF0) continue;
                 if (m == 0 && m_params.zeroF0) std::fill(d, d + (k1 - k0 + 1), toStorage<S>(0.0f));
                 else std::memcpy(d, src + dindex(i, j, k0, m), size_t(k1 - k0 + 1) * sizeof(S));
             }
@@ -385,7 +388,8 @@ private:
         float* buf = s.buf.data();
         const size_t Zp = size_t(m_Zp);
         // 1. Load the row's 19 directions (z contiguous), padding to a multiple of 8 with zeros.
-        for (int m = 0; m < kDirections; ++m) loadRow(src + dindex(i, j, 0, m), buf + size_t(m) * Zp, m_Z);
+        // With m_skipF0 the f_0 row of buf is already zero (set at the end of the previous row).
+        for (int m = m_skipF0 ? 1 : 0; m < kDirections; ++m) loadRow(src + dindex(i, j, 0, m), buf + size_t(m) * Zp, m_Z);
         // 2. Node totals of the source state, for the tolerance check.
         if (outMode != 0) {
             float* tot = &m_totals[(c * size_t(m_X) * m_Y + r) * size_t(m_Z)];
@@ -436,7 +440,7 @@ private:
         }
         if (m_params.zeroF0) std::fill(buf, buf + Zp, 0.0f);   // absorbed: f_0 leaves the visible band
         // 4. Stream: post_m(r) goes to r + c_m when that node is interior.
-        for (int m = 0; m < kDirections; ++m) {
+        for (int m = m_skipF0 ? 1 : 0; m < kDirections; ++m) {
             const int ti = i + kC[m][0], tj = j + kC[m][1], cz = kC[m][2];
             if (ti < 1 || ti > m_X - 2 || tj < 1 || tj > m_Y - 2) continue;
             const int k0 = std::max(0, 1 - cz), k1 = std::min(m_Z - 1, m_Z - 2 - cz);   // source k range
@@ -456,6 +460,9 @@ private:
     std::vector<int> m_brown;          // padded rows, -1 where brown
     std::vector<uint8_t> m_rowActive;  // any density in the row
     std::vector<uint8_t> m_rowBrown;   // any brown node in the row
+    // f_0 is zero in both copies and stays so (zeroF0 from a start that has it zero: the boundary
+    // condition, the coarse start): its rows are then neither read nor written, 1/19 of the traffic.
+    bool m_skipF0 = false;
     std::vector<std::unique_ptr<ChannelField<S>>> m_fields;
     std::vector<float> m_totals;
     std::vector<double> m_rowDiff, m_rowNorm;
