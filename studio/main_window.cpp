@@ -641,8 +641,11 @@ void MainWindow::refreshInspector()
     const Scene& s = m_doc->scene();
     const std::string key = assetKey(s.species[size_t(species)], s.sun, true);
     if (key == m_inspectedKey) return;   // shown or loading
-    if (m_lightingJob) {
-        // The lighting job solves these grids right now: read them from the cache when it is done.
+    if (m_lightingJob || m_lightingTimer.isActive()) {
+        // The lighting job solves these grids (or is about to): read them from the cache when it is
+        // done rather than solve them twice at once.
+        if (m_inspectorJob) m_inspectorJob->cancel();
+        m_inspectedKey.clear();
         m_inspector->setMessage(tr("Waiting for the lighting job..."));
         return;
     }
@@ -799,6 +802,7 @@ Job* MainWindow::computeLighting(bool reload)
     }
     if (m_assets.missingSpecies(scene, lit).empty()) {
         updateViewport();
+        refreshInspector();
         return nullptr;
     }
     GridCache* cache = m_cache.get();

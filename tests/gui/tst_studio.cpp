@@ -206,6 +206,41 @@ private Q_SLOTS:
         select({OutlinerItem::Kind::Instance, 0});
         QCOMPARE(m_win->selectedSpecies(), 0);
         QCOMPARE(m_win->inspector()->grids(), grids);
+
+        // A sun move while the inspector is hidden, shown while the lighting job runs: it waits for
+        // the job, then shows the new grids (the job's own).
+        m_win->inspectorDock()->hide();
+        const Scene first = scene();
+        Scene moved = first;
+        moved.sun.direction = sunDirection(30.0, 200.0);
+        m_win->document()->edit(moved, "sun");
+        QSignalSpy relitSpy(m_win.get(), &MainWindow::lightingFinished);
+        QVERIFY(m_win->computeLighting());
+        m_win->inspectorDock()->show();
+        QVERIFY(!m_win->inspector()->grids());   // waiting
+        QVERIFY(relitSpy.wait(60000));
+        QTRY_VERIFY_WITH_TIMEOUT(m_win->inspector()->grids() != nullptr, 30000);
+        const auto second = m_win->inspector()->grids();
+        const AssetsPtr relit = m_win->assetStore()->find(assetKey(scene().species[0], scene().sun, true));
+        QVERIFY(relit);
+        QVERIFY(second->lighting.rgb == relit->lighting.rgb);
+        QVERIFY(relit->lighting.rgb != grids->lighting.rgb);
+        // Another sun, and back to the second one while its job still runs: the inspector must not
+        // keep waiting for grids it already had.
+        m_win->inspectorDock()->hide();
+        moved.sun.direction = sunDirection(50.0, 100.0);
+        m_win->document()->edit(moved, "sun again");
+        relitSpy.clear();
+        QVERIFY(m_win->computeLighting());
+        m_win->inspectorDock()->show();
+        QVERIFY(!m_win->inspector()->grids());
+        m_win->document()->undoStack()->undo();
+        QVERIFY(relitSpy.wait(60000));
+        QTRY_VERIFY_WITH_TIMEOUT(m_win->inspector()->grids() && m_win->inspector()->grids()->lighting.rgb == second->lighting.rgb, 30000);
+        // Back to the first sun: its grids again (from the cache).
+        m_win->document()->undoStack()->undo();
+        QCOMPARE(scene().sun.direction, first.sun.direction);
+        QTRY_VERIFY_WITH_TIMEOUT(m_win->inspector()->grids() && m_win->inspector()->grids()->lighting.rgb == grids->lighting.rgb, 30000);
         m_win->inspectorDock()->hide();
     }
 
