@@ -93,6 +93,22 @@ inline void storeRow(const float* src, uint16_t* dst, int n)
 #endif
     for (; k < n; ++k) dst[k] = floatToHalf(src[k]);
 }
+// 8 stored values as floats (the caller guarantees 8 readable values).
+inline Vec8 loadVector(const float* p) { return loadVec(p); }
+inline Vec8 loadVector(const uint16_t* p)
+{
+#ifdef SYLVA_LB_F16C
+    const __m256 v = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)));
+    Vec8 out;
+    std::memcpy(&out, &v, sizeof out);
+    return out;
+#else
+    Vec8 out;
+    for (int l = 0; l < kLanes; ++l) out[l] = halfToFloat(p[l]);
+    return out;
+#endif
+}
+
 template <typename S>
 S toStorage(float v);
 template <>
@@ -204,6 +220,15 @@ public:
             m_fields.push_back(std::move(field));
         }
         m_skipF0 = params.zeroF0 && bc[0] == 0.0f;
+        // Where each direction's row segment goes, relative to the source row (i, j, 0, 0): the
+        // neighbour row's segment m, shifted by c_z; the source range skips the z boundary nodes.
+        for (int m = 0; m < kDirections; ++m) {
+            const int cz = kC[m][2];
+            m_streamK0[m] = std::max(0, 1 - cz);
+            m_streamLen[m] = std::min(m_Z - 1, m_Z - 2 - cz) - m_streamK0[m] + 1;
+            m_streamOff[m] = (ptrdiff_t(kC[m][0]) * m_Y + kC[m][1]) * kDirections * ptrdiff_t(m_Z) + ptrdiff_t(m) * m_Z +
+                             m_streamK0[m] + cz;
+        }
     }
 
     size_t bytesPerStep() const { return m_fields.size() * size_t(m_X) * m_Y * m_Z * kDirections * sizeof(S) * 2; }
@@ -368,28 +393,110 @@ private:
 
     void processRow(size_t r, size_t c, const S* src, S* dst, Scratch& s, int outMode)
     {
-        ChannelField<S>& field = *m_fields[c];
         const int i = int(r / size_t(m_Y)), j = int(r % size_t(m_Y));
+        const size_t rowBase = dindex(i, j, 0, 0);
+        const S* srcRow = src + rowBase;
+        S* dstRow = dst + rowBase;
+        // Rows next to the x/y faces have neighbours on the boundary, which keeps its values.
+        const bool nearFace = i < 2 || i > m_X - 3 || j < 2 || j > m_Y - 3;
+        auto targetIsBoundary = [&](int m) {
+            const int ti = i + kC[m][0], tj = j + kC[m][1];
+            return ti < 1 || ti > m_X - 2 || tj < 1 || tj > m_Y - 2;
+        };
+        const int firstM = m_skipF0 ? 1 : 0;
         if (outMode == 0 && !m_rowActive[r]) {
             // No medium in the row and no totals wanted: the values stream unchanged (f_0 zeroed), so
             // they are copied in storage form, which is exactly what converting and back would give.
-            for (int m = 0; m < kDirections; ++m) {
-                const int ti = i + kC[m][0], tj = j + kC[m][1], cz = kC[m][2];
-                if (ti < 1 || ti > m_X - 2 || tj < 1 || tj > m_Y - 2) continue;
-                const int k0 = std::max(0, 1 - cz), k1 = std::min(m_Z - 1, m_Z - 2 - cz);
-                if (k1 < k0) continue;
-                S* d = dst + dindex(ti, tj, k0 + cz, m);
-                if (m == 0 && m_skipF0) continue;
-                if (m == 0 && m_params.zeroF0) std::fill(d, d + (k1 - k0 + 1), toStorage<S>(0.0f));
-                else std::memcpy(d, src + dindex(i, j, k0, m), size_t(k1 - k0 + 1) * sizeof(S));
+            for (int m = firstM; m < kDirections; ++m) {
+                if ((nearFace && targetIsBoundary(m)) || m_streamLen[m] <= 0) continue;
+                S* d = dstRow + m_streamOff[m];
+                if (m == 0 && m_params.zeroF0) std::fill(d, d + m_streamLen[m], toStorage<S>(0.0f));
+                else std::memcpy(d, srcRow + size_t(m) * size_t(m_Z) + size_t(m_streamK0[m]), size_t(m_streamLen[m]) * sizeof(S));
             }
             return;
         }
         float* buf = s.buf.data();
         const size_t Zp = size_t(m_Zp);
-        // 1. Load the row's 19 directions (z contiguous), padding to a multiple of 8 with zeros.
         // With m_skipF0 the f_0 row of buf is already zero (set at the end of the previous row).
-        for (int m = m_skipF0 ? 1 : 0; m < kDirections; ++m) loadRow(src + dindex(i, j, 0, m), buf + size_t(m) * Zp, m_Z);
+        if (outMode == 0) {
+            // 1+3. Load, collide and park in buf one vector of 8 nodes at a time: the values stay in
+            // registers between the load and the collision.
+            collideRowFused(r, c, srcRow, buf, firstM);
+        } else {
+            // 1. Load the row's 19 directions (z contiguous), padding to a multiple of 8 with zeros.
+            for (int m = firstM; m < kDirections; ++m) loadRow(srcRow + size_t(m) * size_t(m_Z), buf + size_t(m) * Zp, m_Z);
+            collideRowInBuf(r, c, buf, outMode);
+        }
+        if (m_params.zeroF0) std::fill(buf, buf + Zp, 0.0f);   // absorbed: f_0 leaves the visible band
+        // 4. Stream: post_m(r) goes to r + c_m when that node is interior.
+        for (int m = firstM; m < kDirections; ++m) {
+            if ((nearFace && targetIsBoundary(m)) || m_streamLen[m] <= 0) continue;
+            storeRow(buf + size_t(m) * Zp + size_t(m_streamK0[m]), dstRow + m_streamOff[m], m_streamLen[m]);
+        }
+    }
+
+    // The collision of one 8-node vector in place (f holds the 19 directions).
+    void collideVector(Vec8 (&f)[kDirections], size_t r, size_t k, const ChannelField<S>& field) const
+    {
+        const size_t Zp = size_t(m_Zp);
+        const float* rho = &m_rho[r * Zp];
+        const int* brown = &m_brown[r * Zp];
+        const Vec8 rv = loadVec(rho + k);
+        bool anyBrown = false;
+        if (m_rowBrown[r])
+            for (int l = 0; l < kLanes; ++l) anyBrown |= brown[k + size_t(l)] != 0;
+        if (!anyBrown) {
+            collideNode(f, rv, field.green, m_params.zeroF0);
+        } else {
+            Vec8 fb[kDirections];
+            for (int m = 0; m < kDirections; ++m) fb[m] = f[m];
+            collideNode(f, rv, field.green, m_params.zeroF0);
+            collideNode(fb, rv, field.brown, m_params.zeroF0);
+            Vec8i mask;
+            std::memcpy(&mask, brown + k, sizeof mask);
+            for (int m = 0; m < kDirections; ++m) f[m] = mask ? fb[m] : f[m];
+        }
+    }
+
+    bool vectorActive(size_t r, size_t k) const
+    {
+        const float* rho = &m_rho[r * size_t(m_Zp)];
+        bool any = false;
+        for (int l = 0; l < kLanes; ++l) any |= rho[k + size_t(l)] > 0.0f;
+        return any;
+    }
+
+    // Loads each 8-node vector of an active row straight from storage, collides it when it holds
+    // medium, and writes it to buf (the rows of 19 directions the streaming then reads).
+    // Loads each 8-node vector of an active row straight from storage, collides it when it holds
+    // medium, and writes it to buf (the rows of 19 directions the streaming then reads).
+    void collideRowFused(size_t r, size_t c, const S* srcRow, float* buf, int firstM) const
+    {
+        const ChannelField<S>& field = *m_fields[c];
+        const size_t Zp = size_t(m_Zp), Z = size_t(m_Z);
+        Vec8 f[kDirections];
+        if (firstM == 1) f[0] = Vec8{};
+        for (size_t k = 0; k < Zp; k += kLanes) {
+            if (k + kLanes <= Z) {
+                for (int m = firstM; m < kDirections; ++m) f[m] = loadVector(srcRow + size_t(m) * Z + k);
+            } else {   // the ragged end of a row whose length is no multiple of 8: zero padding
+                float tmp[kLanes];
+                for (int m = firstM; m < kDirections; ++m) {
+                    std::fill(tmp, tmp + kLanes, 0.0f);
+                    loadRow(srcRow + size_t(m) * Z + k, tmp, int(Z - k));
+                    f[m] = loadVec(tmp);
+                }
+            }
+            if (vectorActive(r, k)) collideVector(f, r, k, field);
+            for (int m = firstM; m < kDirections; ++m) storeVec(buf + size_t(m) * Zp + k, f[m]);
+        }
+    }
+
+    // Node totals (tolerance check) and collision of a row already loaded into buf.
+    void collideRowInBuf(size_t r, size_t c, float* buf, int outMode)
+    {
+        const ChannelField<S>& field = *m_fields[c];
+        const size_t Zp = size_t(m_Zp);
         // 2. Node totals of the source state, for the tolerance check.
         if (outMode != 0) {
             float* tot = &m_totals[(c * size_t(m_X) * m_Y + r) * size_t(m_Z)];
@@ -410,42 +517,13 @@ private:
             }
         }
         // 3. Collide, 8 nodes at a time; rows and vectors without medium stream unchanged.
-        if (m_rowActive[r]) {
-            const float* rho = &m_rho[r * Zp];
-            const int* brown = &m_brown[r * Zp];
-            const bool rowBrown = m_rowBrown[r] != 0;
-            for (size_t k = 0; k < Zp; k += kLanes) {
-                const Vec8 rv = loadVec(rho + k);
-                bool any = false;
-                for (int l = 0; l < kLanes; ++l) any |= rho[k + size_t(l)] > 0.0f;
-                if (!any) continue;
-                Vec8 f[kDirections];
-                for (int m = 0; m < kDirections; ++m) f[m] = loadVec(buf + size_t(m) * Zp + k);
-                bool anyBrown = false;
-                if (rowBrown)
-                    for (int l = 0; l < kLanes; ++l) anyBrown |= brown[k + size_t(l)] != 0;
-                if (!anyBrown) {
-                    collideNode(f, rv, field.green, m_params.zeroF0);
-                } else {
-                    Vec8 fb[kDirections];
-                    for (int m = 0; m < kDirections; ++m) fb[m] = f[m];
-                    collideNode(f, rv, field.green, m_params.zeroF0);
-                    collideNode(fb, rv, field.brown, m_params.zeroF0);
-                    Vec8i mask;
-                    std::memcpy(&mask, brown + k, sizeof mask);
-                    for (int m = 0; m < kDirections; ++m) f[m] = mask ? fb[m] : f[m];
-                }
-                for (int m = 0; m < kDirections; ++m) storeVec(buf + size_t(m) * Zp + k, f[m]);
-            }
-        }
-        if (m_params.zeroF0) std::fill(buf, buf + Zp, 0.0f);   // absorbed: f_0 leaves the visible band
-        // 4. Stream: post_m(r) goes to r + c_m when that node is interior.
-        for (int m = m_skipF0 ? 1 : 0; m < kDirections; ++m) {
-            const int ti = i + kC[m][0], tj = j + kC[m][1], cz = kC[m][2];
-            if (ti < 1 || ti > m_X - 2 || tj < 1 || tj > m_Y - 2) continue;
-            const int k0 = std::max(0, 1 - cz), k1 = std::min(m_Z - 1, m_Z - 2 - cz);   // source k range
-            if (k1 < k0) continue;
-            storeRow(buf + size_t(m) * Zp + size_t(k0), dst + dindex(ti, tj, k0 + cz, m), k1 - k0 + 1);
+        if (!m_rowActive[r]) return;
+        for (size_t k = 0; k < Zp; k += kLanes) {
+            if (!vectorActive(r, k)) continue;
+            Vec8 f[kDirections];
+            for (int m = 0; m < kDirections; ++m) f[m] = loadVec(buf + size_t(m) * Zp + k);
+            collideVector(f, r, k, field);
+            for (int m = 0; m < kDirections; ++m) storeVec(buf + size_t(m) * Zp + k, f[m]);
         }
     }
 
@@ -463,6 +541,8 @@ private:
     // f_0 is zero in both copies and stays so (zeroF0 from a start that has it zero: the boundary
     // condition, the coarse start): its rows are then neither read nor written, 1/19 of the traffic.
     bool m_skipF0 = false;
+    int m_streamK0[kDirections] = {}, m_streamLen[kDirections] = {};
+    ptrdiff_t m_streamOff[kDirections] = {};
     std::vector<std::unique_ptr<ChannelField<S>>> m_fields;
     std::vector<float> m_totals;
     std::vector<double> m_rowDiff, m_rowNorm;
