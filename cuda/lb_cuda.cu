@@ -176,7 +176,7 @@ LightingGrid solveTyped(const DensityGrid& density, const lb::LbParams& params, 
     const int threads = 128;
     const dim3 grid(unsigned((nodes + threads - 1) / threads), unsigned(ns));
     const int steps = params.tolerance > 0.0 ? (params.maxSteps > 0 ? params.maxSteps : 4 * density.geometry.longestEdge())
-                                             : (params.steps > 0 ? params.steps : lb::defaultSteps(dims));
+                                             : lb::fixedSteps(params, dims);
     const int checkEvery = params.checkEvery > 0 ? params.checkEvery : 16;
     DeviceBuffer<float> totA(nodes * size_t(ns), "totals"), totB(nodes * size_t(ns), "totals");
     DeviceBuffer<double> acc(2, "reduction");

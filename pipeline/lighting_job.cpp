@@ -60,7 +60,7 @@ CacheKey lightKey(const DensityGrid& density, const lb::LbParams& p)
         key.add("tolerance", p.tolerance).add("check every", p.checkEvery).add("max steps", p.maxSteps);
         key.add("block steps", p.blockSteps);
     } else {
-        key.add("steps", p.steps > 0 ? p.steps : lb::defaultSteps(density.geometry.dims));
+        key.add("steps", lb::fixedSteps(p, density.geometry.dims));
     }
     return key;
 }
@@ -168,7 +168,7 @@ std::string lightingParamsJson(const lb::LbParams& params, const std::string& pr
     extra << ",\"zero_f0\":" << (params.zeroF0 ? "true" : "false") << ",\"storage\":\""
           << (params.storage == lb::Storage::Fp16 ? "fp16" : "fp32") << "\"";
     if (params.tolerance > 0.0) extra << ",\"tolerance\":" << params.tolerance;
-    else extra << ",\"steps\":" << (params.steps > 0 ? params.steps : lb::defaultSteps(dims));
+    else extra << ",\"steps\":" << lb::fixedSteps(params, dims);
     extra << ",\"warm_start\":" << (params.warmStart ? "true" : "false");
     if (params.coarseStart) extra << ",\"coarse_start\":true";
     extra << "}";

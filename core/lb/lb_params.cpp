@@ -1,6 +1,7 @@
 // Presets from the seeds and parameter validation with messages that name the bound.
 #include "core/lb/lb_params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -41,6 +42,12 @@ LbParams paramsFromPreset(const Preset& preset)
 }
 
 int defaultSteps(const glm::ivec3& dims) { return 2 * glm::max(dims.x, glm::max(dims.y, dims.z)); }
+
+int fixedSteps(const LbParams& params, const glm::ivec3& dims)
+{
+    if (params.steps > 0) return params.steps;
+    return std::max(1, params.stepsPerEdge * glm::max(dims.x, glm::max(dims.y, dims.z)));
+}
 
 namespace {
 
@@ -84,6 +91,8 @@ void validate(const LbParams& params)
         if (!std::isfinite(params.intensity[c]) || params.intensity[c] < 0.0f)
             throw Error(std::string("invalid sun intensity for channel ") + names[c] + ": must be finite and >= 0");
     if (params.steps < 0) throw Error("invalid step count " + std::to_string(params.steps) + ": must be >= 1");
+    if (params.stepsPerEdge < 1 || params.stepsPerEdge > 64)
+        throw Error("invalid steps per edge " + std::to_string(params.stepsPerEdge) + ": must be in [1, 64]");
     if (!std::isfinite(params.tolerance) || params.tolerance < 0.0)
         throw Error("invalid tolerance: must be a finite number > 0");
     if (params.checkEvery < 0) throw Error("invalid tolerance check period: must be >= 1 step (or 0 for automatic)");

@@ -25,7 +25,8 @@ struct LbParams {
     bool zeroF0 = true;                        // plants: true; clouds and plastics keep f_0
     glm::vec3 sun{0.0f, 1.0f, 0.0f};           // direction toward the sun, any length
     glm::vec3 intensity{1.0f};                 // sun intensity per channel
-    int steps = 0;                             // 0 = default: 2 x the longest edge
+    int steps = 0;                             // fixed step count; 0 = stepsPerEdge x the longest edge
+    int stepsPerEdge = 2;                      // with steps = 0: steps per node of the longest edge (the seed's 2)
     double tolerance = 0.0;                    // > 0: stop when the relative L2 change per step < tolerance
     int checkEvery = 0;                        // tolerance check period in steps; 0 = about every 16 steps
     int maxSteps = 0;                          // tolerance mode cap; 0 = 4 x the longest edge
@@ -56,7 +57,9 @@ void validate(const LbParams& params);
 // Checks the density grid: dims >= 3, values finite in [0,1], sizes consistent. Throws Error.
 void validateDensity(const DensityGrid& density);
 
-// The step count a solve with these parameters runs in fixed-step mode (2 x longest edge by default).
+// The seed's step count: 2 x the longest edge.
 int defaultSteps(const glm::ivec3& dims);
+// The step count of a fixed-step solve with these parameters: steps, or stepsPerEdge x the longest edge.
+int fixedSteps(const LbParams& params, const glm::ivec3& dims);
 
 } // namespace sylva::lb

@@ -686,7 +686,7 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
     const int longest = density.geometry.longestEdge();
     const bool tolMode = params.tolerance > 0.0;
     const int steps = tolMode ? (params.maxSteps > 0 ? params.maxSteps : 4 * longest)
-                              : (params.steps > 0 ? params.steps : defaultSteps(density.geometry.dims));
+                              : fixedSteps(params, density.geometry.dims);
     LightingGrid out;
     out.geometry = density.geometry;
     out.rgb.assign(density.geometry.nodeCount() * 3, 0.0f);

@@ -9,7 +9,9 @@ lb::LbParams defaultSpeciesLighting(const lb::Preset& preset)
 {
     lb::LbParams p = lb::paramsFromPreset(preset);
     p.steps = 0;
-    p.tolerance = kDefaultLightingTolerance;
+    p.tolerance = 0.0;
+    p.stepsPerEdge = kDefaultStepsPerEdge;
+    p.storage = lb::Storage::Fp16;
     return p;
 }
 

@@ -28,6 +28,7 @@
 #include "pipeline/io/npy.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/lighting_job.h"
+#include "core/scene/quality.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/study/study.h"
@@ -190,7 +191,8 @@ std::vector<Command> commands()
                     0, 0});
     list.push_back({"render", "[SCENE.sylva.json] [-o OUT.png|.exr|.tif]",
                     "render a scene (the bundled default forest when none is given)",
-                    {{"--width", "W", "image width in pixels (default: the scene's)"},
+                    {{"--quality", "preview|final|reference", "quality preset: LB grid, steps and storage of every species, samples and distance knobs (docs/ACCURACY.md); the options below override it"},
+                     {"--width", "W", "image width in pixels (default: the scene's)"},
                      {"--height", "H", "image height in pixels (default: the scene's)"},
                      {"--spp", "N", "samples per pixel, 1..4096 (default: the scene's)"},
                      {"--mode", "M", "full (LB indirect + sun), local (sun only), ambient (sun + matched constant), lb"},
@@ -630,6 +632,11 @@ int cmdRender(const Args& args)
         if (stem.size() > 6 && stem.substr(stem.size() - 6) == ".sylva") stem.resize(stem.size() - 6);
     }
     RenderSettings& r = scene.render;
+    if (args.has("--quality")) {
+        const QualityPreset* q = findQualityPreset(args.get("--quality"));
+        if (!q) throw UsageError("option --quality: expected preview, final or reference, got '" + args.get("--quality") + "'");
+        applyQuality(scene, *q);
+    }
     if (args.has("--width")) r.width = int(parseInteger("--width", args.get("--width"), 1, 32768));
     if (args.has("--height")) r.height = int(parseInteger("--height", args.get("--height"), 1, 32768));
     if (args.has("--spp")) r.spp = int(parseInteger("--spp", args.get("--spp"), 1, 4096));

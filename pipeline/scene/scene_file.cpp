@@ -453,7 +453,7 @@ private:
     void readLighting(const QJsonValue& v, const KeyPath& path, SpeciesDesc& d) const
     {
         const QJsonObject o = optionalObject(v, path);
-        checkKeys(o, path, {"preset", "sigma_a", "sigma_s", "g", "zero_f0", "grid", "steps", "tolerance", "fp16"});
+        checkKeys(o, path, {"preset", "sigma_a", "sigma_s", "g", "zero_f0", "grid", "steps", "steps_per_edge", "tolerance", "fp16"});
         const QJsonValue presetValue = o.value(QLatin1String("preset"));
         if (!presetValue.isUndefined()) d.preset = string(presetValue, path.field("preset")).toStdString();
         const lb::Preset* preset = lb::findPreset(d.preset);
@@ -478,10 +478,12 @@ private:
         if (!grid.isUndefined()) d.grid = int(integer(grid, path.field("grid"), kMinGrid, kMaxGrid));
         const QJsonValue steps = o.value(QLatin1String("steps"));
         if (!steps.isUndefined()) {
-            // A step count (0: the seed's 2 x the longest edge) asks for fixed steps, not the default tolerance.
+            // A step count (0: steps_per_edge x the longest edge) asks for fixed steps.
             params.steps = int(integer(steps, path.field("steps"), 0, kMaxSteps));
             params.tolerance = 0.0;
         }
+        const QJsonValue perEdge = o.value(QLatin1String("steps_per_edge"));
+        if (!perEdge.isUndefined()) params.stepsPerEdge = int(integer(perEdge, path.field("steps_per_edge"), 1, 64));
         const QJsonValue tolerance = o.value(QLatin1String("tolerance"));
         if (!tolerance.isUndefined()) {
             params.tolerance = number(tolerance, path.field("tolerance"));
@@ -878,6 +880,9 @@ std::string sceneToJson(const Scene& scene, const std::string& baseDir)
         out.key("steps");
         out.integer((long long)l.steps);
         out.raw(", ");
+        out.key("steps_per_edge");
+        out.integer((long long)l.stepsPerEdge);
+        out.raw(", ");
         out.key("tolerance");
         out.number(l.tolerance, lp.field("tolerance"));
         out.raw(", ");
@@ -1077,6 +1082,7 @@ std::string describeScene(const Scene& scene)
         s += ", grid " + std::to_string(d.grid);
         if (l.tolerance > 0.0) s += ", tolerance " + human(l.tolerance);
         else if (l.steps > 0) s += ", " + std::to_string(l.steps) + " steps";
+        else s += ", " + std::to_string(l.stepsPerEdge) + " x the longest edge steps";
         if (l.storage == lb::Storage::Fp16) s += ", fp16";
         s += "; " + std::to_string(counts[i]) + " instances\n";
     }

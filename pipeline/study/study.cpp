@@ -8,36 +8,6 @@
 
 namespace sylva::study {
 
-const std::vector<QualityPreset>& qualityPresets()
-{
-    // Chosen from the measured fronts (docs/ACCURACY.md "Quality presets"); the report checks that
-    // each sits on its front and prints what it costs.
-    static const std::vector<QualityPreset> presets{
-        {"preview", 32, "tol 1e-3", false, 1, 50.0f, 25.0f},
-        {"final", 64, "tol 1e-3", false, 4, 0.0f, 0.0f},
-        {"reference", 128, "tol 1e-4", false, 64, 0.0f, 0.0f},
-    };
-    return presets;
-}
-
-void applyLbPreset(const QualityPreset& preset, lb::LbParams& params, const glm::ivec3& dims)
-{
-    const std::string steps = preset.steps;
-    params.steps = 0;
-    params.tolerance = 0.0;
-    if (steps == "half") {
-        if (dims.x <= 0) throw Error(std::string("preset ") + preset.name + ": half steps need the grid");
-        params.steps = std::max(1, lb::defaultSteps(dims) / 2);
-    } else if (steps == "tol 1e-3") {
-        params.tolerance = 1e-3;
-    } else if (steps == "tol 1e-4") {
-        params.tolerance = 1e-4;
-    } else if (steps != "default") {
-        throw Error(std::string("preset ") + preset.name + ": unknown steps '" + steps + "'");
-    }
-    params.storage = preset.fp16 ? lb::Storage::Fp16 : lb::Storage::Fp32;
-}
-
 bool parsePart(const std::string& name, Part* out)
 {
     if (name == "lb") *out = Part::Lb;
@@ -67,6 +37,7 @@ Result run(const Options& options)
         saveLb(lbPath, lb);
         input.lb = &lb;
     } else if (loadLb(lbPath, &lb)) {
+        markDefaults(lb);   // the report follows the current default, not the one at measuring time
         input.lb = &lb;
     }
     if (wants(Part::Voxel)) {

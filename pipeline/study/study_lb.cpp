@@ -220,12 +220,6 @@ LbData measureLb(const Options& o)
                               "cloud preset", "cloud", [](int n) { return cloudGrid(n); }});
 
     const char* stepModes[] = {"default", "half", "tol 1e-3", "tol 1e-4"};
-    // The product's default solve of a scene species (core/scene/scene.h), marked in every case.
-    const SpeciesDesc defaultSpecies;
-    const lb::LbParams def = defaultSpeciesLighting(*lb::findPreset("leaf"));
-    const std::string defSteps = def.tolerance == 1e-3 ? "tol 1e-3" : def.tolerance == 1e-4 ? "tol 1e-4" : def.tolerance > 0.0 ? "?" : "default";
-    const bool defFp16 = def.storage == lb::Storage::Fp16;
-    data.defaultConfig = "grid " + std::to_string(defaultSpecies.grid) + ", " + defSteps + ", " + (defFp16 ? "fp16" : "fp32");
     bool ran256 = false;
     std::string note256;
     for (const CaseSpec& spec : cases) {
@@ -304,7 +298,6 @@ LbData measureLb(const Options& o)
                     row.stepsTaken = st.steps;
                     row.errSame = own ? relativeL2Interior(out, own->mean, kChannel) : -1.0;
                     row.errFine = n == fine ? row.errSame : relativeL2Interior(resampled(out, fineDensity.geometry), fineRef.mean, kChannel);
-                    row.isDefault = n == defaultSpecies.grid && m == defSteps && fp16 == defFp16;
                     if (n == fine && m == "default" && fp16) fp16DefaultAtFine = cpu;
                     char line[256];
                     std::snprintf(line, sizeof line, "lb %s %s %s %s: %.3f s (CPU %.3f s), %d steps, error %.4f (same grid) %.4f (vs %d)",
@@ -323,7 +316,23 @@ LbData measureLb(const Options& o)
                      std::string(note256.empty() ? "ran for every case." : "ran where it fits: " + note256);
     data.run.seconds = secondsNow() - t0;
     data.run.loadAfter = loadAverage();
+    markDefaults(data);
     return data;
+}
+
+void markDefaults(LbData& data)
+{
+    const SpeciesDesc defaultSpecies;
+    const lb::LbParams def = defaultSpeciesLighting(*lb::findPreset("leaf"));
+    std::string steps = "?";
+    if (def.tolerance == 1e-3) steps = "tol 1e-3";
+    else if (def.tolerance == 1e-4) steps = "tol 1e-4";
+    else if (def.tolerance == 0.0 && def.steps == 0 && def.stepsPerEdge == 2) steps = "default";
+    else if (def.tolerance == 0.0 && def.steps == 0 && def.stepsPerEdge == 1) steps = "half";
+    const bool fp16 = def.storage == lb::Storage::Fp16;
+    data.defaultConfig = "grid " + std::to_string(defaultSpecies.grid) + ", " + steps + ", " + (fp16 ? "fp16" : "fp32");
+    for (LbCase& c : data.cases)
+        for (LbRow& row : c.rows) row.isDefault = row.grid == defaultSpecies.grid && row.steps == steps && row.fp16 == fp16;
 }
 
 } // namespace sylva::study

@@ -5,25 +5,21 @@
 
 #include "core/grid/grid.h"
 #include "core/lb/lb_params.h"
+#include "core/scene/quality.h"
 #include "pipeline/study/study.h"
 #include "pipeline/study/study_data.h"
 
 namespace sylva::study {
 
-// The quality presets the report recommends (docs/ACCURACY.md "Quality presets"): LB settings of every
-// species and render settings. The LB part measures their LB settings among its runs, the render part
-// renders the forest with each.
-struct QualityPreset {
-    const char* name;                   // "preview", "final", "reference"
-    int grid;                           // LB nodes on the longest axis
-    const char* steps;                  // "default", "half", "tol 1e-3", "tol 1e-4" (as LbRow::steps)
-    bool fp16;
-    int spp;
-    float alphaDistance, pruneDistance; // metres, 0 = off
-};
-const std::vector<QualityPreset>& qualityPresets();
-// A preset's steps/tolerance and storage applied to LB parameters ("half" needs the grid: dims).
-void applyLbPreset(const QualityPreset& preset, lb::LbParams& params, const glm::ivec3& dims);
+// The quality presets the report recommends (core/scene/quality.h): the LB part measures their LB
+// settings among its runs, the render part renders the forest with each.
+using sylva::QualityPreset;
+using sylva::qualityPresets;
+
+// The product's default solve of a scene species (defaultSpeciesLighting, SpeciesDesc::grid) in the
+// study's terms: sets data.defaultConfig and marks the rows that are it. Run when measuring and again
+// when writing the report, so the report follows the current default.
+void markDefaults(LbData& data);
 
 LbData measureLb(const Options& options);
 VoxelData measureVoxel(const Options& options);

@@ -202,7 +202,7 @@ RenderData measureRender(const Options& o)
             s.render.height = o.quick ? 112 : 224;
             for (SpeciesDesc& sp : s.species) {
                 sp.grid = q.grid;
-                applyLbPreset(q, sp.lighting, glm::ivec3(0));
+                applyQualityLighting(q, sp.lighting);
             }
             s.render.spp = q.spp;
             s.render.alphaDistance = q.alphaDistance;

@@ -308,7 +308,9 @@ std::string lbSection(const LbData& d, Plotter& pl)
         if (halfN > 0 && 2 * halfLower > halfN)
             s << " Fewer steps even lower the error a little (" << halfLower << " of " << halfN
               << " grids): an unconverged field is darker, which offsets the LB's excess brightness (mean LB / mean reference "
-                 "about 1.035, see Normalization). That is a cancellation, not accuracy; the presets do not count on it.";
+                 "about 1.035, see Normalization). That is a cancellation, not accuracy. The default and the presets solve 1 x "
+                 "the longest edge (\"half\") because the convergence error it leaves is far below the transport error at "
+                 "half the seed's cost, not because of that cancellation.";
         s << "\n";
     }
     s << "- **Grid resolution** is the knob that buys accuracy: error vs " << fine << " at the seed's steps, fp32, by grid:";

@@ -66,6 +66,7 @@ private Q_SLOTS:
         QTest::newRow("picture without extension") << QStringList{"light", "--density", "x.npy", "--sun", "0,1,0", "-o", "y.npy", "--picture", "pic"} << "image extension";
         QTest::newRow("render bad mode") << QStringList{"render", "--mode", "sketch"} << "expected full, local, ambient or lb";
         QTest::newRow("render bad accel") << QStringList{"render", "--accel", "octree"} << "expected bvh or kdtree";
+        QTest::newRow("render bad quality") << QStringList{"render", "--quality", "draft"} << "expected preview, final or reference";
         QTest::newRow("render bad spp") << QStringList{"render", "--spp", "0"} << "outside [1, 4096]";
         QTest::newRow("render bad extension") << QStringList{"render", "-o", "forest.jpg2"} << "unknown image extension";
         QTest::newRow("render two scenes") << QStringList{"render", "a.json", "b.json"} << "unexpected argument 'b.json'";
@@ -171,6 +172,11 @@ private Q_SLOTS:
         r = runSylva({"render", scene, "--width", "40", "--height", "20", "--mode", "lb", "-o", dir + "/small.exr", "--quiet"}, cache);
         QVERIFY2(r.code == 0, qPrintable(r.err));
         QVERIFY(QFileInfo(dir + "/small.exr").exists());
+        // A quality preset sets the species' grids: preview solves them at 32 nodes (the cache holds the
+        // 16-node grids of the runs above and now a 32-node one too); --spp still overrides it.
+        r = runSylva({"render", scene, "--quality", "preview", "--spp", "2", "--width", "40", "--height", "20", "-o", dir + "/preview.png"}, cache);
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QVERIFY2(r.out.contains("2 spp"), qPrintable(r.out));
         r = runSylva({"info", scene});
         QCOMPARE(r.code, 0);
         QVERIFY2(r.out.contains("shrub"), qPrintable(r.out));

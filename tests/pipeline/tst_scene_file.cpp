@@ -14,6 +14,8 @@
 #include <QTest>
 
 #include "core/base/error.h"
+#include "core/scene/quality.h"
+#include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 
 using namespace sylva;
@@ -56,6 +58,8 @@ void compareLb(const lb::LbParams& a, const lb::LbParams& b)
     QCOMPARE(a.sun, b.sun);
     QCOMPARE(a.intensity, b.intensity);
     QCOMPARE(a.steps, b.steps);
+    QCOMPARE(a.stepsPerEdge, b.stepsPerEdge);
+    QCOMPARE(a.storage, b.storage);
     QCOMPARE(a.tolerance, b.tolerance);
     QCOMPARE(a.checkEvery, b.checkEvery);
     QCOMPARE(a.maxSteps, b.maxSteps);
@@ -311,7 +315,8 @@ private Q_SLOTS:
         QCOMPARE(s.species[0].preset, defaultSpecies.preset);
         QCOMPARE(s.species[0].grid, defaultSpecies.grid);
         compareLb(s.species[0].lighting, defaultSpeciesLighting(*lb::findPreset("leaf")));
-        QCOMPARE(s.species[0].lighting.tolerance, kDefaultLightingTolerance);
+        QCOMPARE(s.species[0].lighting.tolerance, 0.0);
+        QCOMPARE(s.species[0].lighting.stepsPerEdge, kDefaultStepsPerEdge);
         QVERIFY(s.species[1].meshPath.empty());
         QVERIFY(s.species[1].grow);
         const GrowSpec g;
@@ -330,8 +335,35 @@ private Q_SLOTS:
         compareScenes(s, expected);   // ground, sun, sky, camera, render: all defaults
     }
 
-    // The default solve is the tolerance kDefaultLightingTolerance; a step count (even 0, the seed's
-    // 2 x longest edge) asks for fixed steps; an explicit tolerance wins over the default.
+    // The default solve is kDefaultStepsPerEdge x the longest edge in fp16; steps_per_edge 2 is the
+    // seed's count; a step count > 0 wins; a tolerance asks for tolerance mode instead.
+    // A quality preset sets every species' grid, steps and storage and the render's samples and
+    // distance knobs, leaving the optics alone.
+    void qualityPresetsSetTheScene()
+    {
+        Scene s = defaultScene();
+        const lb::LbParams before = s.species[0].lighting;
+        for (const char* name : {"preview", "final", "reference"}) {
+            const QualityPreset* q = findQualityPreset(name);
+            QVERIFY(q);
+            applyQuality(s, *q);
+            for (const SpeciesDesc& sp : s.species) {
+                QCOMPARE(sp.grid, q->grid);
+                QCOMPARE(sp.lighting.steps, 0);
+                QCOMPARE(sp.lighting.stepsPerEdge, 1);   // every preset's steps are "half": 1 x the longest edge
+                QCOMPARE(sp.lighting.tolerance, 0.0);
+                QVERIFY(sp.lighting.storage == (q->fp16 ? lb::Storage::Fp16 : lb::Storage::Fp32));
+                QCOMPARE(sp.lighting.channels[1].sigmaS, before.channels[1].sigmaS);
+            }
+            QCOMPARE(s.render.spp, q->spp);
+            QCOMPARE(s.render.alphaDistance, q->alphaDistance);
+            QCOMPARE(s.render.pruneDistance, q->pruneDistance);
+        }
+        QVERIFY(!findQualityPreset("draft"));
+        QCOMPARE(findQualityPreset("preview")->grid, 32);
+        QCOMPARE(findQualityPreset("reference")->spp, 64);
+    }
+
     void lightingStepsAndTolerance()
     {
         auto lighting = [&](const char* json) {
@@ -339,8 +371,14 @@ private Q_SLOTS:
                                      R"(}], "instances": [{"species": "b", "position": [0, 0, 0]}]})";
             return parseScene(text, dir().toStdString(), kName).species[0].lighting;
         };
-        QCOMPARE(lighting("{}").tolerance, kDefaultLightingTolerance);
+        QCOMPARE(lighting("{}").tolerance, 0.0);
         QCOMPARE(lighting("{}").steps, 0);
+        QCOMPARE(lighting("{}").stepsPerEdge, kDefaultStepsPerEdge);
+        QVERIFY(lighting("{}").storage == lb::Storage::Fp16);
+        QVERIFY(lighting(R"({"fp16": false})").storage == lb::Storage::Fp32);
+        QCOMPARE(lb::fixedSteps(lighting("{}"), {40, 64, 30}), 64 * kDefaultStepsPerEdge);
+        QCOMPARE(lb::fixedSteps(lighting(R"({"steps_per_edge": 2})"), {40, 64, 30}), lb::defaultSteps({40, 64, 30}));
+        QCOMPARE(lb::fixedSteps(lighting(R"({"steps_per_edge": 2, "steps": 7})"), {40, 64, 30}), 7);
         QCOMPARE(lighting(R"({"steps": 0})").tolerance, 0.0);
         QCOMPARE(lighting(R"({"steps": 200})").steps, 200);
         QCOMPARE(lighting(R"({"steps": 200})").tolerance, 0.0);
@@ -444,6 +482,8 @@ private Q_SLOTS:
         QTest::newRow("unknown preset") << with({"species", "0", "lighting", "preset"}, "glass")
                                         << "species[0].lighting.preset: unknown preset 'glass' (known: leaf, dogrose, cloud, pmma)";
         QTest::newRow("grid small") << with({"species", "0", "lighting", "grid"}, 4) << "species[0].lighting.grid: must lie in [8, 512], got 4";
+        QTest::newRow("steps per edge 0") << with({"species", "0", "lighting", "steps_per_edge"}, 0)
+                                          << "species[0].lighting.steps_per_edge: must lie in [1, 64], got 0";
         QTest::newRow("grid fraction") << with({"species", "0", "lighting", "grid"}, 32.5)
                                        << "species[0].lighting.grid: must be a whole number, got 32.5";
         QTest::newRow("steps and tolerance") << compact(edited(edited(validScene(), {"species", "0", "lighting", "steps"}, 0, 100).toObject(),

@@ -1,0 +1,54 @@
+// The quality presets and how they set a scene.
+#include "core/scene/quality.h"
+
+#include "core/base/error.h"
+
+namespace sylva {
+
+const std::vector<QualityPreset>& qualityPresets()
+{
+    // From the fronts in docs/ACCURACY.md: LB on the real tree and the dense tree (fixed steps of
+    // 1 x the longest edge in fp16 are the cheapest solve at their error at every grid), render on the
+    // default forest (preview: 1 spp with leaf cut-outs skipped beyond 25 m, the fastest point of the
+    // front; final: 16 spp with both knobs off, on the front; pruning is on no front there: it costs
+    // trace time on this forest).
+    static const std::vector<QualityPreset> presets{
+        {"preview", 32, "half", true, 1, 25.0f, 0.0f},
+        {"final", 64, "half", true, 16, 0.0f, 0.0f},
+        {"reference", 128, "half", true, 64, 0.0f, 0.0f},
+    };
+    return presets;
+}
+
+const QualityPreset* findQualityPreset(const std::string& name)
+{
+    for (const QualityPreset& q : qualityPresets())
+        if (name == q.name) return &q;
+    return nullptr;
+}
+
+void applyQualityLighting(const QualityPreset& preset, lb::LbParams& params)
+{
+    const std::string steps = preset.steps;
+    params.steps = 0;
+    params.tolerance = 0.0;
+    if (steps == "half") params.stepsPerEdge = 1;
+    else if (steps == "default") params.stepsPerEdge = 2;
+    else if (steps == "tol 1e-3") params.tolerance = 1e-3;
+    else if (steps == "tol 1e-4") params.tolerance = 1e-4;
+    else throw Error(std::string("quality preset ") + preset.name + ": unknown steps '" + steps + "'");
+    params.storage = preset.fp16 ? lb::Storage::Fp16 : lb::Storage::Fp32;
+}
+
+void applyQuality(Scene& scene, const QualityPreset& preset)
+{
+    for (SpeciesDesc& sp : scene.species) {
+        sp.grid = preset.grid;
+        applyQualityLighting(preset, sp.lighting);
+    }
+    scene.render.spp = preset.spp;
+    scene.render.alphaDistance = preset.alphaDistance;
+    scene.render.pruneDistance = preset.pruneDistance;
+}
+
+} // namespace sylva
