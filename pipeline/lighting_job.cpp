@@ -147,7 +147,7 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
     return grid;
 }
 
-std::string lightingParamsJson(const lb::LbParams& params, const std::string& preset, const glm::ivec3& dims)
+std::string opticsJsonMembers(const lb::LbParams& params, const std::string& preset)
 {
     std::ostringstream extra;
     extra.precision(9);
@@ -155,7 +155,7 @@ std::string lightingParamsJson(const lb::LbParams& params, const std::string& pr
     std::string name;
     for (char c : preset)
         if (c != '"' && c != '\\' && static_cast<unsigned char>(c) >= 0x20) name += c;
-    extra << "{\"preset\":\"" << name << "\",\"sigma_a\":";
+    extra << "\"preset\":\"" << name << "\",\"sigma_a\":";
     triple([&](int c) { return params.channels[size_t(c)].sigmaA; });
     extra << ",\"sigma_s\":";
     triple([&](int c) { return params.channels[size_t(c)].sigmaS; });
@@ -165,8 +165,16 @@ std::string lightingParamsJson(const lb::LbParams& params, const std::string& pr
     triple([&](int c) { return params.sun[c]; });
     extra << ",\"intensity\":";
     triple([&](int c) { return params.intensity[c]; });
-    extra << ",\"zero_f0\":" << (params.zeroF0 ? "true" : "false") << ",\"storage\":\""
-          << (params.storage == lb::Storage::Fp16 ? "fp16" : "fp32") << "\"";
+    extra << ",\"zero_f0\":" << (params.zeroF0 ? "true" : "false");
+    return extra.str();
+}
+
+std::string lightingParamsJson(const lb::LbParams& params, const std::string& preset, const glm::ivec3& dims)
+{
+    std::ostringstream extra;
+    extra.precision(9);
+    extra << "{" << opticsJsonMembers(params, preset) << ",\"storage\":\"" << (params.storage == lb::Storage::Fp16 ? "fp16" : "fp32")
+          << "\"";
     if (params.tolerance > 0.0) extra << ",\"tolerance\":" << params.tolerance;
     else extra << ",\"steps\":" << lb::fixedSteps(params, dims);
     extra << ",\"warm_start\":" << (params.warmStart ? "true" : "false");

@@ -51,5 +51,8 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
 // sun, zero_f0, storage, tolerance (or steps, the default for dims when params.steps is 0),
 // warm_start, and coarse_start when set.
 std::string lightingParamsJson(const lb::LbParams& params, const std::string& preset, const glm::ivec3& dims);
+// The optics part of it, as JSON members without braces (preset, sigma_a, sigma_s, g, sun, intensity,
+// zero_f0): what `sylva reference` records too.
+std::string opticsJsonMembers(const lb::LbParams& params, const std::string& preset);
 
 } // namespace sylva

@@ -556,18 +556,7 @@ int cmdReference(const Args& args)
     // The sidecars record what produced the grids.
     std::ostringstream extra;
     extra.precision(9);
-    auto triple = [&](auto get) { extra << "[" << get(0) << "," << get(1) << "," << get(2) << "]"; };
-    extra << "{\"solver\":\"reference\",\"preset\":\"" << args.get("--preset", "leaf") << "\",\"sigma_a\":";
-    triple([&](int c) { return params.channels[size_t(c)].sigmaA; });
-    extra << ",\"sigma_s\":";
-    triple([&](int c) { return params.channels[size_t(c)].sigmaS; });
-    extra << ",\"g\":";
-    triple([&](int c) { return params.channels[size_t(c)].g; });
-    extra << ",\"sun\":";
-    triple([&](int c) { return params.sun[c]; });
-    extra << ",\"intensity\":";
-    triple([&](int c) { return params.intensity[c]; });
-    extra << ",\"zero_f0\":" << (params.zeroF0 ? "true" : "false") << ",\"paths\":" << settings.paths
+    extra << "{\"solver\":\"reference\"," << opticsJsonMembers(params, args.get("--preset", "leaf")) << ",\"paths\":" << settings.paths
           << ",\"seed\":" << settings.seed << ",\"max_bounces\":" << settings.maxBounces << ",\"incidence\":\""
           << (settings.incidence == Incidence::Collimated ? "collimated" : "lattice") << "\"";
     const std::string common = extra.str();

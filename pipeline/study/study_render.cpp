@@ -200,13 +200,7 @@ RenderData measureRender(const Options& o)
             Scene s = defaultScene();
             s.render.width = o.quick ? 224 : 448;
             s.render.height = o.quick ? 112 : 224;
-            for (SpeciesDesc& sp : s.species) {
-                sp.grid = q.grid;
-                applyQualityLighting(q, sp.lighting);
-            }
-            s.render.spp = q.spp;
-            s.render.alphaDistance = q.alphaDistance;
-            s.render.pruneDistance = q.pruneDistance;
+            applyQuality(s, q);
             return s;
         };
         const QualityPreset& refPreset = presets.back();
