@@ -418,15 +418,9 @@ private:
         float* buf = s.buf.data();
         const size_t Zp = size_t(m_Zp);
         // With m_skipF0 the f_0 row of buf is already zero (set at the end of the previous row).
-        if (outMode == 0) {
-            // 1+3. Load, collide and park in buf one vector of 8 nodes at a time: the values stay in
-            // registers between the load and the collision.
-            collideRowFused(r, c, srcRow, buf, firstM);
-        } else {
-            // 1. Load the row's 19 directions (z contiguous), padding to a multiple of 8 with zeros.
-            for (int m = firstM; m < kDirections; ++m) loadRow(srcRow + size_t(m) * size_t(m_Z), buf + size_t(m) * Zp, m_Z);
-            collideRowInBuf(r, c, buf, outMode);
-        }
+        // 1-3. Load, (sum,) collide and park in buf one vector of 8 nodes at a time: the values stay in
+        // registers between the load and the collision.
+        collideRowFused(r, c, srcRow, buf, firstM, outMode);
         if (m_params.zeroF0) std::fill(buf, buf + Zp, 0.0f);   // absorbed: f_0 leaves the visible band
         // 4. Stream: post_m(r) goes to r + c_m when that node is interior.
         for (int m = firstM; m < kDirections; ++m) {
@@ -470,10 +464,14 @@ private:
     // medium, and writes it to buf (the rows of 19 directions the streaming then reads).
     // Loads each 8-node vector of an active row straight from storage, collides it when it holds
     // medium, and writes it to buf (the rows of 19 directions the streaming then reads).
-    void collideRowFused(size_t r, size_t c, const S* srcRow, float* buf, int firstM) const
+    // With outMode 1 it stores the node totals sum_m f_m of the source state (tolerance check), with
+    // outMode 2 it also adds their squared change since those and their squares to the row's sums.
+    void collideRowFused(size_t r, size_t c, const S* srcRow, float* buf, int firstM, int outMode)
     {
         const ChannelField<S>& field = *m_fields[c];
         const size_t Zp = size_t(m_Zp), Z = size_t(m_Z);
+        float* tot = outMode != 0 ? &m_totals[(c * size_t(m_X) * m_Y + r) * Z] : nullptr;
+        double diff = 0.0, norm = 0.0;
         Vec8 f[kDirections];
         if (firstM == 1) f[0] = Vec8{};
         for (size_t k = 0; k < Zp; k += kLanes) {
@@ -487,43 +485,24 @@ private:
                     f[m] = loadVec(tmp);
                 }
             }
-            if (vectorActive(r, k)) collideVector(f, r, k, field);
+            if (outMode != 0) {
+                Vec8 sum{};
+                for (int m = 0; m < kDirections; ++m) sum = sum + f[m];
+                for (size_t l = 0; l < kLanes && k + l < Z; ++l) {
+                    if (outMode == 2) {
+                        const double d = double(sum[l]) - double(tot[k + l]);
+                        diff += d * d;
+                        norm += double(sum[l]) * double(sum[l]);
+                    }
+                    tot[k + l] = sum[l];
+                }
+            }
+            if (m_rowActive[r] && vectorActive(r, k)) collideVector(f, r, k, field);
             for (int m = firstM; m < kDirections; ++m) storeVec(buf + size_t(m) * Zp + k, f[m]);
         }
-    }
-
-    // Node totals (tolerance check) and collision of a row already loaded into buf.
-    void collideRowInBuf(size_t r, size_t c, float* buf, int outMode)
-    {
-        const ChannelField<S>& field = *m_fields[c];
-        const size_t Zp = size_t(m_Zp);
-        // 2. Node totals of the source state, for the tolerance check.
-        if (outMode != 0) {
-            float* tot = &m_totals[(c * size_t(m_X) * m_Y + r) * size_t(m_Z)];
-            double diff = 0.0, norm = 0.0;
-            for (int k = 0; k < m_Z; ++k) {
-                float sum = 0.0f;
-                for (int m = 0; m < kDirections; ++m) sum += buf[size_t(m) * Zp + size_t(k)];
-                if (outMode == 2) {
-                    const double d = double(sum) - double(tot[k]);
-                    diff += d * d;
-                    norm += double(sum) * double(sum);
-                }
-                tot[k] = sum;
-            }
-            if (outMode == 2) {
-                m_rowDiff[r] += diff;
-                m_rowNorm[r] += norm;
-            }
-        }
-        // 3. Collide, 8 nodes at a time; rows and vectors without medium stream unchanged.
-        if (!m_rowActive[r]) return;
-        for (size_t k = 0; k < Zp; k += kLanes) {
-            if (!vectorActive(r, k)) continue;
-            Vec8 f[kDirections];
-            for (int m = 0; m < kDirections; ++m) f[m] = loadVec(buf + size_t(m) * Zp + k);
-            collideVector(f, r, k, field);
-            for (int m = 0; m < kDirections; ++m) storeVec(buf + size_t(m) * Zp + k, f[m]);
+        if (outMode == 2) {
+            m_rowDiff[r] += diff;
+            m_rowNorm[r] += norm;
         }
     }
 
