@@ -123,14 +123,15 @@ class PageArray {
 public:
     PageArray() = default;
     PageArray(const PageArray&) = delete;
-    PageArray& operator=(const PageArray& other)
-    {
-        assign(other.m_size, S{});
-        std::memcpy(m_data, other.m_data, m_size * sizeof(S));
-        return *this;
-    }
+    PageArray& operator=(const PageArray&) = delete;
     ~PageArray() { std::free(m_data); }
     void assign(size_t n, S value)
+    {
+        allocate(n);
+        std::fill(m_data, m_data + n, value);
+    }
+    // Room for n values, not initialized.
+    void allocate(size_t n)
     {
         std::free(m_data);
         m_data = nullptr;
@@ -143,7 +144,6 @@ public:
         madvise(p, std::max(bytes, kHuge), MADV_HUGEPAGE);
 #endif
         m_data = static_cast<S*>(p);
-        std::fill(m_data, m_data + n, value);
     }
     S* data() { return m_data; }
     const S* data() const { return m_data; }
@@ -201,22 +201,24 @@ public:
         const size_t count = rows * size_t(kDirections) * size_t(m_Z);
         for (const ChannelParams& cp : solves) {
             auto field = std::make_unique<ChannelField<S>>(compactOmega(cp), compactOmega({cp.sigmaA, cp.sigmaS, -1.0f}));
-            field->a.assign(count, toStorage<S>(0.0f));
-            for (int i = 0; i < m_X; ++i)
+            // Both copies: the boundary condition on the boundary (everywhere with a warm start), zero
+            // inside; written once, in parallel (each x-slab by the thread that will first touch it).
+            field->a.allocate(count);
+            field->b.allocate(count);
+            S bcValue[kDirections];
+            for (int m = 0; m < kDirections; ++m) bcValue[m] = toStorage<S>(bc[size_t(m)]);
+            tbb::parallel_for(0, m_X, [&](int i) {
                 for (int j = 0; j < m_Y; ++j) {
                     const bool wholeRow = params.warmStart || i == 0 || j == 0 || i == m_X - 1 || j == m_Y - 1;
                     for (int m = 0; m < kDirections; ++m) {
-                        S* row = &field->a[dindex(i, j, 0, m)];
-                        const S v = toStorage<S>(bc[size_t(m)]);
-                        if (wholeRow) {
-                            std::fill(row, row + m_Z, v);
-                        } else {
-                            row[0] = v;
-                            row[m_Z - 1] = v;
+                        for (S* row : {&field->a[dindex(i, j, 0, m)], &field->b[dindex(i, j, 0, m)]}) {
+                            std::fill(row, row + m_Z, wholeRow ? bcValue[m] : toStorage<S>(0.0f));
+                            row[0] = bcValue[m];
+                            row[m_Z - 1] = bcValue[m];
                         }
                     }
                 }
-            field->b = field->a;
+            });
             m_fields.push_back(std::move(field));
         }
         m_skipF0 = params.zeroF0 && bc[0] == 0.0f;
