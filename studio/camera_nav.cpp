@@ -9,20 +9,23 @@ namespace {
 
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 
+// v turned by yawDeg about +Y and pitchDeg toward +Y, keeping its length: spherical angles with yaw
+// from +Z toward +X and pitch above the horizon, pitch clamped to +-89 degrees. v must not be zero.
+glm::dvec3 turned(const glm::dvec3& v, double yawDeg, double pitchDeg)
+{
+    const double dist = glm::length(v);
+    const double yaw = std::atan2(v.x, v.z) + yawDeg * kDegToRad;
+    const double pitch = std::clamp(std::asin(std::clamp(v.y / dist, -1.0, 1.0)) + pitchDeg * kDegToRad, -89.0 * kDegToRad, 89.0 * kDegToRad);
+    return dist * glm::dvec3(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
+}
+
 } // namespace
 
 CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg)
 {
     CameraDesc c = camera;
-    const glm::dvec3 offset = c.position - c.target;
-    const double dist = glm::length(offset);
-    if (!(dist > 0.0)) return c;
-    double yaw = std::atan2(offset.x, offset.z);
-    double pitch = std::asin(std::clamp(offset.y / dist, -1.0, 1.0));
-    yaw += yawDeg * kDegToRad;
-    pitch = std::clamp(pitch + pitchDeg * kDegToRad, -89.0 * kDegToRad, 89.0 * kDegToRad);
-    const glm::dvec3 dir(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
-    c.position = c.target + dist * dir;
+    if (!(glm::length(c.position - c.target) > 0.0)) return c;
+    c.position = c.target + turned(c.position - c.target, yawDeg, pitchDeg);
     c.up = glm::vec3(0.0f, 1.0f, 0.0f);
     return c;
 }
@@ -58,18 +61,10 @@ CameraDesc zoomCamera(const CameraDesc& camera, double steps, double factor)
 
 CameraDesc flyLook(const CameraDesc& camera, double yawDeg, double pitchDeg)
 {
+    // The camera's right is cross(view, up), i.e. toward decreasing yaw.
     CameraDesc c = camera;
-    const glm::dvec3 view = c.target - c.position;
-    const double dist = glm::length(view);
-    if (!(dist > 0.0)) return c;
-    // Spherical angles of the view direction: yaw from +Z toward +X, pitch above the horizon. The
-    // camera's right is cross(view, up), i.e. toward decreasing yaw.
-    double yaw = std::atan2(view.x, view.z);
-    double pitch = std::asin(std::clamp(view.y / dist, -1.0, 1.0));
-    yaw -= yawDeg * kDegToRad;
-    pitch = std::clamp(pitch + pitchDeg * kDegToRad, -89.0 * kDegToRad, 89.0 * kDegToRad);
-    const glm::dvec3 dir(std::cos(pitch) * std::sin(yaw), std::sin(pitch), std::cos(pitch) * std::cos(yaw));
-    c.target = c.position + dist * dir;
+    if (!(glm::length(c.target - c.position) > 0.0)) return c;
+    c.target = c.position + turned(c.target - c.position, -yawDeg, pitchDeg);
     c.up = glm::vec3(0.0f, 1.0f, 0.0f);
     return c;
 }
