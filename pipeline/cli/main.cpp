@@ -439,6 +439,28 @@ lb::LbParams lightParams(const Args& args)
     return p;
 }
 
+// The density grid of `light` and `reference`: --density FILE (checked), or --mesh voxelized through
+// the cache with a progress bar.
+DensityGrid loadDensityInput(const Args& args, const VoxelizeSettings& voxel, GridCache* cache, JobLog& log)
+{
+    if (args.has("--density")) {
+        const std::string path = args.get("--density");
+        requireReadable(path, "density grid");
+        DensityGrid density = readDensityGrid(path);
+        try {
+            lb::validateDensity(density);
+        } catch (const Error& e) {
+            throw Error(path + ": " + e.what());
+        }
+        return density;
+    }
+    requireReadable(args.get("--mesh"), "mesh file");
+    ProgressPrinter vbar("voxelize", args.has("--quiet"));
+    DensityGrid density = densityForMesh({args.get("--mesh"), importOptions(args), voxel}, cache, &vbar.progress(), &log);
+    vbar.finish(log.stages.back());
+    return density;
+}
+
 int cmdLight(const Args& args)
 {
     auto threads = threadLimit(args);
@@ -451,28 +473,13 @@ int cmdLight(const Args& args)
     const lb::LbParams params = lightParams(args);
     auto cache = openCache(args);
     JobLog log;
-    DensityGrid density;
     const VoxelizeSettings voxel = voxelSettings(args);
     if (args.has("--density"))
         for (const char* meshOnly : {"--grid", "--subcells", "--leaf-materials"})
             if (args.has(meshOnly)) throw UsageError(std::string(meshOnly) + " applies to --mesh, not to --density");
     const PictureOptions picture = pictureOptions(args);
     requireReplaceableFile(out);
-    if (args.has("--density")) {
-        const std::string path = args.get("--density");
-        requireReadable(path, "density grid");
-        density = readDensityGrid(path);
-        try {
-            lb::validateDensity(density);
-        } catch (const Error& e) {
-            throw Error(path + ": " + e.what());
-        }
-    } else {
-        requireReadable(args.get("--mesh"), "mesh file");
-        ProgressPrinter vbar("voxelize", args.has("--quiet"));
-        density = densityForMesh({args.get("--mesh"), importOptions(args), voxel}, cache.get(), &vbar.progress(), &log);
-        vbar.finish(log.stages.back());
-    }
+    const DensityGrid density = loadDensityInput(args, voxel, cache.get(), log);
     printDensitySummary(density);
     ProgressPrinter bar("light", args.has("--quiet"));
     const LightingGrid light = lightingFor(density, params, cache.get(), &bar.progress(), &log, compute.get());
@@ -529,22 +536,7 @@ int cmdReference(const Args& args)
     }
     auto cache = openCache(args);
     JobLog log;
-    DensityGrid density;
-    if (args.has("--density")) {
-        const std::string path = args.get("--density");
-        requireReadable(path, "density grid");
-        density = readDensityGrid(path);
-        try {
-            lb::validateDensity(density);
-        } catch (const Error& e) {
-            throw Error(path + ": " + e.what());
-        }
-    } else {
-        requireReadable(args.get("--mesh"), "mesh file");
-        ProgressPrinter vbar("voxelize", args.has("--quiet"));
-        density = densityForMesh({args.get("--mesh"), importOptions(args), voxel}, cache.get(), &vbar.progress(), &log);
-        vbar.finish(log.stages.back());
-    }
+    const DensityGrid density = loadDensityInput(args, voxel, cache.get(), log);
     if (compare && compare->geometry.dims != density.geometry.dims)
         throw Error(args.get("--compare") + ": grid " + dimsText(compare->geometry) + " differs from the density grid " +
                     dimsText(density.geometry));
