@@ -654,7 +654,7 @@ int cmdRender(const Args& args)
                      args.has("--band-rows") ? "" : " (the whole frame does not fit in the available memory)");
         if (device != "cpu") std::fprintf(stderr, "note: a frame in bands is traced on the CPU (the LB solves still run on %s)\n", device.c_str());
         ProgressPrinter bar("render", args.has("--quiet"));
-        const BandedRender result = renderSceneInBands(scene, out, bandRows, cache.get(), &bar.progress(), &log);
+        const BandedRender result = renderSceneInBands(scene, out, bandRows, cache.get(), &bar.progress(), &log, compute.get());
         bar.finish();
         st = result.stats;
         timings = result.timings;

@@ -254,7 +254,7 @@ struct FileCloser {
 } // namespace
 
 BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, int bandRows, GridCache* cache,
-                                Progress* progress, JobLog* log)
+                                Progress* progress, JobLog* log, Backend* backend)
 {
     const RenderSettings& r = scene.render;
     if (bandRows < 1) throw Error("render: rows per band must be at least 1, got " + std::to_string(bandRows));
@@ -297,7 +297,7 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
     };
 
     BandedRender out;
-    const RenderScene rs = prepareFrame(scene, cache, progress, log, nullptr, out.timings);
+    const RenderScene rs = prepareFrame(scene, cache, progress, log, backend, out.timings);
     out.stats = rs.stats();
     const RenderView view = rs.view();
     const int bands = (r.height + bandRows - 1) / bandRows;

@@ -90,8 +90,9 @@ struct BandedRender {
 // exactly the one renderScene + composeMode + writeRender produce: the ambient constant and the
 // log-average luminance sum the bands in the whole frame's order. Throws Error or Cancelled; the
 // target file is only replaced at the end.
+// backend: where the species' LB solves run (null = the CPU); the bands are traced on the CPU.
 BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, int bandRows, GridCache* cache,
-                                Progress* progress = nullptr, JobLog* log = nullptr);
+                                Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
 
 // Tone-mapped (Reinhard, log-average key) sRGB picture of linear RGB pixels, alpha 1.
 ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key);
