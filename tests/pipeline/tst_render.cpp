@@ -18,6 +18,7 @@
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/render/render_job.h"
+#include "small_forest.h"
 
 using namespace sylva;
 
@@ -299,7 +300,7 @@ private Q_SLOTS:
     // local mode solves no lighting grid; a leaf in the open is brighter than one in shadow.
     void modesAndStages()
     {
-        Scene s = smallForest();
+        Scene s = test::smallForest();
         GridCache cache((m_out + "/cache").toStdString());
         JobLog log;
         const RenderOutput out = renderScene(s, &cache, nullptr, &log);
@@ -325,7 +326,7 @@ private Q_SLOTS:
     // The kd-tree run draws the same picture as the BVH run.
     void kdTreeRendersTheSamePicture()
     {
-        Scene s = smallForest();
+        Scene s = test::smallForest();
         s.render.spp = 1;
         GridCache cache((m_out + "/cache").toStdString());
         const auto bvh = composeMode(renderScene(s, &cache).film, RenderMode::Full, s.sky);
@@ -340,7 +341,7 @@ private Q_SLOTS:
     // Moving the whole scene and camera 1e6 m and 1e7 m from the origin changes no pixel noticeably.
     void precisionFarFromOrigin()
     {
-        Scene s = smallForest();
+        Scene s = test::smallForest();
         s.render.mode = RenderMode::Local;
         s.render.width = 96;
         s.render.height = 64;
@@ -373,7 +374,7 @@ private Q_SLOTS:
     void goldenImages()
     {
         QFETCH(int, mode);
-        Scene s = smallForest();
+        Scene s = test::smallForest();
         s.render.mode = RenderMode(mode);
         GridCache cache((m_out + "/cache").toStdString());
         const RenderOutput out = renderScene(s, &cache);
@@ -403,38 +404,6 @@ private Q_SLOTS:
                                  .arg(cmp.meanerror)
                                  .arg(QString::fromStdString(outPath))));
         }
-    }
-
-private:
-    // Three grown trees of two species on the ground, a close camera: small enough for CI.
-    static Scene smallForest()
-    {
-        Scene s;
-        s.species.resize(2);
-        s.species[0].name = "broadleaf";
-        s.species[0].grow = GrowSpec{"broadleaf", 3, 6000, 8.0f};
-        s.species[1].name = "birch";
-        s.species[1].grow = GrowSpec{"birch", 4, 5000, 9.0f};
-        for (SpeciesDesc& sp : s.species) {
-            sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-            sp.grid = 24;
-        }
-        InstanceDesc a, b, c;
-        a.position = {-3.0, 0.0, 4.0};
-        b.species = 1;
-        b.position = {3.0, 0.0, 6.0};
-        b.rotationDeg = {0.0f, 40.0f, 0.0f};
-        c.position = {0.0, 0.0, 12.0};
-        c.scale = 1.2f;
-        c.rotationDeg = {0.0f, 200.0f, 0.0f};
-        s.instances = {a, b, c};
-        s.camera.position = {0.0, 3.0, -9.0};
-        s.camera.target = {0.0, 4.0, 6.0};
-        s.sun.direction = sunDirection(40.0, 120.0);
-        s.render.width = 120;
-        s.render.height = 80;
-        s.render.spp = 4;
-        return s;
     }
 };
 

@@ -15,6 +15,7 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/render/render_job.h"
+#include "small_forest.h"
 
 using namespace sylva;
 
@@ -83,36 +84,6 @@ SpeciesAssets cardAndWall()
     return a;
 }
 
-// Three grown trees on the ground (tst_render's small forest), small enough for CI.
-Scene smallForest()
-{
-    Scene s;
-    s.species.resize(2);
-    s.species[0].name = "broadleaf";
-    s.species[0].grow = GrowSpec{"broadleaf", 3, 6000, 8.0f};
-    s.species[1].name = "birch";
-    s.species[1].grow = GrowSpec{"birch", 4, 5000, 9.0f};
-    for (SpeciesDesc& sp : s.species) {
-        sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-        sp.grid = 24;
-    }
-    InstanceDesc a, b, c;
-    a.position = {-3.0, 0.0, 4.0};
-    b.species = 1;
-    b.position = {3.0, 0.0, 6.0};
-    b.rotationDeg = {0.0f, 40.0f, 0.0f};
-    c.position = {0.0, 0.0, 12.0};
-    c.scale = 1.2f;
-    c.rotationDeg = {0.0f, 200.0f, 0.0f};
-    s.instances = {a, b, c};
-    s.camera.position = {0.0, 3.0, -9.0};
-    s.camera.target = {0.0, 4.0, 6.0};
-    s.sun.direction = sunDirection(40.0, 120.0);
-    s.render.width = 120;
-    s.render.height = 80;
-    s.render.spp = 4;
-    return s;
-}
 
 } // namespace
 
@@ -345,7 +316,7 @@ private Q_SLOTS:
     // neither acts; on at short distances they change the picture a little and trace fewer triangles.
     void offIsTheUsualPicture()
     {
-        Scene s = smallForest();
+        Scene s = test::smallForest();
         QCOMPARE(s.render.alphaDistance, 0.0f);
         QCOMPARE(s.render.pruneDistance, 0.0f);
         const QString dir = QString(SYLVA_TEST_OUTPUT) + "/render_lod";
