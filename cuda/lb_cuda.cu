@@ -16,11 +16,11 @@
 namespace sylva::cuda {
 namespace {
 
-using lb::CompactOmega;
+using lb::SymmetricOmega;
 using lb::kDirections;
 
 constexpr int kMaxSolves = 3;
-__constant__ CompactOmega c_omega[kMaxSolves][2];   // [solve][green, brown]
+__constant__ SymmetricOmega c_omega[kMaxSolves][2];   // [solve][green, brown]
 __constant__ int c_dir[kDirections][3];
 
 SYLVA_DEVICE SYLVA_INLINE float loadF(const float* p) { return *p; }
@@ -136,10 +136,10 @@ LightingGrid solveTyped(const DensityGrid& density, const lb::LbParams& params, 
         }
     }
     const int ns = int(solves.size());
-    CompactOmega om[kMaxSolves][2];
+    SymmetricOmega om[kMaxSolves][2];
     for (int s = 0; s < ns; ++s) {
-        om[s][0] = lb::compactOmega(solves[size_t(s)]);
-        om[s][1] = lb::compactOmega({solves[size_t(s)].sigmaA, solves[size_t(s)].sigmaS, -1.0f});
+        om[s][0] = lb::symmetricOmega(solves[size_t(s)]);
+        om[s][1] = lb::symmetricOmega({solves[size_t(s)].sigmaA, solves[size_t(s)].sigmaS, -1.0f});
     }
     check(cudaMemcpyToSymbol(c_omega, om, sizeof(om)), "Omega to constant memory");
     check(cudaMemcpyToSymbol(c_dir, lb::kC, sizeof(lb::kC)), "lattice to constant memory");

@@ -40,21 +40,29 @@ typedef float Vec8u __attribute__((vector_size(32), aligned(4)));
 inline Vec8 loadVec(const float* p) { return *reinterpret_cast<const Vec8u*>(p); }
 inline void storeVec(float* p, Vec8 v) { *reinterpret_cast<Vec8u*>(p) = v; }
 
-// CompactOmega with every coefficient broadcast to 8 lanes (5.2 KB): the inner products use a vector
-// operand from L1 instead of a broadcast per multiply-add.
-struct CompactOmega8 {
-    Vec8 even[kPairs][kPairs];
-    Vec8 odd[kPairs][kPairs];
+// SymmetricOmega with every coefficient broadcast to 8 lanes: the products use a vector operand from
+// L1 instead of a broadcast per multiply-add.
+struct SymmetricOmega8 {
+    Vec8 ass, asg, bss, bsg, ags, agg, bgs, bgg, dd, oDD, oDV, oVD, oVV, oWW;
     float sigmaA;
     float sigmaT;
-    explicit CompactOmega8(const CompactOmega& c) : sigmaA(c.sigmaA), sigmaT(c.sigmaT)
+    explicit SymmetricOmega8(const SymmetricOmega& c) : sigmaA(c.sigmaA), sigmaT(c.sigmaT)
     {
-        for (int p = 0; p < kPairs; ++p)
-            for (int q = 0; q < kPairs; ++q)
-                for (int l = 0; l < kLanes; ++l) {
-                    even[p][q][l] = c.even[p][q];
-                    odd[p][q][l] = c.odd[p][q];
-                }
+        auto bc = [](float v) { return Vec8{v, v, v, v, v, v, v, v}; };
+        ass = bc(c.ass);
+        asg = bc(c.asg);
+        bss = bc(c.bss);
+        bsg = bc(c.bsg);
+        ags = bc(c.ags);
+        agg = bc(c.agg);
+        bgs = bc(c.bgs);
+        bgg = bc(c.bgg);
+        dd = bc(c.dd);
+        oDD = bc(c.oDD);
+        oDV = bc(c.oDV);
+        oVD = bc(c.oVD);
+        oVV = bc(c.oVV);
+        oWW = bc(c.oWW);
     }
 };
 
@@ -159,8 +167,8 @@ private:
 // One distinct channel solve: optics (green and brown) and two copies of f.
 template <typename S>
 struct ChannelField {
-    ChannelField(const CompactOmega& greenOmega, const CompactOmega& brownOmega) : green(greenOmega), brown(brownOmega) {}
-    CompactOmega8 green, brown;
+    ChannelField(const SymmetricOmega& greenOmega, const SymmetricOmega& brownOmega) : green(greenOmega), brown(brownOmega) {}
+    SymmetricOmega8 green, brown;
     PageArray<S> a, b;
     bool flip = false;
 };
@@ -200,7 +208,7 @@ public:
         const std::vector<float> bc = boundaryDistribution(params.sun);
         const size_t count = rows * size_t(kDirections) * size_t(m_Z);
         for (const ChannelParams& cp : solves) {
-            auto field = std::make_unique<ChannelField<S>>(compactOmega(cp), compactOmega({cp.sigmaA, cp.sigmaS, -1.0f}));
+            auto field = std::make_unique<ChannelField<S>>(symmetricOmega(cp), symmetricOmega({cp.sigmaA, cp.sigmaS, -1.0f}));
             // Both copies: the boundary condition on the boundary (everywhere with a warm start), zero
             // inside; written once, in parallel (each x-slab by the thread that will first touch it).
             field->a.allocate(count);
