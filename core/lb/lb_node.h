@@ -12,14 +12,17 @@ namespace sylva::lb {
 // coordinates (axial, plane sums and differences; axial, V and W) instead of two 9x9 products.
 // T is float, double or a SIMD vector; Om has SymmetricOmega's coefficient members (float, double,
 // or broadcast vectors so that no broadcast sits in the CPU's inner loop).
+// The rest direction's isotropic re-emission, w_p f0 (1/12 axial, 1/24 diagonal), is added to a in
+// the two shared terms.
 template <typename T, typename Om>
-SYLVA_HD SYLVA_INLINE void symmetricScatter(const T (&s)[kPairs], const T (&d)[kPairs], T (&a)[kPairs], T (&b)[kPairs], const Om& om)
+SYLVA_HD SYLVA_INLINE void symmetricScatter(const T (&s)[kPairs], const T (&d)[kPairs], T f0, T (&a)[kPairs], T (&b)[kPairs],
+                                            const Om& om)
 {
     // Even: plane sums by normal axis (x: plane yz = pairs 7, 8; y: xz = 5, 6; z: xy = 3, 4).
     const T gx = s[7] + s[8], gy = s[5] + s[6], gz = s[3] + s[4];
     const T S = s[0] + s[1] + s[2], G = gx + gy + gz;
-    const T ts = S * om.bss + G * om.bsg;
-    const T tg = S * om.bgs + G * om.bgg;
+    const T ts = S * om.bss + G * om.bsg + f0 * (1.0f / 12.0f);
+    const T tg = S * om.bgs + G * om.bgg + f0 * (1.0f / 24.0f);
     a[0] = ts + s[0] * om.ass + gx * om.asg;
     a[1] = ts + s[1] * om.ass + gy * om.asg;
     a[2] = ts + s[2] * om.ass + gz * om.asg;
@@ -57,12 +60,12 @@ SYLVA_HD SYLVA_INLINE void symmetricScatter(const T (&s)[kPairs], const T (&d)[k
     b[8] = pyzY - pyzZ;
 }
 
-// max(x, 0) for a scalar or a SIMD vector.
+// max(x, 0) for a scalar or a SIMD vector. A backend whose vector type has a one-instruction maximum
+// specializes it (the CPU solver: vmaxps); the generic compare-and-select costs two.
 template <typename T>
-SYLVA_HD SYLVA_INLINE T nonNegative(T x)
-{
-    return x < T{} ? T{} : x;
-}
+struct Lanes {
+    static SYLVA_HD SYLVA_INLINE T nonNegative(T x) { return x > T{} ? x : T{}; }
+};
 
 // In place: f[m] <- f[m] + rho * (Omega f)[m] for all 19 directions (LB_MODEL.md "Update"), the
 // scattering part through symmetricScatter. With zeroF0 the rest direction is returned as 0 (plants:
@@ -81,15 +84,13 @@ SYLVA_HD SYLVA_INLINE void collideNode(T (&f)[kDirections], T rho, const Om& om,
     T moving = s[0];
     SYLVA_UNROLL
     for (int q = 1; q < kPairs; ++q) moving = moving + s[q];
-    symmetricScatter(s, d, a, b, om);
     const T f0 = f[0];
+    symmetricScatter(s, d, f0, a, b, om);
     SYLVA_UNROLL
     for (int p = 0; p < kPairs; ++p) {
-        const float w = p < 3 ? 1.0f / 12.0f : 1.0f / 24.0f;
-        const T common = a[p] + f0 * w;
         const int ip = pairPos(p), in = pairNeg(p);
-        f[ip] = nonNegative(f[ip] + rho * (common + b[p] - f[ip] * om.sigmaT));
-        f[in] = nonNegative(f[in] + rho * (common - b[p] - f[in] * om.sigmaT));
+        f[ip] = Lanes<T>::nonNegative(f[ip] + rho * (a[p] + b[p] - f[ip] * om.sigmaT));
+        f[in] = Lanes<T>::nonNegative(f[in] + rho * (a[p] - b[p] - f[in] * om.sigmaT));
     }
     if (zeroF0) f[0] = T{};
     else f[0] = f0 + rho * (moving * om.sigmaA - f0);

@@ -34,7 +34,7 @@ struct LbParams {
                                                // (same steady state, reached in fewer steps; not the seed's start)
     bool coarseStart = false;                  // tolerance mode: start from the same solve on a grid of half the
                                                // resolution (recursively), interpolated; fewer fine steps
-    int solvesPerPass = 0;                     // channel solves advanced together; 0 = all that fit in memory
+    int solvesPerPass = 0;                     // channel solves advanced together (memory allowing); 0 = one
     int blockSteps = 0;                        // steps per cache-blocked wavefront; 0 = sized to the cache
     float brownThreshold = 0.5f;               // wood fraction above which a node is brown (g = -1)
     Storage storage = Storage::Fp32;

@@ -40,6 +40,24 @@ typedef float Vec8u __attribute__((vector_size(32), aligned(4)));
 inline Vec8 loadVec(const float* p) { return *reinterpret_cast<const Vec8u*>(p); }
 inline void storeVec(float* p, Vec8 v) { *reinterpret_cast<Vec8u*>(p) = v; }
 
+} // namespace
+
+// vmaxps for the 8-wide vectors: same result as the generic x > 0 ? x : 0 (0 for NaN), one instruction.
+template <>
+struct Lanes<Vec8> {
+    static Vec8 nonNegative(Vec8 x)
+    {
+#ifdef SYLVA_LB_F16C
+        const __m256 r = _mm256_max_ps(reinterpret_cast<__m256>(x), _mm256_setzero_ps());
+        return reinterpret_cast<Vec8>(r);
+#else
+        return x > Vec8{} ? x : Vec8{};
+#endif
+    }
+};
+
+namespace {
+
 // SymmetricOmega with every coefficient broadcast to 8 lanes: the products use a vector operand from
 // L1 instead of a broadcast per multiply-add.
 struct SymmetricOmega8 {
@@ -204,32 +222,7 @@ public:
                     if (brown) m_rowBrown[r] = 1;
                 }
             }
-        // Boundary condition for unit intensity; the solve is linear in intensity (scaled at the end).
-        const std::vector<float> bc = boundaryDistribution(params.sun);
-        const size_t count = rows * size_t(kDirections) * size_t(m_Z);
-        for (const ChannelParams& cp : solves) {
-            auto field = std::make_unique<ChannelField<S>>(symmetricOmega(cp), symmetricOmega({cp.sigmaA, cp.sigmaS, -1.0f}));
-            // Both copies: the boundary condition on the boundary (everywhere with a warm start), zero
-            // inside; written once, in parallel (each x-slab by the thread that will first touch it).
-            field->a.allocate(count);
-            field->b.allocate(count);
-            S bcValue[kDirections];
-            for (int m = 0; m < kDirections; ++m) bcValue[m] = toStorage<S>(bc[size_t(m)]);
-            tbb::parallel_for(0, m_X, [&](int i) {
-                for (int j = 0; j < m_Y; ++j) {
-                    const bool wholeRow = params.warmStart || i == 0 || j == 0 || i == m_X - 1 || j == m_Y - 1;
-                    for (int m = 0; m < kDirections; ++m) {
-                        for (S* row : {&field->a[dindex(i, j, 0, m)], &field->b[dindex(i, j, 0, m)]}) {
-                            std::fill(row, row + m_Z, wholeRow ? bcValue[m] : toStorage<S>(0.0f));
-                            row[0] = bcValue[m];
-                            row[m_Z - 1] = bcValue[m];
-                        }
-                    }
-                }
-            });
-            m_fields.push_back(std::move(field));
-        }
-        m_skipF0 = params.zeroF0 && bc[0] == 0.0f;
+        setSolves(solves, false);
         // Where each direction's row segment goes, relative to the source row (i, j, 0, 0): the
         // neighbour row's segment m, shifted by c_z; the source range skips the z boundary nodes.
         for (int m = 0; m < kDirections; ++m) {
@@ -239,6 +232,58 @@ public:
             m_streamOff[m] = (ptrdiff_t(kC[m][0]) * m_Y + kC[m][1]) * kDirections * ptrdiff_t(m_Z) + ptrdiff_t(m) * m_Z +
                              m_streamK0[m] + cz;
         }
+    }
+
+    // Makes the solver's channel solves `solves`, each starting from the boundary condition (everywhere
+    // with a warm start) and zero inside. Memory of earlier solves is reused: a solver advances one
+    // channel group after another without touching fresh pages again (on this VM the kernel's zeroing of
+    // fresh pages cost ~15% of a 128^3 solve). With interiorFollows the caller writes the interior of
+    // the current copy next (prolongateFrom), so only new memory is initialized; the other copy's
+    // interior is overwritten by the first step and its boundary keeps the boundary condition.
+    void setSolves(const std::vector<ChannelParams>& solves, bool interiorFollows)
+    {
+        // Boundary condition for unit intensity; the solve is linear in intensity (scaled at the end).
+        const std::vector<float> bc = boundaryDistribution(m_params.sun);
+        const size_t count = size_t(m_X) * size_t(m_Y) * size_t(kDirections) * size_t(m_Z);
+        S bcValue[kDirections];
+        for (int m = 0; m < kDirections; ++m) bcValue[m] = toStorage<S>(bc[size_t(m)]);
+        m_fields.resize(std::min(m_fields.size(), solves.size()));
+        for (size_t c = 0; c < solves.size(); ++c) {
+            const ChannelParams& cp = solves[c];
+            const SymmetricOmega green = symmetricOmega(cp), brown = symmetricOmega({cp.sigmaA, cp.sigmaS, -1.0f});
+            const bool fresh = c >= m_fields.size();
+            if (fresh) {
+                m_fields.push_back(std::make_unique<ChannelField<S>>(green, brown));
+                m_fields[c]->a.allocate(count);
+                m_fields[c]->b.allocate(count);
+            } else {
+                m_fields[c]->green = SymmetricOmega8(green);
+                m_fields[c]->brown = SymmetricOmega8(brown);
+            }
+            ChannelField<S>& field = *m_fields[c];
+            field.flip = false;
+            if (!fresh && interiorFollows) continue;
+            // Fresh memory: both copies in full, in parallel (each x-slab by the thread that will first
+            // touch it). Reused memory: the interior of the current copy; the boundary already holds the
+            // boundary condition in both.
+            tbb::parallel_for(0, m_X, [&](int i) {
+                for (int j = 0; j < m_Y; ++j) {
+                    const bool boundaryRow = i == 0 || j == 0 || i == m_X - 1 || j == m_Y - 1;
+                    if (!fresh && boundaryRow) continue;
+                    const bool wholeRow = m_params.warmStart || boundaryRow;
+                    for (int m = 0; m < kDirections; ++m) {
+                        for (PageArray<S>* copy : {&field.a, &field.b}) {
+                            if (!fresh && copy != &field.a) continue;
+                            S* row = &(*copy)[dindex(i, j, 0, m)];
+                            std::fill(row, row + m_Z, wholeRow ? bcValue[m] : toStorage<S>(0.0f));
+                            row[0] = bcValue[m];
+                            row[m_Z - 1] = bcValue[m];
+                        }
+                    }
+                }
+            });
+        }
+        m_skipF0 = m_params.zeroF0 && bc[0] == 0.0f;
     }
 
     size_t bytesPerStep() const { return m_fields.size() * size_t(m_X) * m_Y * m_Z * kDirections * sizeof(S) * 2; }
@@ -615,22 +660,43 @@ StepResult runSteps(Solver<S>& solver, const LbParams& params, int steps, SolveS
     return r;
 }
 
-// Coarse start: sets the state of `solver` (the `solves` on `fine`) from the same solves run to the
-// tolerance on the coarsened grid, itself coarse-started while it has at least 32 nodes on its
-// longest edge.
+// Coarse start: the same solves run to the tolerance on the coarsened grid, itself coarse-started
+// while it has at least 32 nodes on its longest edge, then interpolated as the start of the fine
+// solve. The levels' grids and solvers are made once and reused for every channel group.
 template <typename S>
-void coarseStart(Solver<S>& solver, const DensityGrid& fine, const LbParams& params, const std::vector<ChannelParams>& solves,
-                 SolveStats& stats)
-{
-    const DensityGrid coarse = coarsen(fine);
-    Solver<S> coarseSolver(coarse, params, solves);
-    if (coarse.geometry.longestEdge() >= 32) coarseStart(coarseSolver, coarse, params, solves, stats);
-    SolveStats coarseStats;
-    const int maxSteps = params.maxSteps > 0 ? params.maxSteps : 4 * coarse.geometry.longestEdge();
-    const StepResult r = runSteps(coarseSolver, params, maxSteps, coarseStats, [](int) {});
-    stats.coarseSteps += r.steps + coarseStats.coarseSteps;
-    solver.prolongateFrom(coarseSolver);
-}
+class CoarseChain {
+public:
+    CoarseChain(const DensityGrid& fine, const LbParams& params) : m_params(params)
+    {
+        m_grids.push_back(coarsen(fine));
+        while (m_grids.back().geometry.longestEdge() >= 32) m_grids.push_back(coarsen(m_grids.back()));
+        m_solvers.resize(m_grids.size());
+    }
+
+    // Sets the state of `solver` (whose interior is to be written) for `solves`; returns the steps run
+    // on all coarse levels.
+    int start(Solver<S>& solver, const std::vector<ChannelParams>& solves)
+    {
+        int steps = 0;
+        for (size_t l = m_grids.size(); l-- > 0;) {
+            const bool fromCoarser = l + 1 < m_grids.size();
+            if (!m_solvers[l]) m_solvers[l] = std::make_unique<Solver<S>>(m_grids[l], m_params, solves);
+            else m_solvers[l]->setSolves(solves, fromCoarser);
+            if (fromCoarser) m_solvers[l]->prolongateFrom(*m_solvers[l + 1]);
+            SolveStats levelStats;
+            const int maxSteps = m_params.maxSteps > 0 ? m_params.maxSteps : 4 * m_grids[l].geometry.longestEdge();
+            const StepResult r = runSteps(*m_solvers[l], m_params, maxSteps, levelStats, [](int) {});
+            steps += r.steps;
+        }
+        solver.prolongateFrom(*m_solvers[0]);
+        return steps;
+    }
+
+private:
+    const LbParams& m_params;
+    std::vector<DensityGrid> m_grids;   // [0] half the fine resolution, then coarser
+    std::vector<std::unique_ptr<Solver<S>>> m_solvers;
+};
 
 template <typename S>
 LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progress* progress, SolveStats& stats)
@@ -651,15 +717,18 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
     }
     stats.channelSolves = int(solves.size());
 
-    // Memory: two copies of 19 values per node for each channel solve. Solve all channels in one pass
-    // when they fit in what the machine has available, else one channel at a time, else refuse.
+    // Memory: two copies of 19 values per node for each channel solve advanced together, plus an
+    // eighth of that per level for a coarse start (1/8 + 1/64 + ... < 1/7). One solve at a time by
+    // default: the channels are independent, so advancing them together saves nothing, and one at a
+    // time needs a third of the memory and touches it once (the solver is reused). Refused when even
+    // one does not fit in what the machine has available.
     const double nodes = double(density.geometry.nodeCount());
-    const double perSolve = 2.0 * nodes * kDirections * sizeof(S);
+    const bool coarseWanted = params.coarseStart && params.tolerance > 0.0 && density.geometry.longestEdge() >= 32;
+    const double perSolve = 2.0 * nodes * kDirections * sizeof(S) * (coarseWanted ? 8.0 / 7.0 : 1.0);
     const double other = nodes * (4.0 * 3 + 8.0);   // output grid, padded density and brown mask
     const double available = availableMemoryBytes();
-    size_t group = solves.size();
+    size_t group = params.solvesPerPass > 0 ? std::min(solves.size(), size_t(params.solvesPerPass)) : 1;
     if (available > 0 && perSolve * double(group) + other > 0.8 * available) group = 1;
-    if (params.solvesPerPass > 0) group = std::min(group, size_t(params.solvesPerPass));
     if (available > 0 && perSolve + other > 0.8 * available) {
         const glm::ivec3 d = density.geometry.dims;
         char msg[256];
@@ -670,7 +739,7 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
                       sizeof(S) == 2 ? "" : " or fp16 storage");
         throw Error(msg);
     }
-    stats.bytesPerStep = perSolve * double(solves.size());
+    stats.bytesPerStep = 2.0 * nodes * kDirections * sizeof(S) * double(solves.size());
 
     const int longest = density.geometry.longestEdge();
     const bool tolMode = params.tolerance > 0.0;
@@ -682,13 +751,22 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
     std::vector<float> tot;
     const size_t groups = (solves.size() + group - 1) / group;
     bool allConverged = true;
+    // One solver (and one coarse chain) for all channel groups: their memory is reused.
+    const bool coarse = params.coarseStart && tolMode && longest >= 32;
+    std::unique_ptr<Solver<S>> solver;
+    std::unique_ptr<CoarseChain<S>> chain;
+    if (coarse) chain = std::make_unique<CoarseChain<S>>(density, params);
     for (size_t g0 = 0; g0 < solves.size(); g0 += group) {
         const std::vector<ChannelParams> these(solves.begin() + long(g0), solves.begin() + long(std::min(solves.size(), g0 + group)));
-        Solver<S> solver(density, params, these);
-        solver.m_progress = progress;
-        if (params.coarseStart && tolMode && longest >= 32) coarseStart(solver, density, params, these, stats);
+        if (!solver) {
+            solver = std::make_unique<Solver<S>>(density, params, these);
+            solver->m_progress = progress;
+        } else {
+            solver->setSolves(these, coarse);
+        }
+        if (coarse) stats.coarseSteps = std::max(stats.coarseSteps, chain->start(*solver, these));
         const double groupIndex = double(g0 / group);
-        const StepResult r = runSteps(solver, params, steps, stats, [&](int done) {
+        const StepResult r = runSteps(*solver, params, steps, stats, [&](int done) {
             if (progress)
                 progress->report((groupIndex + double(done) / double(steps)) / double(groups),
                                  "LB step " + std::to_string(done) + "/" + std::to_string(steps) +
@@ -699,7 +777,7 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
         stats.steps = std::max(stats.steps, done);
         allConverged = allConverged && groupConverged;
         for (size_t s = 0; s < these.size(); ++s) {
-            solver.totals(s, tot);
+            solver->totals(s, tot);
             for (int c = 0; c < 3; ++c) {
                 if (solveOf[c] != int(g0 + s)) continue;
                 const float intensity = params.intensity[c];

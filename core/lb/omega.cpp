@@ -177,7 +177,7 @@ SymmetricOmega symmetricOmega(const ChannelParams& p)
         d[q] = 1.0;
         apply(B.even, s, ea);
         apply(B.odd, d, ob);
-        symmetricScatter(s, d, ra, rb, o);
+        symmetricScatter(s, d, 0.0, ra, rb, o);
         for (int a = 0; a < kPairs; ++a)
             if (std::fabs(ra[a] - ea[a]) > 1e-12 * (1.0 + scale) || std::fabs(rb[a] - ob[a]) > 1e-12 * (1.0 + scale))
                 throw Error("internal: the symmetric form of Omega does not reproduce its blocks (g = " + std::to_string(p.g) + ")");
