@@ -48,8 +48,13 @@ struct Bvh {
 Bvh buildBvh(const std::vector<Bounds3>& primBounds, const BvhBuildSettings& settings = {});
 
 // Device-friendly view of a BVH's nodes.
+// Optionally, where leaf records live (leaf child c at leafData + c * leafBytes) so that the traversal
+// can prefetch them: the host fetches the first 192 bytes of every leaf of a node before testing the
+// nearest.
 struct BvhView {
     const BvhNode* nodes;
+    const char* leafData = nullptr;
+    uint32_t leafBytes = 0;
 };
 
 // Optional traversal counters for profiling tools (compiled in only with SYLVA_TRAVERSAL_STATS).
@@ -166,36 +171,55 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
         SYLVA_COUNT(g_bvhNodeVisits);
         float tn[4];
         unsigned mask = nodeEntry(n, org, inv, zeroAxes, tmin, tmax, tn);
-        // Leaves are handled at once (they may shrink tmax); inner children are sorted near to far.
+        // Leaves are handled at once, nearest first (a hit shrinks tmax and may spare the others);
+        // inner children are sorted near to far.
         uint32_t innerNode[4];
         float innerDist[4];
         int inner = 0;
+        unsigned leaves = 0;
         while (mask) {
             const int k = lowestBit(mask);
             mask &= mask - 1u;
-            if (!(tn[k] <= tmax)) continue;   // a leaf of this node recorded a closer hit
             if (n.count[k] > 0) {
-                SYLVA_COUNT(g_bvhLeafVisits);
-                if constexpr (std::is_invocable_v<LeafFn, uint32_t, uint32_t, float&>) {
-                    if (leaf(n.child[k], n.count[k], tmax)) return true;
-                } else {
-                    for (uint32_t p = 0; p < n.count[k]; ++p)
-                        if (leaf(n.child[k] + p, tmax)) return true;
-                }
-            } else {
-                int j = inner++;
-                while (j > 0 && innerDist[j - 1] < tn[k]) {   // descending: the nearest ends last
-                    innerDist[j] = innerDist[j - 1];
-                    innerNode[j] = innerNode[j - 1];
-                    --j;
-                }
-                innerDist[j] = tn[k];
-                innerNode[j] = n.child[k];
+                leaves |= 1u << k;
 #if !defined(__CUDA_ARCH__)
-                // Start the fetch of the child's 128-byte node now: traversal is bound by memory latency.
-                __builtin_prefetch(&bvh.nodes[n.child[k]]);
-                __builtin_prefetch(reinterpret_cast<const char*>(&bvh.nodes[n.child[k]]) + 64);
+                if (bvh.leafData) {
+                    const char* p = bvh.leafData + size_t(n.child[k]) * bvh.leafBytes;
+                    __builtin_prefetch(p);
+                    __builtin_prefetch(p + 64);
+                    __builtin_prefetch(p + 128);
+                }
 #endif
+                continue;
+            }
+            int j = inner++;
+            while (j > 0 && innerDist[j - 1] < tn[k]) {   // descending: the nearest ends last
+                innerDist[j] = innerDist[j - 1];
+                innerNode[j] = innerNode[j - 1];
+                --j;
+            }
+            innerDist[j] = tn[k];
+            innerNode[j] = n.child[k];
+#if !defined(__CUDA_ARCH__)
+            // Start the fetch of the child's 128-byte node now: traversal is bound by memory latency.
+            __builtin_prefetch(&bvh.nodes[n.child[k]]);
+            __builtin_prefetch(reinterpret_cast<const char*>(&bvh.nodes[n.child[k]]) + 64);
+#endif
+        }
+        while (leaves) {
+            int k = lowestBit(leaves);
+            for (unsigned rest = leaves & (leaves - 1u); rest; rest &= rest - 1u) {
+                const int o = lowestBit(rest);
+                if (tn[o] < tn[k]) k = o;
+            }
+            leaves &= ~(1u << k);
+            if (!(tn[k] <= tmax)) continue;   // a nearer leaf of this node recorded a closer hit
+            SYLVA_COUNT(g_bvhLeafVisits);
+            if constexpr (std::is_invocable_v<LeafFn, uint32_t, uint32_t, float&>) {
+                if (leaf(n.child[k], n.count[k], tmax)) return true;
+            } else {
+                for (uint32_t p = 0; p < n.count[k]; ++p)
+                    if (leaf(n.child[k] + p, tmax)) return true;
             }
         }
         // Push the farther ones, continue with the nearest (re-checked against a shrunken tmax).

@@ -2,6 +2,7 @@
 #include "core/render/render_scene.h"
 
 #include <array>
+#include <algorithm>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -194,10 +195,28 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
     });
     if (progress) progress->report(0.7, "species BVHs built");
 
+    // A triangle's corner uvs for TriBlock::uv: each axis shifted by the whole units below its smallest
+    // corner (the cut-out wraps, so the test sees the same texels), rounded to 1/kBlockUvScale. False
+    // when a corner lies 4 units or more above that (no room in 16 bits) or is not finite.
+    auto packBlockUv = [](const glm::uvec3& corners, const std::vector<glm::vec2>& uvs, uint16_t (&out)[6]) {
+        for (int axis = 0; axis < 2; ++axis) {
+            float lo = uvs[corners[0]][axis];
+            for (int c = 1; c < 3; ++c) lo = std::min(lo, uvs[corners[c]][axis]);
+            if (!std::isfinite(lo)) return false;
+            const double base = std::floor(double(lo));
+            for (int c = 0; c < 3; ++c) {
+                const double q = std::round((double(uvs[corners[c]][axis]) - base) * double(kBlockUvScale));
+                if (!(q >= 0.0 && q <= 65535.0)) return false;
+                out[2 * c + axis] = uint16_t(q);
+            }
+        }
+        return true;
+    };
+
     // Triangles of a geometry record in BVH order, then its leaves as 4-wide blocks. corner(prim, c)
     // is the species-frame position of corner c of BVH primitive prim, meshTri(prim) its mesh triangle.
     std::vector<uint32_t> triBase(ns);
-    auto appendTriangles = [&rs](SpeciesRecord& sr, const Bvh& bvh, uint32_t base, auto corner, auto meshTri) {
+    auto appendTriangles = [&rs, &packBlockUv](SpeciesRecord& sr, const Bvh& bvh, uint32_t base, auto corner, auto meshTri) {
         sr.nodeOffset = uint32_t(rs.blasNodes.size());
         sr.triOffset = uint32_t(rs.tris.size());
         rs.blasNodes.insert(rs.blasNodes.end(), bvh.nodes.begin(), bvh.nodes.end());
@@ -227,6 +246,7 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
                     blk.e2x[l] = t.e2.x, blk.e2y[l] = t.e2.y, blk.e2z[l] = t.e2.z;
                     blk.tri[l] = t.tri;
                     blk.alpha[l] = t.alpha;
+                    if (t.alpha != 0u && packBlockUv(rs.triVerts[t.tri], rs.uvs, blk.uv[l])) blk.uvPacked |= 1u << l;
                 }
                 node.child[k] = uint32_t(rs.blocks.size() - sr.blockOffset);
                 rs.blocks.push_back(blk);

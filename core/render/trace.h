@@ -28,6 +28,17 @@ SYLVA_HD SYLVA_INLINE glm::vec2 triangleUv(const RenderView& v, uint32_t tri, fl
     return (1.0f - u - w) * v.uvs[t.x] + u * v.uvs[t.y] + w * v.uvs[t.z];
 }
 
+// The cut-out coordinates of triangle k of a block at barycentrics (u, w): from the block's packed
+// corners when it has them (equal to triangleUv up to whole units and 3e-5), else from the shading arrays.
+SYLVA_HD SYLVA_INLINE glm::vec2 blockUv(const RenderView& v, const TriBlock& b, int k, float u, float w)
+{
+    if (!((b.uvPacked >> k) & 1u)) return triangleUv(v, b.tri[k], u, w);
+    const uint16_t* q = b.uv[k];
+    const float a = 1.0f - u - w;
+    constexpr float s = 1.0f / kBlockUvScale;
+    return glm::vec2((a * float(q[0]) + u * float(q[2]) + w * float(q[4])) * s, (a * float(q[1]) + u * float(q[3]) + w * float(q[5])) * s);
+}
+
 // tAlpha of a ray that tests every cut-out (adaptive transparency off).
 inline constexpr float kAlphaEverywhere = 3.0e38f;
 
@@ -102,7 +113,7 @@ SYLVA_HD inline bool hitBlock(const RenderView& v, const TriBlock& b, uint32_t c
     bool found = false;
     for (int k = 0; k < 4; ++k) {
         if (!ok[k] || !(tt[k] < tmax)) continue;
-        if (b.alpha[k] != 0u && tt[k] < tAlpha && !alphaOpaque(v, b.alpha[k] - 1u, triangleUv(v, b.tri[k], uu[k], vv[k])))
+        if (b.alpha[k] != 0u && tt[k] < tAlpha && !alphaOpaque(v, b.alpha[k] - 1u, blockUv(v, b, k, uu[k], vv[k])))
             continue;
         tmax = tt[k];
         u = uu[k];
@@ -175,7 +186,8 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
             return traverseKd(view, o, d, ray.tmin, tlasMax, triFn);
         } else {
             const TriBlock* blocks = v.blocks + geo.blockOffset;
-            return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset}, o, d, ray.tmin, tlasMax,
+            return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset, reinterpret_cast<const char*>(blocks), sizeof(TriBlock)}, o, d,
+                               ray.tmin, tlasMax,
                                [&](uint32_t block, uint32_t count, float& blasMax) {
                                    float u, w;
                                    uint32_t tri;

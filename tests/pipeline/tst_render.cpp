@@ -296,6 +296,81 @@ private Q_SLOTS:
         QVERIFY(traceScene<true>(v, blocked, h));
     }
 
+    // The cut-out coordinates packed into the triangle blocks (16 bits above whole units) give the
+    // texels the mesh's uvs give: per triangle against triangleUv, and per ray against the brute-force
+    // test (which reads the mesh's uvs), on tiled uvs far from 0, negative ones, and triangles spanning
+    // 4 units or more (not packed: read from the mesh).
+    void packedCutoutCoordinatesMatchTheMesh()
+    {
+        TriangleMesh m = randomSoup(4000, 31);
+        std::mt19937 rng(5);
+        std::uniform_real_distribution<float> base(-20.0f, 20.0f), span(0.0f, 1.0f);
+        int wide = 0;
+        for (size_t t = 0; t < m.triangles.size(); ++t) {
+            const float s = t % 50 == 0 ? 5.0f : 1.5f;   // every 50th spans up to 5 units
+            const glm::vec2 b(base(rng), base(rng));
+            glm::vec2 lo(1e30f), hi(-1e30f);
+            for (int c = 0; c < 3; ++c) {
+                const glm::vec2 uv = b + s * glm::vec2(span(rng), span(rng));
+                m.uvs.push_back(uv);
+                lo = glm::min(lo, uv);
+                hi = glm::max(hi, uv);
+            }
+            const glm::vec2 room = hi - glm::floor(lo);
+            if (std::max(room.x, room.y) >= 3.9999f) ++wide;
+        }
+        m.materials[0].isLeaf = true;
+        SpeciesAssets a = assetsFor(m);
+        ImageRgba cut(16, 16, glm::vec4(1.0f));
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 16; ++x) cut.at(x, y)[3] = ((x / 2 + y / 2) % 2) ? 1.0f : 0.0f;   // 2-texel checkerboard
+        a.cutout = {cut};
+        Scene scene = sceneFor({InstanceDesc{}});
+        std::vector<SpeciesAssets> assets{a};
+        const RenderScene rs = buildRenderScene(scene, assets, glm::vec3(1.0f));
+        const RenderView v = rs.view();
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+        int packed = 0, unpacked = 0;
+        for (const TriBlock& b : rs.blocks)
+            for (int k = 0; k < 4; ++k) {
+                if (b.alpha[k] == 0u) continue;
+                if (!((b.uvPacked >> k) & 1u)) {
+                    ++unpacked;
+                    continue;
+                }
+                ++packed;
+                for (int r = 0; r < 4; ++r) {
+                    float bu = u01(rng), bw = u01(rng);
+                    if (bu + bw > 1.0f) bu = 1.0f - bu, bw = 1.0f - bw;
+                    const glm::vec2 got = blockUv(v, b, k, bu, bw), want = triangleUv(v, b.tri[k], bu, bw);
+                    for (int axis = 0; axis < 2; ++axis) {
+                        const double d = double(got[axis]) - double(want[axis]);
+                        const double off = d - std::round(d);   // whole units apart
+                        QVERIFY2(std::fabs(off) < 1e-4, qPrintable(QString("triangle %1: uv %2 vs %3").arg(b.tri[k]).arg(got[axis]).arg(want[axis])));
+                    }
+                }
+            }
+        QCOMPARE(unpacked, wide);
+        QVERIFY(packed > 3000);
+        // Whole rays: the same closest hit as the brute force over the mesh's uvs, bar rays that land
+        // within the packing's 3e-5 of a texel edge.
+        const Bounds3 bounds = meshBounds(m);
+        const glm::vec3 cam = glm::vec3(scene.camera.position);
+        int hits = 0, differ = 0;
+        for (int i = 0; i < 20000; ++i) {
+            Ray r = randomRay(rng, bounds);
+            r.org -= cam;
+            uint32_t refPrim;
+            const float ref = bruteForce(v, m.triangles.size(), r, &refPrim);
+            Hit h{};
+            const bool got = traceScene<false>(v, r, h);
+            if (got) ++hits;
+            if (got != (ref >= 0.0f) || (got && std::fabs(h.t - ref) > 1e-5f * std::max(1.0f, ref))) ++differ;
+        }
+        QVERIFY(hits > 2000);
+        QVERIFY2(differ <= hits / 1000, qPrintable(QString("%1 of %2 rays differ").arg(differ).arg(hits)));
+    }
+
     // full = local + lb (the film's parts add up); ambient matches the mean luminance of full;
     // local mode solves no lighting grid; a leaf in the open is brighter than one in shadow.
     void modesAndStages()
