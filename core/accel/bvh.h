@@ -162,82 +162,85 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
 {
     const glm::vec3 inv = safeReciprocal(dir);
     const unsigned zeroAxes = (dir.x == 0.0f ? 1u : 0u) | (dir.y == 0.0f ? 2u : 0u) | (dir.z == 0.0f ? 4u : 0u);
-    uint32_t stackNode[kBvhStackSize];
+    // Stack entries and the sorted children are inner nodes (count 0) or leaves (count > 0, tested
+    // when they come up): every entered child is taken nearest first, so a far leaf is tested only
+    // if nothing nearer hit before it (closest hit), and a hit shrinks tmax for everything behind.
+    uint32_t stackNode[kBvhStackSize], stackCount[kBvhStackSize];
     float stackDist[kBvhStackSize];
     int sp = 0;
     uint32_t node = 0;
+    auto testLeaf = [&](uint32_t first, uint32_t count) {
+        SYLVA_COUNT(g_bvhLeafVisits);
+        if constexpr (std::is_invocable_v<LeafFn, uint32_t, uint32_t, float&>) {
+            return leaf(first, count, tmax);
+        } else {
+            for (uint32_t p = 0; p < count; ++p)
+                if (leaf(first + p, tmax)) return true;
+            return false;
+        }
+    };
     for (;;) {
         const BvhNode& n = bvh.nodes[node];
         SYLVA_COUNT(g_bvhNodeVisits);
         float tn[4];
         unsigned mask = nodeEntry(n, org, inv, zeroAxes, tmin, tmax, tn);
-        // Leaves are handled at once, nearest first (a hit shrinks tmax and may spare the others);
-        // inner children are sorted near to far.
-        uint32_t innerNode[4];
-        float innerDist[4];
-        int inner = 0;
-        unsigned leaves = 0;
+        // Entered children sorted far to near (the nearest ends last); their data fetched at once.
+        uint32_t kidNode[4], kidCount[4];
+        float kidDist[4];
+        int kids = 0;
         while (mask) {
             const int k = lowestBit(mask);
             mask &= mask - 1u;
-            if (n.count[k] > 0) {
-                leaves |= 1u << k;
+            int j = kids++;
+            while (j > 0 && kidDist[j - 1] < tn[k]) {
+                kidDist[j] = kidDist[j - 1];
+                kidNode[j] = kidNode[j - 1];
+                kidCount[j] = kidCount[j - 1];
+                --j;
+            }
+            kidDist[j] = tn[k];
+            kidNode[j] = n.child[k];
+            kidCount[j] = n.count[k];
 #if !defined(__CUDA_ARCH__)
+            // Start the fetches now: traversal is bound by memory latency.
+            if (n.count[k] > 0) {
                 if (bvh.leafData) {
                     const char* p = bvh.leafData + size_t(n.child[k]) * bvh.leafBytes;
                     __builtin_prefetch(p);
                     __builtin_prefetch(p + 64);
                     __builtin_prefetch(p + 128);
                 }
-#endif
-                continue;
-            }
-            int j = inner++;
-            while (j > 0 && innerDist[j - 1] < tn[k]) {   // descending: the nearest ends last
-                innerDist[j] = innerDist[j - 1];
-                innerNode[j] = innerNode[j - 1];
-                --j;
-            }
-            innerDist[j] = tn[k];
-            innerNode[j] = n.child[k];
-#if !defined(__CUDA_ARCH__)
-            // Start the fetch of the child's 128-byte node now: traversal is bound by memory latency.
-            __builtin_prefetch(&bvh.nodes[n.child[k]]);
-            __builtin_prefetch(reinterpret_cast<const char*>(&bvh.nodes[n.child[k]]) + 64);
-#endif
-        }
-        while (leaves) {
-            int k = lowestBit(leaves);
-            for (unsigned rest = leaves & (leaves - 1u); rest; rest &= rest - 1u) {
-                const int o = lowestBit(rest);
-                if (tn[o] < tn[k]) k = o;
-            }
-            leaves &= ~(1u << k);
-            if (!(tn[k] <= tmax)) continue;   // a nearer leaf of this node recorded a closer hit
-            SYLVA_COUNT(g_bvhLeafVisits);
-            if constexpr (std::is_invocable_v<LeafFn, uint32_t, uint32_t, float&>) {
-                if (leaf(n.child[k], n.count[k], tmax)) return true;
             } else {
-                for (uint32_t p = 0; p < n.count[k]; ++p)
-                    if (leaf(n.child[k] + p, tmax)) return true;
+                __builtin_prefetch(&bvh.nodes[n.child[k]]);
+                __builtin_prefetch(reinterpret_cast<const char*>(&bvh.nodes[n.child[k]]) + 64);
             }
+#endif
         }
-        // Push the farther ones, continue with the nearest (re-checked against a shrunken tmax).
-        for (int j = 0; j + 1 < inner; ++j) {
-            if (!(innerDist[j] <= tmax)) continue;
+        // Leaves nearer than every inner child are tested now, nearest first.
+        while (kids > 0 && kidCount[kids - 1] > 0) {
+            --kids;
+            if (kidDist[kids] <= tmax && testLeaf(kidNode[kids], kidCount[kids])) return true;
+        }
+        // Push the farther ones, continue with the nearest inner child (re-checked against tmax).
+        for (int j = 0; j + 1 < kids; ++j) {
+            if (!(kidDist[j] <= tmax)) continue;
             SYLVA_KERNEL_ASSERT(sp < kBvhStackSize);
-            stackNode[sp] = innerNode[j];
-            stackDist[sp] = innerDist[j];
+            stackNode[sp] = kidNode[j];
+            stackCount[sp] = kidCount[j];
+            stackDist[sp] = kidDist[j];
             ++sp;
         }
-        if (inner > 0 && innerDist[inner - 1] <= tmax) {
-            node = innerNode[inner - 1];
+        if (kids > 0 && kidDist[kids - 1] <= tmax) {
+            node = kidNode[kids - 1];
             continue;
         }
+        // Pop: leaves are tested on the way, the first inner node still in reach is visited.
         for (;;) {
             if (sp == 0) return false;
             --sp;
-            if (stackDist[sp] <= tmax) break;
+            if (!(stackDist[sp] <= tmax)) continue;
+            if (stackCount[sp] == 0) break;
+            if (testLeaf(stackNode[sp], stackCount[sp])) return true;
         }
         node = stackNode[sp];
     }
