@@ -674,14 +674,15 @@ public:
     }
 
     // Sets the state of `solver` (whose interior is to be written) for `solves`; returns the steps run
-    // on all coarse levels.
-    int start(Solver<S>& solver, const std::vector<ChannelParams>& solves)
+    // on all coarse levels. The coarse solves check `progress` for cancel like the fine one.
+    int start(Solver<S>& solver, const std::vector<ChannelParams>& solves, Progress* progress)
     {
         int steps = 0;
         for (size_t l = m_grids.size(); l-- > 0;) {
             const bool fromCoarser = l + 1 < m_grids.size();
             if (!m_solvers[l]) m_solvers[l] = std::make_unique<Solver<S>>(m_grids[l], m_params, solves);
             else m_solvers[l]->setSolves(solves, fromCoarser);
+            m_solvers[l]->m_progress = progress;
             if (fromCoarser) m_solvers[l]->prolongateFrom(*m_solvers[l + 1]);
             SolveStats levelStats;
             const int maxSteps = m_params.maxSteps > 0 ? m_params.maxSteps : 4 * m_grids[l].geometry.longestEdge();
@@ -764,13 +765,15 @@ LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progre
         } else {
             solver->setSolves(these, coarse);
         }
-        if (coarse) stats.coarseSteps = std::max(stats.coarseSteps, chain->start(*solver, these));
+        if (coarse) stats.coarseSteps = std::max(stats.coarseSteps, chain->start(*solver, these, progress));
         const double groupIndex = double(g0 / group);
         const StepResult r = runSteps(*solver, params, steps, stats, [&](int done) {
             if (progress)
                 progress->report((groupIndex + double(done) / double(steps)) / double(groups),
                                  "LB step " + std::to_string(done) + "/" + std::to_string(steps) +
-                                     (groups > 1 ? " (channel group " + std::to_string(g0 / group + 1) + "/" + std::to_string(groups) + ")" : ""));
+                                     (groups > 1 ? (group == 1 ? " (channel solve " : " (channel group ") + std::to_string(g0 / group + 1) +
+                                                       "/" + std::to_string(groups) + ")"
+                                                 : ""));
         });
         const int done = r.steps;
         const bool groupConverged = r.converged;
