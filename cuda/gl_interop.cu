@@ -13,8 +13,6 @@ namespace sylva::cuda {
 struct GlInterop::State {
     cudaGraphicsResource* resource = nullptr;
     int width = 0, height = 0;
-    const RenderScene* uploadedFrom = nullptr;   // the scene the device copy was made from
-    std::unique_ptr<DeviceScene> device;
 };
 
 GlInterop::GlInterop()
@@ -44,24 +42,28 @@ void GlInterop::setPixelBuffer(unsigned glBuffer, int width, int height)
     m_state->height = height;
 }
 
-void GlInterop::render(const RenderScene& scene, RenderMode mode, float key)
+void GlInterop::releasePixelBuffer()
+{
+    if (m_state && m_state->resource) cudaGraphicsUnregisterResource(m_state->resource);
+    if (m_state) m_state->resource = nullptr;
+}
+
+void GlInterop::render(const DeviceScene& scene, RenderMode mode, float key, std::optional<RenderMode> right, uint32_t* hostCopy)
 {
     if (!m_state || !m_state->resource) throw BackendError("CUDA-GL interop: no pixel buffer registered");
-    const RenderView host = scene.view();
-    if (host.width != m_state->width || host.height != m_state->height)
+    const RenderView& v = scene.view();
+    if (v.width != m_state->width || v.height != m_state->height)
         throw BackendError("CUDA-GL interop: the pixel buffer size does not match the render size");
-    if (m_state->uploadedFrom != &scene || !m_state->device) {
-        m_state->device = std::make_unique<DeviceScene>(scene);
-        m_state->uploadedFrom = &scene;
-    }
     check(cudaGraphicsMapResources(1, &m_state->resource), "map the GL pixel buffer");
     void* ptr = nullptr;
     size_t bytes = 0;
+    const size_t need = size_t(v.width) * size_t(v.height) * 4;
     cudaError_t err = cudaGraphicsResourceGetMappedPointer(&ptr, &bytes, m_state->resource);
-    if (err == cudaSuccess && bytes < size_t(host.width) * size_t(host.height) * 4) err = cudaErrorInvalidValue;
+    if (err == cudaSuccess && bytes < need) err = cudaErrorInvalidValue;
     if (err == cudaSuccess) {
         try {
-            renderToRgba8(*m_state->device, mode, key, static_cast<uint32_t*>(ptr));
+            renderToRgba8(scene, mode, key, static_cast<uint32_t*>(ptr), right);
+            if (hostCopy) check(cudaMemcpy(hostCopy, ptr, need, cudaMemcpyDeviceToHost), "picture download");
         } catch (...) {
             cudaGraphicsUnmapResources(1, &m_state->resource);
             throw;

@@ -17,7 +17,7 @@
 #include "core/render/render_cpu.h"
 #include "core/scene/scene.h"
 #include "studio/asset_store.h"
-#include "studio/view_frame.h"
+#include "pipeline/render/view_frame.h"
 
 namespace sylva {
 

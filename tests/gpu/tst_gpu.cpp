@@ -4,7 +4,9 @@
 #include <QTemporaryDir>
 #include <QTest>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <random>
 
 #include "core/grid/grid_compare.h"
@@ -15,7 +17,10 @@
 #include "pipeline/backend_select.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/render/view_frame.h"
+#include "tests/gpu/egl_context.h"
 #if SYLVA_HAVE_CUDA
+#include "cuda/gl_interop.h"
 #include "cuda/lb_cuda.h"
 #include "cuda/render_cuda.h"
 #endif
@@ -171,6 +176,111 @@ private Q_SLOTS:
             qInfo("%s: %d of %zu values differ by more than 0.1", renderModeName(m), bad, a.pixels.size());
             QVERIFY(bad <= int(a.pixels.size()) / 200);
         }
+#endif
+    }
+
+    // The studio's camera moves on the GPU: a device scene re-placed at another camera, with an instance
+    // moved and one added (the top level grows) and another size and sample count, renders exactly
+    // what a fresh upload of the same host frame renders, and what the CPU renders of it.
+    void placeMatchesFreshUpload()
+    {
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
+        Scene s = smallScene();
+        QTemporaryDir dir;
+        GridCache cache(dir.path().toStdString());
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
+        const glm::vec3 sun = sunRadiance(s.sun);
+        ViewFrame f = buildViewFrame(s, assets, sun);
+        placeViewFrame(f, s, sun, s.render.width, s.render.height, 1);
+        cuda::DeviceScene placed(f.rs);
+        const Film before = cuda::renderCuda(placed);
+        s.camera.position = {-2.0, 2.0, -4.0};
+        s.instances[1].position += glm::dvec3(0.3, 0.0, -0.2);
+        InstanceDesc c;
+        c.position = {-1.2, 0.0, 1.5};
+        c.rotationDeg = {0.0f, 200.0f, 0.0f};
+        c.scale = 0.8f;
+        s.instances.push_back(c);
+        placeViewFrame(f, s, sun, 80, 56, 2);
+        placed.place(f.rs);
+        const Film moved = cuda::renderCuda(placed);
+        const Film fresh = cuda::renderCuda(cuda::DeviceScene(f.rs));
+        QCOMPARE(moved.width, 80);
+        QCOMPARE(moved.height, 56);
+        QCOMPARE(moved.pixels.size(), fresh.pixels.size());
+        QVERIFY(std::memcmp(moved.pixels.data(), fresh.pixels.data(), moved.pixels.size() * sizeof(SampleParts)) == 0);
+        // and the move is visible: the picture changed
+        QVERIFY(before.pixels.size() != moved.pixels.size() ||
+                std::memcmp(before.pixels.data(), moved.pixels.data(), moved.pixels.size() * sizeof(SampleParts)) != 0);
+        const Film cpu = renderFilm(f.rs.view());
+        const ImageRgba a = toneMapped(composeMode(cpu, RenderMode::Full, s.sky), 80, 56, 0.18f);
+        const ImageRgba b = toneMapped(composeMode(moved, RenderMode::Full, s.sky), 80, 56, 0.18f);
+        int bad = 0;
+        for (size_t i = 0; i < a.pixels.size(); ++i) bad += std::fabs(a.pixels[i] - b.pixels[i]) > 0.1f;
+        qInfo("re-placed frame vs CPU: %d of %zu values differ by more than 0.1", bad, a.pixels.size());
+        QVERIFY(bad <= int(a.pixels.size()) / 200);
+#endif
+    }
+
+    // The viewport's GPU path: CUDA traces and tone-maps into a GL pixel buffer; the buffer, read back
+    // through OpenGL, holds the CPU's picture in every mode and in the side-by-side compare (each
+    // half tone-mapped as its own mode's picture). Needs an NVIDIA OpenGL (EGL device); skips otherwise.
+    void interopMatchesCpu()
+    {
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
+        Scene s = smallScene();
+        const int w = s.render.width, h = s.render.height;
+        test::EglContext gl(w, h);
+        if (!gl.ok()) QSKIP(qPrintable(QString("skipped: no OpenGL on the CUDA device: ") + gl.why().c_str()));
+        qInfo("OpenGL renderer: %s", gl.renderer().c_str());
+        QTemporaryDir dir;
+        GridCache cache(dir.path().toStdString());
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
+        const RenderScene rs = buildRenderScene(s, assets, sunRadiance(s.sun));
+        const Film cpu = renderFilm(rs.view());
+        const cuda::DeviceScene ds(rs);
+        GLuint pbo = 0;
+        glGenBuffers(1, &pbo);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, pbo);
+        glBufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(w) * h * 4, nullptr, GL_STREAM_DRAW);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        cuda::GlInterop interop;
+        QVERIFY(interop.available());
+        interop.setPixelBuffer(pbo, w, h);
+        const std::pair<RenderMode, RenderMode> cases[] = {{RenderMode::Full, RenderMode::Full},
+                                                           {RenderMode::Local, RenderMode::Local},
+                                                           {RenderMode::Ambient, RenderMode::Ambient},
+                                                           {RenderMode::Lb, RenderMode::Lb},
+                                                           {RenderMode::Full, RenderMode::Lb},
+                                                           {RenderMode::Local, RenderMode::Ambient}};
+        for (const auto& [left, right] : cases) {
+            std::vector<uint32_t> host(size_t(w) * h, 0xdeadbeefu), viaGl(size_t(w) * h, 0xdeadbeefu);
+            interop.render(ds, left, 0.18f, right == left ? std::nullopt : std::optional<RenderMode>(right), host.data());
+            glBindBuffer(GL_PIXEL_UNPACK_BUFFER, pbo);
+            glGetBufferSubData(GL_PIXEL_UNPACK_BUFFER, 0, GLsizeiptr(w) * h * 4, viaGl.data());
+            glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+            QCOMPARE(glGetError(), GLenum(GL_NO_ERROR));
+            QVERIFY(host == viaGl);
+            const ImageRgba a = toneMapped(composeMode(cpu, left, s.sky), w, h, 0.18f);
+            const ImageRgba b = toneMapped(composeMode(cpu, right, s.sky), w, h, 0.18f);
+            int bad = 0;
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    const size_t i = size_t(y) * w + size_t(x);
+                    const float* want = &(x < w / 2 ? a : b).pixels[i * 4];
+                    for (int c = 0; c < 3; ++c) {
+                        const float got = float((viaGl[i] >> (8 * c)) & 0xffu) / 255.0f;
+                        bad += std::fabs(got - std::clamp(want[c], 0.0f, 1.0f)) > 0.1f;
+                    }
+                    bad += (viaGl[i] >> 24) != 0xffu;
+                }
+            qInfo("%s | %s: %d of %d values differ by more than 0.1", renderModeName(left), renderModeName(right), bad, w * h * 3);
+            QVERIFY(bad <= w * h * 3 / 200);
+        }
+        interop.releasePixelBuffer();
+        glDeleteBuffers(1, &pbo);
 #endif
     }
 

@@ -12,7 +12,7 @@
 #include "pipeline/render/render_job.h"
 #include "studio/asset_store.h"
 #include "studio/render_worker.h"
-#include "studio/view_frame.h"
+#include "pipeline/render/view_frame.h"
 
 using namespace sylva;
 

@@ -1,5 +1,5 @@
 // placeViewFrame: the top level of buildRenderScene (instances, instance BVH, environment) redone alone.
-#include "studio/view_frame.h"
+#include "pipeline/render/view_frame.h"
 
 #include "core/base/error.h"
 
