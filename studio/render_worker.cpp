@@ -5,6 +5,7 @@
 
 #include <QMutexLocker>
 
+#include "core/backend/backend.h"
 #include "core/base/error.h"
 #include "pipeline/render/render_job.h"
 #include "studio/background_priority.h"
@@ -50,7 +51,10 @@ QImage picture(const Film& film, const Scene& scene, const std::optional<RenderM
 
 } // namespace
 
-RenderWorker::RenderWorker(QObject* parent) : QThread(parent), m_passes(defaultPasses()) {}
+RenderWorker::RenderWorker(QObject* parent) : QThread(parent), m_passes(defaultPasses())
+{
+    qRegisterMetaType<sylva::GpuFramePtr>();
+}
 
 RenderWorker::~RenderWorker()
 {
@@ -68,6 +72,12 @@ void RenderWorker::setPasses(std::vector<RenderPass> passes)
 {
     QMutexLocker lock(&m_mutex);
     m_passes = std::move(passes);
+}
+
+std::vector<RenderPass> RenderWorker::passes() const
+{
+    QMutexLocker lock(&m_mutex);
+    return m_passes;
 }
 
 void RenderWorker::request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size, std::optional<RenderMode> compare)
@@ -90,6 +100,12 @@ void RenderWorker::clear()
     QMutexLocker lock(&m_mutex);
     m_hasRequest = false;
     m_restart = true;
+}
+
+void RenderWorker::setGpuMode(bool on)
+{
+    m_gpu = on;
+    m_gpuForget = true;
 }
 
 void RenderWorker::run()
@@ -135,6 +151,30 @@ void RenderWorker::process(const Request& req, Progress& progress)
         QMutexLocker lock(&m_mutex);
         return double(m_sinceRequest.nsecsElapsed()) * 1e-9;
     };
+
+    if (m_gpu) {
+        if (m_gpuForget.exchange(false)) m_gpuAssets.clear();
+        if (m_gpuAssets == req.assets) return;   // the viewport has this frame and traces it itself
+        try {
+            std::vector<SpeciesAssets> copies;
+            copies.reserve(req.assets.size());
+            for (const AssetsPtr& a : req.assets) copies.push_back(*a);
+            const glm::vec3 sun = sunRadiance(scene.sun);
+            auto g = std::make_shared<GpuFrame>();
+            g->frame = buildViewFrame(scene, copies, sun);
+            if (interrupted()) throw Cancelled();
+            placeViewFrame(g->frame, scene, sun, w, h, 1);
+            g->device = std::make_unique<cuda::DeviceScene>(g->frame.rs);
+            g->assets = req.assets;
+            m_gpuAssets = req.assets;
+            Q_EMIT gpuFrameReady(g);
+            return;
+        } catch (const BackendError& e) {
+            m_gpu = false;
+            m_gpuAssets.clear();
+            Q_EMIT gpuFailed(QString::fromStdString(e.what()));
+        }
+    }
 
     // A change of mode, compare mode or exposure alone: the film already holds every mode's parts.
     if (m_lastScene && m_frameAssets == req.assets && m_lastSize == req.size && m_lastPass == int(passes.size()) - 1) {

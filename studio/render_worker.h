@@ -1,5 +1,7 @@
 // The viewport's progressive CPU renderer on its own thread: restarts on every request, emits images
-// from a quarter-resolution preview up to a refined frame (Qt's mandelbrot RenderThread pattern).
+// from a quarter-resolution preview up to a refined frame (Qt's mandelbrot RenderThread pattern). In
+// GPU mode it builds and uploads the species part of the frame instead, and the viewport traces on
+// the device through CUDA-GL interop.
 #pragma once
 
 #include <atomic>
@@ -16,8 +18,9 @@
 
 #include "core/render/render_cpu.h"
 #include "core/scene/scene.h"
-#include "studio/asset_store.h"
+#include "cuda/render_cuda.h"
 #include "pipeline/render/view_frame.h"
+#include "studio/asset_store.h"
 
 namespace sylva {
 
@@ -34,6 +37,15 @@ QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float 
 // left), the rest from filmImage(film, right); each half is exactly that mode's own picture.
 QImage compareImage(const Film& film, RenderMode left, RenderMode right, const glm::vec3& sky, float exposureKey);
 
+// The GPU viewport's frame: the species part built and uploaded on the worker thread, then handed to
+// the viewport, which re-places it for every camera move (placeViewFrame, DeviceScene::place).
+struct GpuFrame {
+    ViewFrame frame;
+    std::unique_ptr<cuda::DeviceScene> device;
+    std::vector<AssetsPtr> assets;   // what it was built from
+};
+using GpuFramePtr = std::shared_ptr<GpuFrame>;
+
 class RenderWorker : public QThread {
     Q_OBJECT
 
@@ -44,6 +56,7 @@ public:
     // The default schedule: 1/4 size at 1 spp, full size at 1 spp, full size at 4 spp.
     static std::vector<RenderPass> defaultPasses();
     void setPasses(std::vector<RenderPass> passes);
+    std::vector<RenderPass> passes() const;
 
     // Renders `scene` with `assets` (one per species, in order) at `size` pixels. Cancels the frame in
     // progress. Same assets as the last request: only the top level is re-placed (fast); a change of
@@ -55,10 +68,20 @@ public:
     // Stops the frame in progress and forgets the request (e.g. assets are being recomputed).
     void clear();
 
+    // GPU mode: a request with new assets builds the frame, uploads it and emits gpuFrameReady instead
+    // of tracing; a request with the assets of the last GPU frame does nothing (the viewport traces).
+    // Switching (either way) forgets the last GPU frame.
+    void setGpuMode(bool on);
+    bool gpuMode() const { return m_gpu.load(); }
+
 Q_SIGNALS:
     // pass: index into the schedule; last: the schedule is done; seconds: since the request.
     void imageReady(const QImage& image, int pass, bool last, double seconds);
     void failed(const QString& message);
+    // GPU mode: the frame for the requested assets is on the device.
+    void gpuFrameReady(const sylva::GpuFramePtr& frame);
+    // GPU mode failed (e.g. out of device memory): the worker is back in CPU mode and rendered on the CPU.
+    void gpuFailed(const QString& message);
 
 protected:
     void run() override;
@@ -74,12 +97,12 @@ private:
     void process(const Request& req, Progress& progress);
     bool interrupted() const { return m_restart.load() || m_abort.load(); }
 
-    QMutex m_mutex;
+    mutable QMutex m_mutex;
     QWaitCondition m_condition;
     Request m_request;
     std::vector<RenderPass> m_passes;
     QElapsedTimer m_sinceRequest;
-    std::atomic<bool> m_restart{false}, m_abort{false};
+    std::atomic<bool> m_restart{false}, m_abort{false}, m_gpu{false}, m_gpuForget{false};
     bool m_hasRequest = false;
 
     // Worker-thread state.
@@ -89,6 +112,9 @@ private:
     QSize m_lastSize;
     Film m_lastFilm;
     int m_lastPass = -1;
+    std::vector<AssetsPtr> m_gpuAssets;   // what the last GPU frame was built from
 };
 
 } // namespace sylva
+
+Q_DECLARE_METATYPE(sylva::GpuFramePtr)

@@ -10,6 +10,10 @@
 #include <QPainter>
 #include <QWheelEvent>
 
+#include "core/backend/backend.h"
+#include "cuda/device_query.h"
+#include "cuda/gl_interop.h"
+#include "pipeline/render/render_job.h"
 #include "studio/camera_nav.h"
 #include "studio/render_worker.h"
 #include "studio/scene_document.h"
@@ -43,6 +47,20 @@ Viewport::Viewport(QWidget* parent) : QOpenGLWidget(parent), m_worker(new Render
     connect(m_worker, &RenderWorker::failed, this, [this](const QString& message) {
         setStatus(message);
         Q_EMIT renderFailed(message);
+    });
+    connect(m_worker, &RenderWorker::gpuFrameReady, this, [this](const GpuFramePtr& frame) {
+        if (!m_interop || frame->assets != m_assets) return;   // stale: the assets changed again meanwhile
+        m_gpuFrame = frame;
+        m_gpuPass = 0;
+        update();
+    });
+    connect(m_worker, &RenderWorker::gpuFailed, this, [this](const QString& message) {
+        // The worker is back on the CPU and renders this request there.
+        if (m_interop) {
+            makeCurrent();
+            disableGpu(message);
+            doneCurrent();
+        }
     });
 }
 
@@ -88,6 +106,14 @@ void Viewport::requestRender()
     }
     setStatus(QString());
     m_awaitingFirst = true;
+    m_sinceRequest.start();
+    if (m_interop) {
+        // The device traces in paintGL; the worker only builds and uploads frames for new assets.
+        m_gpuPass = 0;
+        if (!m_gpuFrame || m_gpuFrame->assets != m_assets) m_worker->request(m_scene, m_assets, renderSize(), m_compare);
+        update();
+        return;
+    }
     m_worker->request(m_scene, m_assets, renderSize(), m_compare);
 }
 
@@ -122,12 +148,69 @@ void Viewport::initializeGL()
     m_quad.allocate(quad, sizeof quad);
     m_quad.release();
     m_imageDirty = true;
+    setupGpu();
+}
+
+void Viewport::setupGpu()
+{
+    if (m_interop) return;
+    if (qEnvironmentVariable("SYLVA_VIEWPORT") == QLatin1String("cpu")) {
+        m_backendNote = tr("CPU viewport (SYLVA_VIEWPORT=cpu)");
+        return;
+    }
+    auto interop = std::make_unique<cuda::GlInterop>();
+    if (!interop->available()) {
+        m_backendNote = tr("CPU viewport: %1").arg(QString::fromStdString(interop->whyUnavailable()));
+        return;
+    }
+    // Interop needs this GL context to run on the CUDA device: registering a buffer tells.
+    GLuint probe = 0;
+    glGenBuffers(1, &probe);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, probe);
+    glBufferData(GL_PIXEL_UNPACK_BUFFER, 4, nullptr, GL_STREAM_DRAW);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    try {
+        interop->setPixelBuffer(probe, 1, 1);
+    } catch (const BackendError& e) {
+        glDeleteBuffers(1, &probe);
+        m_backendNote = tr("CPU viewport: this OpenGL (%1) cannot share buffers with CUDA (%2)")
+                            .arg(QString::fromLatin1(reinterpret_cast<const char*>(glGetString(GL_RENDERER))),
+                                 QString::fromStdString(e.what()));
+        return;
+    }
+    m_interop = std::move(interop);
+    m_pbo = probe;
+    m_pboSize = QSize(1, 1);
+    const cuda::DeviceQuery q = cuda::queryDevices();
+    m_backendNote = tr("GPU viewport: CUDA-GL interop on %1").arg(QString::fromStdString(q.devices.empty() ? "?" : q.devices[0].name));
+    m_worker->setGpuMode(true);
+    requestRender();
+}
+
+void Viewport::disableGpu(const QString& why)
+{
+    // The GL context is current. Unregister before the buffer goes.
+    m_interop.reset();
+    m_gpuFrame.reset();
+    if (m_pbo) glDeleteBuffers(1, &m_pbo);
+    m_pbo = 0;
+    m_pboSize = QSize();
+    m_backendNote = tr("CPU viewport: the GPU path stopped (%1)").arg(why);
+    m_worker->setGpuMode(false);
+    qWarning("viewport: %s", qPrintable(m_backendNote));
+    Q_EMIT gpuDisabled(why);
+    requestRender();
 }
 
 void Viewport::cleanupGL()
 {
-    if (!m_program && !m_texture && !m_quad.isCreated()) return;
+    if (!m_program && !m_texture && !m_quad.isCreated() && !m_interop) return;
     makeCurrent();
+    m_interop.reset();   // unregisters the pixel buffer while it still exists
+    m_gpuFrame.reset();
+    if (m_pbo) glDeleteBuffers(1, &m_pbo);
+    m_pbo = 0;
+    m_pboSize = QSize();
     delete m_texture;
     m_texture = nullptr;
     delete m_program;
@@ -142,7 +225,15 @@ void Viewport::paintGL()
 {
     glClearColor(0.12f, 0.12f, 0.13f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT);
-    if (m_imageDirty && !m_image.isNull()) {
+    bool gpuDrawn = false;
+    if (m_interop) {
+        try {
+            gpuDrawn = paintGpu();
+        } catch (const std::exception& e) {
+            disableGpu(QString::fromStdString(e.what()));
+        }
+    }
+    if (!gpuDrawn && m_imageDirty && !m_image.isNull()) {
         delete m_texture;
         m_texture = new QOpenGLTexture(m_image, QOpenGLTexture::DontGenerateMipMaps);
         m_texture->setMinificationFilter(QOpenGLTexture::Linear);
@@ -150,26 +241,12 @@ void Viewport::paintGL()
         m_texture->setWrapMode(QOpenGLTexture::ClampToEdge);
         m_imageDirty = false;
     }
-    if (m_texture && m_program && m_program->isLinked()) {
-        m_program->bind();
-        m_program->setUniformValue("film", 0);
-        m_texture->bind(0);
-        m_quad.bind();
-        m_program->enableAttributeArray(0);
-        m_program->enableAttributeArray(1);
-        m_program->setAttributeBuffer(0, GL_FLOAT, 0, 2, 4 * sizeof(GLfloat));
-        m_program->setAttributeBuffer(1, GL_FLOAT, 2 * sizeof(GLfloat), 2, 4 * sizeof(GLfloat));
-        glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
-        m_program->disableAttributeArray(0);
-        m_program->disableAttributeArray(1);
-        m_quad.release();
-        m_texture->release();
-        m_program->release();
-    }
-    if (m_compare && m_texture && !m_image.isNull()) {
-        // The split the worker made (column width / 2 of the picture), and which mode is where.
+    drawTexture();
+    if (m_compare && m_texture && m_texture->width() > 0) {
+        // The split the renderer made (column width / 2 of the picture), and which mode is where.
         QPainter p(this);
-        const int x = int(double(width()) * double(m_image.width() / 2) / double(m_image.width()));
+        const int iw = m_texture->width();
+        const int x = int(double(width()) * double(iw / 2) / double(iw));
         p.setPen(QColor(255, 255, 255, 200));
         p.drawLine(x, 0, x, height());
         p.drawText(QRect(8, 8, x - 16, 20), Qt::AlignLeft | Qt::AlignTop, QString::fromLatin1(renderModeName(m_scene.render.mode)));
@@ -180,6 +257,88 @@ void Viewport::paintGL()
         p.setPen(QColor(230, 230, 230));
         p.drawText(rect().adjusted(12, 12, -12, -12), Qt::AlignLeft | Qt::AlignTop | Qt::TextWordWrap, m_status);
     }
+}
+
+void Viewport::drawTexture()
+{
+    if (!m_texture || !m_program || !m_program->isLinked()) return;
+    m_program->bind();
+    m_program->setUniformValue("film", 0);
+    m_texture->bind(0);
+    m_quad.bind();
+    m_program->enableAttributeArray(0);
+    m_program->enableAttributeArray(1);
+    m_program->setAttributeBuffer(0, GL_FLOAT, 0, 2, 4 * sizeof(GLfloat));
+    m_program->setAttributeBuffer(1, GL_FLOAT, 2 * sizeof(GLfloat), 2, 4 * sizeof(GLfloat));
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    m_program->disableAttributeArray(0);
+    m_program->disableAttributeArray(1);
+    m_quad.release();
+    m_texture->release();
+    m_program->release();
+}
+
+// One pass of the GPU schedule (the worker's full-size passes, e.g. 1 then 4 samples per pixel): place
+// the frame at the current camera, trace and tone-map into the pixel buffer, copy it into the texture
+// on the GPU. Passes after the first follow while nothing changes.
+bool Viewport::paintGpu()
+{
+    if (!m_gpuFrame || m_gpuFrame->assets != m_assets || m_scene.instances.empty()) return false;
+    std::vector<int> spps;
+    for (const RenderPass& p : m_worker->passes())
+        if (p.divisor == 1) spps.push_back(p.spp);
+    if (spps.empty()) spps.push_back(1);
+    m_gpuPass = std::min(m_gpuPass, spps.size() - 1);
+    const QSize size = renderSize();
+    const int w = size.width(), h = size.height();
+    if (m_pboSize != size || !m_texture || m_texture->width() != w || m_texture->height() != h) {
+        m_interop->releasePixelBuffer();   // before the buffer is reallocated
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, m_pbo);
+        glBufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(w) * h * 4, nullptr, GL_STREAM_DRAW);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        m_interop->setPixelBuffer(m_pbo, w, h);
+        m_pboSize = size;
+        delete m_texture;
+        m_texture = new QOpenGLTexture(QOpenGLTexture::Target2D);
+        m_texture->setSize(w, h);
+        m_texture->setFormat(QOpenGLTexture::RGBA8_UNorm);
+        m_texture->setMipLevels(1);
+        m_texture->allocateStorage(QOpenGLTexture::RGBA, QOpenGLTexture::UInt8);
+        m_texture->setMinificationFilter(QOpenGLTexture::Linear);
+        m_texture->setMagnificationFilter(QOpenGLTexture::Linear);
+        m_texture->setWrapMode(QOpenGLTexture::ClampToEdge);
+    }
+    const size_t pass = m_gpuPass;
+    const bool last = pass + 1 == spps.size();
+    placeViewFrame(m_gpuFrame->frame, m_scene, sunRadiance(m_scene.sun), w, h, spps[pass]);
+    m_gpuFrame->device->place(m_gpuFrame->frame.rs);
+    // The last pass is also kept on the host (lastImage(), tests, export of what is shown).
+    QImage picture;
+    if (last) picture = QImage(w, h, QImage::Format_RGBX8888);
+    m_interop->render(*m_gpuFrame->device, m_scene.render.mode, m_scene.render.exposureKey, m_compare,
+                      last ? reinterpret_cast<uint32_t*>(picture.bits()) : nullptr);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, m_pbo);
+    m_texture->bind(0);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, nullptr);
+    m_texture->release();
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    m_imageDirty = false;
+
+    const double seconds = m_sinceRequest.isValid() ? double(m_sinceRequest.nsecsElapsed()) * 1e-9 : 0.0;
+    if (last) m_image = picture;
+    m_lastPass = int(pass);
+    m_lastFinal = last;
+    if (m_awaitingFirst) {
+        m_firstImageSeconds = seconds;
+        m_awaitingFirst = false;
+    }
+    if (!last) {
+        ++m_gpuPass;
+        update();   // the next pass, unless something changes first (requestRender restarts at pass 0)
+    }
+    Q_EMIT imageShown(int(pass), last, seconds);
+    return true;
 }
 
 void Viewport::mousePressEvent(QMouseEvent* event)

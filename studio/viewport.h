@@ -1,10 +1,13 @@
-// The 3D view: a QOpenGLWidget showing the CPU-rendered film as a texture, with orbit/pan/zoom.
-// The texture upload is the seam where the CUDA-GL interop path (a later issue) plugs in.
+// The 3D view: a QOpenGLWidget showing the ray-traced forest as a texture, with orbit/pan/zoom and fly
+// navigation. On an NVIDIA GPU the frame is traced on the device in paintGL and reaches the texture
+// through a CUDA-GL pixel buffer (the picture never leaves the GPU); otherwise the render worker
+// traces on the CPU and the film is uploaded.
 #pragma once
 
 #include <memory>
 #include <optional>
 
+#include <QElapsedTimer>
 #include <QImage>
 #include <QOpenGLBuffer>
 #include <QOpenGLFunctions>
@@ -13,13 +16,16 @@
 
 #include "core/scene/scene.h"
 #include "studio/asset_store.h"
+#include "studio/render_worker.h"
 
 class QOpenGLShaderProgram;
 class QOpenGLTexture;
 
 namespace sylva {
 
-class RenderWorker;
+namespace cuda {
+class GlInterop;
+}
 
 class Viewport : public QOpenGLWidget, protected QOpenGLFunctions {
     Q_OBJECT
@@ -43,6 +49,12 @@ public:
     QSize renderSize() const;
     RenderWorker* worker() const { return m_worker; }
 
+    // Where frames are traced: "cuda-gl" (device, interop) or "cpu"; set when the GL context is made.
+    // Environment SYLVA_VIEWPORT=cpu keeps the CPU path. backendNote(): why the GPU path is off, or
+    // the device it runs on.
+    QString backend() const { return m_interop ? QStringLiteral("cuda-gl") : QStringLiteral("cpu"); }
+    QString backendNote() const { return m_backendNote; }
+
     QSize sizeHint() const override { return {800, 450}; }
 
     // Side-by-side compare: the right half of the picture in a second mode, from the same trace.
@@ -62,6 +74,8 @@ Q_SIGNALS:
     void imageShown(int pass, bool last, double seconds);
     void renderFailed(const QString& message);
     void flyModeChanged(bool on);
+    // The GPU path was switched off (why); rendering goes on on the CPU.
+    void gpuDisabled(const QString& message);
 
 protected:
     void initializeGL() override;
@@ -77,6 +91,9 @@ private:
     void cleanupGL();
     void requestRender();
     void onImage(const QImage& image, int pass, bool last, double seconds);
+    void setupGpu();
+    bool paintGpu();   // false: no GPU frame to show yet
+    void disableGpu(const QString& why);
 
     RenderWorker* m_worker;
     Scene m_scene;
@@ -107,6 +124,16 @@ private:
     QOpenGLShaderProgram* m_program = nullptr;
     QOpenGLTexture* m_texture = nullptr;
     QOpenGLBuffer m_quad;
+    void drawTexture();
+
+    // GPU path (null m_interop: CPU path)
+    std::unique_ptr<cuda::GlInterop> m_interop;
+    GpuFramePtr m_gpuFrame;
+    GLuint m_pbo = 0;
+    QSize m_pboSize;
+    size_t m_gpuPass = 0;   // index into the full-size passes of the worker's schedule
+    QElapsedTimer m_sinceRequest;
+    QString m_backendNote;
 };
 
 } // namespace sylva
