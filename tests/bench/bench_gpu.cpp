@@ -42,7 +42,7 @@ double median(int reps, F&& f)
 }
 
 // A 128^3 crown-like grid: an ellipsoid of medium with random holes (as bench_lb's synthetic crown).
-DensityGrid crown(int n)
+[[maybe_unused]] DensityGrid crown(int n)
 {
     DensityGrid d;
     d.geometry.dims = glm::ivec3(n);
@@ -85,6 +85,9 @@ int main(int argc, char** argv)
                     q.built ? q.message.c_str() : "this build has no CUDA backend");
         return 0;
     }
+#if !SYLVA_HAVE_CUDA
+    (void)grid, (void)reps, (void)frames, (void)vw, (void)vh, (void)cpu, (void)lb;
+#endif
 #if SYLVA_HAVE_CUDA
     std::printf("device: %s, %d SMs, %.1f GiB\n", q.devices[0].name.c_str(), q.devices[0].multiprocessors,
                 double(q.devices[0].totalMemoryBytes) / (1 << 30));

@@ -29,7 +29,7 @@ using namespace sylva;
 
 namespace {
 
-DensityGrid randomDensity(glm::ivec3 dims, uint32_t seed, bool withWood)
+[[maybe_unused]] DensityGrid randomDensity(glm::ivec3 dims, uint32_t seed, bool withWood)
 {
     DensityGrid d;
     d.geometry.dims = dims;
@@ -50,7 +50,7 @@ DensityGrid randomDensity(glm::ivec3 dims, uint32_t seed, bool withWood)
 }
 
 // Two grown shrubs on the ground, small enough to trace quickly on the CPU.
-Scene smallScene()
+[[maybe_unused]] Scene smallScene()
 {
     Scene s;
     s.species.resize(1);
