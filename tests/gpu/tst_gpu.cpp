@@ -19,6 +19,7 @@
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/view_frame.h"
 #include "tests/gpu/egl_context.h"
+#include "tests/gpu/shrub_scene.h"
 #if SYLVA_HAVE_CUDA
 #include "cuda/gl_interop.h"
 #include "cuda/lb_cuda.h"
@@ -49,24 +50,14 @@ namespace {
     return d;
 }
 
-// Two grown shrubs on the ground, small enough to trace quickly on the CPU.
-[[maybe_unused]] Scene smallScene()
+// Values (colour channels of the tone-mapped pictures, 0..1) in mode m differing by more than 0.1.
+[[maybe_unused]] int valuesOff(const Film& cpu, const Film& gpu, RenderMode m, const glm::vec3& sky)
 {
-    Scene s;
-    s.species.resize(1);
-    s.species[0].name = "shrub";
-    s.species[0].grow = GrowSpec{"shrub", 2, 4000, 2.0f};
-    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-    s.species[0].grid = 16;
-    InstanceDesc a, b;
-    b.position = {1.5, 0.0, 1.0};
-    b.rotationDeg = {0.0f, 70.0f, 0.0f};
-    s.instances = {a, b};
-    s.camera.position = {0.0, 1.5, -5.0};
-    s.camera.target = {0.5, 0.8, 0.5};
-    s.render.width = 96;
-    s.render.height = 64;
-    return s;
+    const ImageRgba a = toneMapped(composeMode(cpu, m, sky), cpu.width, cpu.height, 0.18f);
+    const ImageRgba b = toneMapped(composeMode(gpu, m, sky), gpu.width, gpu.height, 0.18f);
+    int bad = 0;
+    for (size_t i = 0; i < a.pixels.size(); ++i) bad += std::fabs(a.pixels[i] - b.pixels[i]) > 0.1f;
+    return bad;
 }
 
 } // namespace
@@ -125,7 +116,7 @@ private Q_SLOTS:
     {
         if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
 #if SYLVA_HAVE_CUDA
-        const Scene s = smallScene();
+        const Scene s = test::twoShrubs();
         const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, nullptr, false);
         const RenderScene rs = buildRenderScene(s, assets, glm::vec3(1.0f));
         const RenderView v = rs.view();
@@ -161,7 +152,7 @@ private Q_SLOTS:
     {
         if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
 #if SYLVA_HAVE_CUDA
-        Scene s = smallScene();
+        Scene s = test::twoShrubs();
         QTemporaryDir dir;
         GridCache cache(dir.path().toStdString());
         const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
@@ -169,12 +160,9 @@ private Q_SLOTS:
         const Film cpu = renderFilm(rs.view());
         const Film gpu = cuda::renderCuda(cuda::DeviceScene(rs));
         for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb}) {
-            const ImageRgba a = toneMapped(composeMode(cpu, m, s.sky), s.render.width, s.render.height, 0.18f);
-            const ImageRgba b = toneMapped(composeMode(gpu, m, s.sky), s.render.width, s.render.height, 0.18f);
-            int bad = 0;
-            for (size_t i = 0; i < a.pixels.size(); ++i) bad += std::fabs(a.pixels[i] - b.pixels[i]) > 0.1f;
-            qInfo("%s: %d of %zu values differ by more than 0.1", renderModeName(m), bad, a.pixels.size());
-            QVERIFY(bad <= int(a.pixels.size()) / 200);
+            const int bad = valuesOff(cpu, gpu, m, s.sky), n = cpu.width * cpu.height * 4;
+            qInfo("%s: %d of %d values differ by more than 0.1", renderModeName(m), bad, n);
+            QVERIFY(bad <= n / 200);
         }
 #endif
     }
@@ -186,7 +174,7 @@ private Q_SLOTS:
     {
         if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
 #if SYLVA_HAVE_CUDA
-        Scene s = smallScene();
+        Scene s = test::twoShrubs();
         QTemporaryDir dir;
         GridCache cache(dir.path().toStdString());
         const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
@@ -214,12 +202,9 @@ private Q_SLOTS:
         QVERIFY(before.pixels.size() != moved.pixels.size() ||
                 std::memcmp(before.pixels.data(), moved.pixels.data(), moved.pixels.size() * sizeof(SampleParts)) != 0);
         const Film cpu = renderFilm(f.rs.view());
-        const ImageRgba a = toneMapped(composeMode(cpu, RenderMode::Full, s.sky), 80, 56, 0.18f);
-        const ImageRgba b = toneMapped(composeMode(moved, RenderMode::Full, s.sky), 80, 56, 0.18f);
-        int bad = 0;
-        for (size_t i = 0; i < a.pixels.size(); ++i) bad += std::fabs(a.pixels[i] - b.pixels[i]) > 0.1f;
-        qInfo("re-placed frame vs CPU: %d of %zu values differ by more than 0.1", bad, a.pixels.size());
-        QVERIFY(bad <= int(a.pixels.size()) / 200);
+        const int bad = valuesOff(cpu, moved, RenderMode::Full, s.sky), n = 80 * 56 * 4;
+        qInfo("re-placed frame vs CPU: %d of %d values differ by more than 0.1", bad, n);
+        QVERIFY(bad <= n / 200);
 #endif
     }
 
@@ -230,7 +215,7 @@ private Q_SLOTS:
     {
         if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
 #if SYLVA_HAVE_CUDA
-        Scene s = smallScene();
+        Scene s = test::twoShrubs();
         const int w = s.render.width, h = s.render.height;
         test::EglContext gl(w, h);
         if (!gl.ok()) QSKIP(qPrintable(QString("skipped: no OpenGL on the CUDA device: ") + gl.why().c_str()));

@@ -15,28 +15,12 @@
 #include "pipeline/render/view_frame.h"
 #include "studio/render_worker.h"
 #include "studio/viewport.h"
+#include "tests/gpu/shrub_scene.h"
 #include "tests/gui/studio_test_util.h"
 
 using namespace sylva;
 
 namespace {
-
-Scene shrubScene()
-{
-    Scene s;
-    s.species.resize(1);
-    s.species[0].name = "shrub";
-    s.species[0].grow = GrowSpec{"shrub", 2, 4000, 2.0f};
-    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-    s.species[0].grid = 16;
-    InstanceDesc a, b;
-    b.position = {1.5, 0.0, 1.0};
-    b.rotationDeg = {0.0f, 70.0f, 0.0f};
-    s.instances = {a, b};
-    s.camera.position = {0.0, 1.5, -5.0};
-    s.camera.target = {0.5, 0.8, 0.5};
-    return s;
-}
 
 // What the CPU shows for the same frame (filmImage / compareImage of a film traced at that size and
 // the last pass's samples).
@@ -86,7 +70,7 @@ private Q_SLOTS:
         qInfo("%s", qPrintable(v.backendNote()));
         if (v.backend() != QLatin1String("cuda-gl")) QSKIP(qPrintable("skipped: " + v.backendNote()));
 
-        Scene s = shrubScene();
+        Scene s = test::twoShrubs();
         GridCache cache(m_dir.filePath("grids").toStdString());
         const std::vector<SpeciesAssets> loaded = loadSpeciesAssets(s, &cache, true);
         std::vector<AssetsPtr> assets;
