@@ -66,6 +66,18 @@ class TestGpu : public QObject {
     Q_OBJECT
 
     QString m_noDevice;   // non-empty: why the device tests skip
+    QTemporaryDir m_cacheDir;
+    std::vector<SpeciesAssets> m_litShrubs;
+
+    // test::twoShrubs()'s species grown and lit once for the tests that need lighting grids.
+    const std::vector<SpeciesAssets>& litShrubs()
+    {
+        if (m_litShrubs.empty()) {
+            GridCache cache(m_cacheDir.path().toStdString());
+            m_litShrubs = loadSpeciesAssets(test::twoShrubs(), &cache, true);
+        }
+        return m_litShrubs;
+    }
 
 private Q_SLOTS:
     void initTestCase()
@@ -153,9 +165,7 @@ private Q_SLOTS:
         if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
 #if SYLVA_HAVE_CUDA
         Scene s = test::twoShrubs();
-        QTemporaryDir dir;
-        GridCache cache(dir.path().toStdString());
-        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
+        const std::vector<SpeciesAssets>& assets = litShrubs();
         const RenderScene rs = buildRenderScene(s, assets, sunRadiance(s.sun));
         const Film cpu = renderFilm(rs.view());
         const Film gpu = cuda::renderCuda(cuda::DeviceScene(rs));
@@ -175,9 +185,7 @@ private Q_SLOTS:
         if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
 #if SYLVA_HAVE_CUDA
         Scene s = test::twoShrubs();
-        QTemporaryDir dir;
-        GridCache cache(dir.path().toStdString());
-        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
+        const std::vector<SpeciesAssets>& assets = litShrubs();
         const glm::vec3 sun = sunRadiance(s.sun);
         ViewFrame f = buildViewFrame(s, assets, sun);
         placeViewFrame(f, s, sun, s.render.width, s.render.height, 1);
@@ -220,9 +228,7 @@ private Q_SLOTS:
         test::EglContext gl(w, h);
         if (!gl.ok()) QSKIP(qPrintable(QString("skipped: no OpenGL on the CUDA device: ") + gl.why().c_str()));
         qInfo("OpenGL renderer: %s", gl.renderer().c_str());
-        QTemporaryDir dir;
-        GridCache cache(dir.path().toStdString());
-        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, &cache, true);
+        const std::vector<SpeciesAssets>& assets = litShrubs();
         const RenderScene rs = buildRenderScene(s, assets, sunRadiance(s.sun));
         const Film cpu = renderFilm(rs.view());
         const cuda::DeviceScene ds(rs);
