@@ -146,9 +146,10 @@ float surfaceArea(const Bounds3& b)
     return 2.0f * (e.x * e.y + e.y * e.z + e.z * e.x);
 }
 
-void clearNode(BvhNode& n)
+template <int W>
+void clearNode(BvhNodeW<W>& n)
 {
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < W; ++k) {
         n.lox[k] = n.loy[k] = n.loz[k] = 1e30f;
         n.hix[k] = n.hiy[k] = n.hiz[k] = -1e30f;
         n.child[k] = kNoHit;
@@ -156,13 +157,14 @@ void clearNode(BvhNode& n)
     }
 }
 
-// Writes the (up to four) children of `parent` at nodes[slot]: its two children, with the inner
+// Writes the (up to W) children of `parent` at nodes[slot]: its two children, with the inner
 // child of largest area replaced by its own two children while there is room. Recurses depth-first.
-void flatten(const BuildNode* parent, uint32_t slot, std::vector<BvhNode>& nodes, int depth, int& maxDepth)
+template <int W>
+void flatten(const BuildNode* parent, uint32_t slot, std::vector<BvhNodeW<W>>& nodes, int depth, int& maxDepth)
 {
-    const BuildNode* kids[4] = {parent->child[0].get(), parent->child[1].get(), nullptr, nullptr};
+    const BuildNode* kids[W] = {parent->child[0].get(), parent->child[1].get()};
     int nk = 2;
-    while (nk < 4) {
+    while (nk < W) {
         int best = -1;
         float bestArea = -1.0f;
         for (int k = 0; k < nk; ++k)
@@ -178,7 +180,7 @@ void flatten(const BuildNode* parent, uint32_t slot, std::vector<BvhNode>& nodes
     clearNode(nodes[slot]);
     for (int k = 0; k < nk; ++k) {
         const BuildNode* c = kids[k];
-        BvhNode& n = nodes[slot];
+        BvhNodeW<W>& n = nodes[slot];
         n.lox[k] = c->bounds.lo.x;
         n.loy[k] = c->bounds.lo.y;
         n.loz[k] = c->bounds.lo.z;
@@ -199,8 +201,32 @@ void flatten(const BuildNode* parent, uint32_t slot, std::vector<BvhNode>& nodes
         nodes.emplace_back();
         nodes[slot].child[k] = childSlot;
         nodes[slot].count[k] = 0;
-        flatten(c, childSlot, nodes, depth + 1, maxDepth);
+        flatten<W>(c, childSlot, nodes, depth + 1, maxDepth);
     }
+}
+
+// The tree below `top` at nodes[0] (a single leaf: the root holds it as its first child). Returns the depth.
+template <int W>
+int flattenTree(const BuildNode* top, uint32_t prims, std::vector<BvhNodeW<W>>& nodes)
+{
+    nodes.emplace_back();
+    clearNode(nodes[0]);
+    if (!top) return 0;
+    if (top->leaf()) {
+        BvhNodeW<W>& root = nodes[0];
+        root.lox[0] = top->bounds.lo.x;
+        root.loy[0] = top->bounds.lo.y;
+        root.loz[0] = top->bounds.lo.z;
+        root.hix[0] = top->bounds.hi.x;
+        root.hiy[0] = top->bounds.hi.y;
+        root.hiz[0] = top->bounds.hi.z;
+        root.child[0] = 0;
+        root.count[0] = prims;
+        return 1;
+    }
+    int maxDepth = 1;
+    flatten<W>(top, 0, nodes, 1, maxDepth);
+    return maxDepth;
 }
 
 } // namespace
@@ -217,29 +243,13 @@ Bvh buildBvh(const std::vector<Bounds3>& primBounds, const BvhBuildSettings& set
         b.refs.push_back(i);
     }
     Bvh out;
-    out.nodes.emplace_back();
-    clearNode(out.nodes[0]);
+    std::unique_ptr<BuildNode> top;
     if (!b.refs.empty()) {
-        std::unique_ptr<BuildNode> top = b.build(0, uint32_t(b.refs.size()), 0);
+        top = b.build(0, uint32_t(b.refs.size()), 0);
         out.bounds = top->bounds;
-        if (top->leaf()) {
-            // A single leaf: the root holds it as its first child.
-            BvhNode& root = out.nodes[0];
-            root.lox[0] = top->bounds.lo.x;
-            root.loy[0] = top->bounds.lo.y;
-            root.loz[0] = top->bounds.lo.z;
-            root.hix[0] = top->bounds.hi.x;
-            root.hiy[0] = top->bounds.hi.y;
-            root.hiz[0] = top->bounds.hi.z;
-            root.child[0] = 0;
-            root.count[0] = uint32_t(b.refs.size());
-            out.depth = 1;
-        } else {
-            int maxDepth = 1;
-            flatten(top.get(), 0, out.nodes, 1, maxDepth);
-            out.depth = maxDepth;
-        }
     }
+    out.depth = flattenTree<4>(top.get(), uint32_t(b.refs.size()), out.nodes);
+    if (settings.wide) out.wideDepth = flattenTree<8>(top.get(), uint32_t(b.refs.size()), out.wideNodes);
     out.primOrder = std::move(b.refs);
     return out;
 }

@@ -15,23 +15,30 @@
 
 namespace sylva {
 
-// A 4-wide node: the boxes of up to four children as structure of arrays (one SIMD test for all
-// four). Child k with count[k] == 0 is an inner node at index child[k]; count[k] > 0 is a leaf of
+// A W-wide node: the boxes of up to W children as structure of arrays (one SIMD test for all of
+// them). Child k with count[k] == 0 is an inner node at index child[k]; count[k] > 0 is a leaf of
 // primitives [child[k], child[k] + count[k]) in the BVH's primitive order; unused children have
 // child[k] == kNoHit and count 0 (their boxes are not tested: an inverted box is still a slab hit).
-// 128 bytes, 64-byte aligned.
-struct alignas(64) BvhNode {
-    float lox[4], hix[4], loy[4], hiy[4], loz[4], hiz[4];
-    uint32_t child[4];
-    uint32_t count[4];
+// 64-byte aligned. BvhNode (4-wide, 128 bytes) is the structure every backend traverses; BvhNode8
+// (8-wide, 256 bytes) is a second flattening of the same build for the host's 8-wide SIMD: half the
+// levels, so half the dependent node loads a ray waits for.
+template <int W>
+struct alignas(64) BvhNodeW {
+    float lox[W], hix[W], loy[W], hiy[W], loz[W], hiz[W];
+    uint32_t child[W];
+    uint32_t count[W];
 };
+using BvhNode = BvhNodeW<4>;
+using BvhNode8 = BvhNodeW<8>;
 static_assert(sizeof(BvhNode) == 128);
+static_assert(sizeof(BvhNode8) == 256);
 
 struct BvhBuildSettings {
     int maxLeafSize = 8;          // primitives per leaf at most
     float traversalCost = 1.0f;   // SAH cost of a node visit, relative to one primitive test
     int leafBlock = 1;            // primitives tested together (SIMD leaf blocks): leaves cost per started block
     int bins = 16;                // SAH bins per axis
+    bool wide = false;            // also flatten the build 8-wide (Bvh::wideNodes)
 };
 
 // The host-side result: nodes (node 0 is the root's pair), the primitive order (primOrder[slot] =
@@ -41,21 +48,26 @@ struct Bvh {
     std::vector<uint32_t> primOrder;
     Bounds3 bounds;
     int depth = 0;                // deepest leaf, root children at depth 1
+    std::vector<BvhNode8> wideNodes;   // with BvhBuildSettings::wide: the same leaves under 8-wide nodes
+    int wideDepth = 0;
 };
 
 // Builds over primitive boxes (invalid boxes are allowed and end up in no leaf). Deterministic for
 // any thread count. Uses oneTBB for large inputs.
 Bvh buildBvh(const std::vector<Bounds3>& primBounds, const BvhBuildSettings& settings = {});
 
-// Device-friendly view of a BVH's nodes.
+// Device-friendly view of a BVH's nodes (BvhView: 4-wide, BvhView8: 8-wide, host only).
 // Optionally, where leaf records live (leaf child c at leafData + c * leafBytes) so that the traversal
 // can prefetch them: the host fetches the first 192 bytes of every leaf of a node before testing the
 // nearest.
-struct BvhView {
-    const BvhNode* nodes;
+template <class Node>
+struct BvhViewT {
+    const Node* nodes;
     const char* leafData = nullptr;
     uint32_t leafBytes = 0;
 };
+using BvhView = BvhViewT<BvhNode>;
+using BvhView8 = BvhViewT<BvhNode8>;
 
 // Optional traversal counters for profiling tools (compiled in only with SYLVA_TRAVERSAL_STATS).
 #if defined(SYLVA_TRAVERSAL_STATS) && !defined(__CUDA_ARCH__)
@@ -65,76 +77,98 @@ inline thread_local uint64_t g_bvhNodeVisits = 0, g_bvhLeafVisits = 0;
 #define SYLVA_COUNT(counter) ((void)0)
 #endif
 
-// Every visit pushes at most three children; build depth is capped below 64.
-inline constexpr int kBvhStackSize = 192;
+// Every visit pushes at most W - 1 children; build depth is capped below 64.
+template <int W>
+inline constexpr int kBvhStackSizeW = (W - 1) * 64;
+inline constexpr int kBvhStackSize = kBvhStackSizeW<4>;
 
 #if !defined(__CUDA_ARCH__)
 namespace detail {
-typedef float Float4 __attribute__((vector_size(16)));
-typedef int Int4 __attribute__((vector_size(16)));
-SYLVA_INLINE Float4 load4(const float* p)
+// W floats as one GCC vector (SSE for 4, AVX for 8 where the target has it).
+template <int W>
+struct FloatVec {
+    typedef float type __attribute__((vector_size(4 * W)));
+};
+typedef FloatVec<4>::type Float4;
+template <class V>
+SYLVA_INLINE V loadVec(const float* p)
 {
-    Float4 v;
-    __builtin_memcpy(&v, p, 16);
+    V v;
+    __builtin_memcpy(&v, p, sizeof(V));
     return v;
 }
-SYLVA_INLINE Float4 min4(Float4 a, Float4 b) { return a < b ? a : b; }
-SYLVA_INLINE Float4 max4(Float4 a, Float4 b) { return a > b ? a : b; }
+template <class V>
+SYLVA_INLINE V minVec(V a, V b)
+{
+    return a < b ? a : b;
+}
+template <class V>
+SYLVA_INLINE V maxVec(V a, V b)
+{
+    return a > b ? a : b;
+}
+SYLVA_INLINE Float4 load4(const float* p) { return loadVec<Float4>(p); }
 } // namespace detail
 #endif
 
-// Entry distances of the ray into the node's four child boxes and the mask of children entered
-// within [tmin, tmax] (bit k = child k; unused children are never entered).
-SYLVA_HD SYLVA_INLINE unsigned nodeEntry(const BvhNode& n, const glm::vec3& org, const glm::vec3& inv, unsigned zeroAxes,
-                                         float tmin, float tmax, float tn[4])
+// Entry distances of the ray into the node's W child boxes and the mask of children entered
+// within [tmin, tmax] (bit k = child k; unused children are never entered). One SIMD slab test on
+// the host, a loop on the device.
+template <int W>
+SYLVA_HD SYLVA_INLINE unsigned nodeEntry(const BvhNodeW<W>& n, const glm::vec3& org, const glm::vec3& inv, unsigned zeroAxes,
+                                         float tmin, float tmax, float tn[W])
 {
 #if !defined(__CUDA_ARCH__)
     using namespace detail;
-    const Float4 ox = {org.x, org.x, org.x, org.x}, oy = {org.y, org.y, org.y, org.y}, oz = {org.z, org.z, org.z, org.z};
-    const Float4 ix = {inv.x, inv.x, inv.x, inv.x}, iy = {inv.y, inv.y, inv.y, inv.y}, iz = {inv.z, inv.z, inv.z, inv.z};
-    const Float4 lo = {tmin, tmin, tmin, tmin}, hi = {tmax, tmax, tmax, tmax};
-    Float4 tnear, tfar;
+    using V = typename FloatVec<W>::type;
+    const V zero = {};
+    const V ox = zero + org.x, oy = zero + org.y, oz = zero + org.z;
+    const V ix = zero + inv.x, iy = zero + inv.y, iz = zero + inv.z;
+    const V lo = zero + tmin, hi = zero + tmax;
+    V tnear, tfar;
     if (__builtin_expect(zeroAxes == 0, 1)) {
         // Near and far planes chosen by the direction's signs: no min/max per axis, and an inverted
         // (unused) box gives near > far on every axis, so it is never entered.
-        const Float4 nx = (load4(inv.x >= 0.0f ? n.lox : n.hix) - ox) * ix, fx = (load4(inv.x >= 0.0f ? n.hix : n.lox) - ox) * ix;
-        const Float4 ny = (load4(inv.y >= 0.0f ? n.loy : n.hiy) - oy) * iy, fy = (load4(inv.y >= 0.0f ? n.hiy : n.loy) - oy) * iy;
-        const Float4 nz = (load4(inv.z >= 0.0f ? n.loz : n.hiz) - oz) * iz, fz = (load4(inv.z >= 0.0f ? n.hiz : n.loz) - oz) * iz;
-        tnear = max4(max4(nx, ny), max4(nz, lo));
-        tfar = min4(min4(fx, fy), min4(fz, hi));
+        const V nx = (loadVec<V>(inv.x >= 0.0f ? n.lox : n.hix) - ox) * ix, fx = (loadVec<V>(inv.x >= 0.0f ? n.hix : n.lox) - ox) * ix;
+        const V ny = (loadVec<V>(inv.y >= 0.0f ? n.loy : n.hiy) - oy) * iy, fy = (loadVec<V>(inv.y >= 0.0f ? n.hiy : n.loy) - oy) * iy;
+        const V nz = (loadVec<V>(inv.z >= 0.0f ? n.loz : n.hiz) - oz) * iz, fz = (loadVec<V>(inv.z >= 0.0f ? n.hiz : n.loz) - oz) * iz;
+        tnear = maxVec(maxVec(nx, ny), maxVec(nz, lo));
+        tfar = minVec(minVec(fx, fy), minVec(fz, hi));
     } else {
         // A zero direction component (rare; the same branch for the whole traversal): on that axis
         // the slab is all of t when the origin lies in [lo, hi] (a ray in a box face enters it), else empty.
-        const Float4 big = {1e30f, 1e30f, 1e30f, 1e30f};
-        auto axis = [&](const float* l, const float* h, const Float4& o, const Float4& i, bool zero, Float4& t0, Float4& t1) {
-            const Float4 L = load4(l), H = load4(h);
-            if (zero) {
+        const V big = zero + 1e30f;
+        auto axis = [&](const float* l, const float* h, const V& o, const V& i, bool zeroAxis, V& t0, V& t1) {
+            const V L = loadVec<V>(l), H = loadVec<V>(h);
+            if (zeroAxis) {
                 const auto inside = (L <= o) & (o <= H);
                 t0 = inside ? -big : big;
                 t1 = inside ? big : -big;
             } else {
-                const Float4 a = (L - o) * i, b = (H - o) * i;
-                t0 = min4(a, b);
-                t1 = max4(a, b);
+                const V a = (L - o) * i, b = (H - o) * i;
+                t0 = minVec(a, b);
+                t1 = maxVec(a, b);
                 const auto inverted = L > H;   // unused child
                 t0 = inverted ? big : t0;
                 t1 = inverted ? -big : t1;
             }
         };
-        Float4 x0, x1, y0, y1, z0, z1;
+        V x0, x1, y0, y1, z0, z1;
         axis(n.lox, n.hix, ox, ix, zeroAxes & 1u, x0, x1);
         axis(n.loy, n.hiy, oy, iy, zeroAxes & 2u, y0, y1);
         axis(n.loz, n.hiz, oz, iz, zeroAxes & 4u, z0, z1);
-        tnear = max4(max4(x0, y0), max4(z0, lo));
-        tfar = min4(min4(x1, y1), min4(z1, hi));
+        tnear = maxVec(maxVec(x0, y0), maxVec(z0, lo));
+        tfar = minVec(minVec(x1, y1), minVec(z1, hi));
     }
     const auto entered = tnear <= tfar;
-    __builtin_memcpy(tn, &tnear, 16);
-    return (entered[0] ? 1u : 0u) | (entered[1] ? 2u : 0u) | (entered[2] ? 4u : 0u) | (entered[3] ? 8u : 0u);
+    __builtin_memcpy(tn, &tnear, sizeof(V));
+    unsigned mask = 0;
+    for (int k = 0; k < W; ++k) mask |= entered[k] ? 1u << k : 0u;
+    return mask;
 #else
     (void)zeroAxes;
     unsigned mask = 0;
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < W; ++k) {
         tn[k] = rayBoxEntry(glm::vec3(n.lox[k], n.loy[k], n.loz[k]), glm::vec3(n.hix[k], n.hiy[k], n.hiz[k]), org, inv,
                             tmin, tmax);
         if (tn[k] <= tmax && n.child[k] != kNoHit) mask |= 1u << k;
@@ -156,17 +190,18 @@ SYLVA_HD SYLVA_INLINE int lowestBit(unsigned mask)
 // callback leaf(slot, tmax) it is called per primitive with the primitive's slot in BVH order; with
 // leaf(first, count, tmax) once per leaf. The callback shrinks tmax when it records a closer hit and
 // returns true to stop at once (any-hit queries). Returns true when stopped by the callback.
-template <class LeafFn>
-SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::vec3& dir, float tmin, float& tmax,
-                                 LeafFn&& leaf)
+template <int W, class LeafFn>
+SYLVA_HD inline bool traverseBvh(BvhViewT<BvhNodeW<W>> bvh, const glm::vec3& org, const glm::vec3& dir, float tmin,
+                                 float& tmax, LeafFn&& leaf)
 {
+    constexpr int kStack = kBvhStackSizeW<W>;
     const glm::vec3 inv = safeReciprocal(dir);
     const unsigned zeroAxes = (dir.x == 0.0f ? 1u : 0u) | (dir.y == 0.0f ? 2u : 0u) | (dir.z == 0.0f ? 4u : 0u);
     // Stack entries and the sorted children are inner nodes (count 0) or leaves (count > 0, tested
     // when they come up): every entered child is taken nearest first, so a far leaf is tested only
     // if nothing nearer hit before it (closest hit), and a hit shrinks tmax for everything behind.
-    uint32_t stackNode[kBvhStackSize], stackCount[kBvhStackSize];
-    float stackDist[kBvhStackSize];
+    uint32_t stackNode[kStack], stackCount[kStack];
+    float stackDist[kStack];
     int sp = 0;
     uint32_t node = 0;
     auto testLeaf = [&](uint32_t first, uint32_t count) {
@@ -180,13 +215,13 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
         }
     };
     for (;;) {
-        const BvhNode& n = bvh.nodes[node];
+        const BvhNodeW<W>& n = bvh.nodes[node];
         SYLVA_COUNT(g_bvhNodeVisits);
-        float tn[4];
+        float tn[W];
         unsigned mask = nodeEntry(n, org, inv, zeroAxes, tmin, tmax, tn);
         // Entered children sorted far to near (the nearest ends last); their data fetched at once.
-        uint32_t kidNode[4], kidCount[4];
-        float kidDist[4];
+        uint32_t kidNode[W], kidCount[W];
+        float kidDist[W];
         int kids = 0;
         while (mask) {
             const int k = lowestBit(mask);
@@ -211,8 +246,8 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
                     __builtin_prefetch(p + 128);
                 }
             } else {
-                __builtin_prefetch(&bvh.nodes[n.child[k]]);
-                __builtin_prefetch(reinterpret_cast<const char*>(&bvh.nodes[n.child[k]]) + 64);
+                const char* p = reinterpret_cast<const char*>(&bvh.nodes[n.child[k]]);
+                for (unsigned line = 0; line < sizeof(BvhNodeW<W>); line += 64) __builtin_prefetch(p + line);
             }
 #endif
         }
@@ -224,7 +259,7 @@ SYLVA_HD inline bool traverseBvh(BvhView bvh, const glm::vec3& org, const glm::v
         // Push the farther ones, continue with the nearest inner child (re-checked against tmax).
         for (int j = 0; j + 1 < kids; ++j) {
             if (!(kidDist[j] <= tmax)) continue;
-            SYLVA_KERNEL_ASSERT(sp < kBvhStackSize);
+            SYLVA_KERNEL_ASSERT(sp < kStack);
             stackNode[sp] = kidNode[j];
             stackCount[sp] = kidCount[j];
             stackDist[sp] = kidDist[j];

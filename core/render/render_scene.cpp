@@ -89,11 +89,13 @@ RenderView RenderScene::view() const
 {
     RenderView v = base;
     v.tlasNodes = tlasNodes.data();
+    v.tlasWideNodes = tlasWideNodes.empty() ? nullptr : tlasWideNodes.data();
     v.tlasOrder = tlasOrder.data();
     v.instances = instances.data();
     v.instanceCount = uint32_t(instances.size());
     v.species = species.data();
     v.blasNodes = blasNodes.data();
+    v.blasWideNodes = blasWideNodes.empty() ? nullptr : blasWideNodes.data();
     v.tris = tris.data();
     v.blocks = blocks.data();
     v.kdTlasNodes = kdTlasNodes.empty() ? nullptr : kdTlasNodes.data();
@@ -191,6 +193,7 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         BvhBuildSettings bs;
         bs.maxLeafSize = 4;
         bs.leafBlock = 4;   // leaves are tested as one 4-wide block
+        bs.wide = scene.render.accel == AccelKind::Bvh;   // the host traverses 8-wide nodes
         geo.bvh = buildBvh(boxes, bs);
     });
     if (progress) progress->report(0.7, "species BVHs built");
@@ -233,6 +236,7 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         }
         // BVH leaves become 4-wide triangle blocks: leaf children then index blocks, not slots.
         sr.blockOffset = uint32_t(rs.blocks.size());
+        std::vector<uint32_t> blockOfSlot(bvh.wideNodes.empty() ? 0 : bvh.primOrder.size(), kNoHit);
         for (size_t ni2 = sr.nodeOffset; ni2 < rs.blasNodes.size(); ++ni2) {
             BvhNode& node = rs.blasNodes[ni2];
             for (int k = 0; k < 4; ++k) {
@@ -248,9 +252,17 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
                     blk.alpha[l] = t.alpha;
                     if (t.alpha != 0u && packBlockUv(rs.triVerts[t.tri], rs.uvs, blk.uv[l])) blk.uvPacked |= 1u << l;
                 }
+                if (!blockOfSlot.empty()) blockOfSlot[node.child[k]] = uint32_t(rs.blocks.size() - sr.blockOffset);
                 node.child[k] = uint32_t(rs.blocks.size() - sr.blockOffset);
                 rs.blocks.push_back(blk);
             }
+        }
+        // The 8-wide flattening has the same leaves: their children become the same blocks.
+        sr.wideNodeOffset = uint32_t(rs.blasWideNodes.size());
+        for (BvhNode8 node : bvh.wideNodes) {
+            for (int k = 0; k < 8; ++k)
+                if (node.count[k] > 0) node.child[k] = blockOfSlot.at(node.child[k]);
+            rs.blasWideNodes.push_back(node);
         }
     };
 
@@ -320,10 +332,12 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         rs.species.push_back(sr);
         rs.m_stats.speciesTriangles += m.triangles.size();
         rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, geos[s].bvh.depth);
+        rs.m_stats.maxWideBlasDepth = std::max(rs.m_stats.maxWideBlasDepth, geos[s].bvh.wideDepth);
     }
 
     // Pruned levels: own triangles and BVH, the species' shading data and lighting grid.
     const size_t nodesBefore = rs.blasNodes.size(), trisBefore = rs.tris.size(), blocksBefore = rs.blocks.size();
+    const size_t wideBefore = rs.blasWideNodes.size();
     for (size_t gi = ns; gi < geos.size(); ++gi) {
         const Geometry& geo = geos[gi];
         SpeciesRecord sr = rs.species[geo.species];
@@ -333,6 +347,7 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
             [&p](uint32_t prim) { return p.tris[prim]; });
         rs.species.push_back(sr);
         rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, geo.bvh.depth);
+        rs.m_stats.maxWideBlasDepth = std::max(rs.m_stats.maxWideBlasDepth, geo.bvh.wideDepth);
     }
     rs.m_stats.prunedLevels = geos.size() - ns;
 
@@ -398,10 +413,13 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
     }
     BvhBuildSettings ts;
     ts.maxLeafSize = 2;
+    ts.wide = scene.render.accel == AccelKind::Bvh;
     Bvh tlas = buildBvh(boxes, ts);
     rs.tlasNodes = std::move(tlas.nodes);
+    rs.tlasWideNodes = std::move(tlas.wideNodes);
     rs.tlasOrder = std::move(tlas.primOrder);
     if (scene.render.accel != AccelKind::KdTree) rs.m_stats.tlasDepth = tlas.depth;
+    rs.m_stats.wideTlasDepth = tlas.wideDepth;
 
     // Environment, camera, settings.
     RenderView& b = rs.base;
@@ -429,13 +447,15 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
                        rs.kdSpecies.size() * sizeof(KdSpeciesRecord);
     } else {
         st.tlasBytes = rs.tlasNodes.size() * sizeof(BvhNode) + rs.tlasOrder.size() * sizeof(uint32_t);
+        st.wideTlasBytes = rs.tlasWideNodes.size() * sizeof(BvhNode8);
         st.blasBytes = rs.blasNodes.size() * sizeof(BvhNode);
+        st.wideBlasBytes = rs.blasWideNodes.size() * sizeof(BvhNode8);
     }
     st.instanceBytes = rs.instances.size() * sizeof(InstanceRecord);
     st.triangleBytes = scene.render.accel == AccelKind::KdTree ? rs.tris.size() * sizeof(TriAccel)
                                                                : rs.blocks.size() * sizeof(TriBlock);
     st.pruneBytes = (rs.blasNodes.size() - nodesBefore) * sizeof(BvhNode) + (rs.tris.size() - trisBefore) * sizeof(TriAccel) +
-                    (rs.blocks.size() - blocksBefore) * sizeof(TriBlock);
+                    (rs.blocks.size() - blocksBefore) * sizeof(TriBlock) + (rs.blasWideNodes.size() - wideBefore) * sizeof(BvhNode8);
     st.instances = rs.instances.size();
     if (progress) progress->report(1.0, "acceleration structures built");
     return rs;

@@ -26,9 +26,11 @@ struct SpeciesAssets {
 // Sizes in bytes of what the traversal reads, for the performance notes.
 struct AccelStats {
     size_t tlasBytes = 0, instanceBytes = 0, blasBytes = 0, triangleBytes = 0;   // the structures the run traverses
+    size_t wideTlasBytes = 0, wideBlasBytes = 0;   // the host's 8-wide copies of the BVHs (the host traverses them instead)
     size_t instances = 0, speciesTriangles = 0;
     double instancedTriangles = 0.0;     // triangles the instances trace (pruned levels count their own)
     int tlasDepth = 0, maxBlasDepth = 0;
+    int wideTlasDepth = 0, maxWideBlasDepth = 0;   // of the host's 8-wide copies
     size_t prunedLevels = 0;             // pruned levels of detail built (only those some instance uses)
     size_t pruneBytes = 0;               // their BVH nodes, triangles and blocks (included in the sizes above)
     size_t instancesPerLevel[kMaxPruneLevels] = {};   // instances per level of detail, 0 = full
@@ -42,10 +44,12 @@ public:
 
     // Everything below is filled by buildRenderScene; the CUDA backend uploads these arrays as they are.
     std::vector<BvhNode> tlasNodes;
+    std::vector<BvhNode8> tlasWideNodes;   // host only: the same top level under 8-wide nodes (BVH runs)
     std::vector<uint32_t> tlasOrder;
     std::vector<InstanceRecord> instances;
     std::vector<SpeciesRecord> species;
     std::vector<BvhNode> blasNodes;
+    std::vector<BvhNode8> blasWideNodes;   // host only: the same leaves under 8-wide nodes (BVH runs)
     std::vector<TriAccel> tris;
     std::vector<TriBlock> blocks;
     std::vector<glm::uvec3> triVerts;

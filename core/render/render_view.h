@@ -64,7 +64,7 @@ struct SpeciesRecord {
     uint32_t nodeOffset;     // into RenderView::blasNodes (leaves index blocks of RenderView::blocks)
     uint32_t triOffset;      // into RenderView::tris (BVH slot order; kd-tree runs and tests)
     uint32_t blockOffset;    // into RenderView::blocks
-    uint32_t pad;
+    uint32_t wideNodeOffset; // into RenderView::blasWideNodes (host)
     glm::vec3 gridOrigin;    // species frame, metres, node (0,0,0)
     float gridInvSpacing;    // 1 / node spacing; 0 = no lighting grid
     glm::ivec3 gridDims;
@@ -117,11 +117,13 @@ struct CameraRecord {
 struct RenderView {
     // top level (instances) and bottom level (per species) BVHs
     const BvhNode* tlasNodes;
+    const BvhNode8* tlasWideNodes;   // host only, may be null: the same top level under 8-wide nodes
     const uint32_t* tlasOrder;       // BVH slot -> instance index
     const InstanceRecord* instances;
     uint32_t instanceCount;
     const SpeciesRecord* species;
     const BvhNode* blasNodes;
+    const BvhNode8* blasWideNodes;   // host only, may be null: the same leaves under 8-wide nodes
     const TriAccel* tris;            // every triangle, BVH slot order (kd-tree traversal, tests)
     const TriBlock* blocks;          // BVH leaves' triangles
 

@@ -186,22 +186,29 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
             return traverseKd(view, o, d, ray.tmin, tlasMax, triFn);
         } else {
             const TriBlock* blocks = v.blocks + geo.blockOffset;
-            return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset, reinterpret_cast<const char*>(blocks), sizeof(TriBlock)}, o, d,
-                               ray.tmin, tlasMax,
-                               [&](uint32_t block, uint32_t count, float& blasMax) {
-                                   float u, w;
-                                   uint32_t tri;
-                                   if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, ray.tmin, blasMax, u, w, tri, tAlpha))
-                                       return false;
-                                   if (!AnyHit) {
-                                       hit.t = blasMax;
-                                       hit.u = u;
-                                       hit.v = w;
-                                       hit.prim = tri;
-                                       hit.inst = inst;
-                                   }
-                                   return AnyHit;
-                               });
+            auto blockFn = [&](uint32_t block, uint32_t count, float& blasMax) {
+                float u, w;
+                uint32_t tri;
+                if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, ray.tmin, blasMax, u, w, tri, tAlpha)) return false;
+                if (!AnyHit) {
+                    hit.t = blasMax;
+                    hit.u = u;
+                    hit.v = w;
+                    hit.prim = tri;
+                    hit.inst = inst;
+                }
+                return AnyHit;
+            };
+            const char* leafData = reinterpret_cast<const char*>(blocks);
+#if !defined(__CUDACC__)
+            // The host's 8-wide flattening of the same tree when the scene has it (same leaves; the same
+            // closest hit up to which of two triangles at exactly the same t wins).
+            if (v.blasWideNodes)
+                return traverseBvh(BvhView8{v.blasWideNodes + geo.wideNodeOffset, leafData, sizeof(TriBlock)}, o, d, ray.tmin,
+                                   tlasMax, blockFn);
+#endif
+            return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset, leafData, sizeof(TriBlock)}, o, d, ray.tmin, tlasMax,
+                               blockFn);
         }
     };
     bool stopped;
@@ -209,8 +216,12 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
         const KdView tlas{v.kdTlasNodes, v.kdTlasRefs, v.kdTlasLo, v.kdTlasHi};
         stopped = traverseKd(tlas, ray.org, ray.dir, ray.tmin, tmax, instanceFn);
     } else {
-        stopped = traverseBvh(BvhView{v.tlasNodes}, ray.org, ray.dir, ray.tmin, tmax,
-                              [&](uint32_t slot, float& tlasMax) { return instanceFn(v.tlasOrder[slot], tlasMax); });
+        auto slotFn = [&](uint32_t slot, float& tlasMax) { return instanceFn(v.tlasOrder[slot], tlasMax); };
+#if !defined(__CUDACC__)
+        if (v.tlasWideNodes) stopped = traverseBvh(BvhView8{v.tlasWideNodes}, ray.org, ray.dir, ray.tmin, tmax, slotFn);
+        else
+#endif
+            stopped = traverseBvh(BvhView{v.tlasNodes}, ray.org, ray.dir, ray.tmin, tmax, slotFn);
     }
     if (AnyHit) return stopped;
     return hit.prim != kNoHit;

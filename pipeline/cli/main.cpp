@@ -675,10 +675,12 @@ int cmdRender(const Args& args)
                 device.c_str(), out.c_str());
     if (args.has("--stats")) {
         std::printf("time: assets %.3f s, build %.3f s, trace %.3f s\n", timings.assets, timings.build, timings.trace);
-        const double accelBytes = double(st.tlasBytes + st.instanceBytes + st.blasBytes + st.triangleBytes);
-        std::printf("acceleration structures: %.1f MB (tlas %zu B, instances %zu B, blas %zu B, triangles %zu B); "
-                    "%.4f B per instanced triangle, %.1f B per instance; depth tlas %d, blas %d\n",
-                    accelBytes / 1e6, st.tlasBytes, st.instanceBytes, st.blasBytes, st.triangleBytes,
+        const double accelBytes =
+            double(st.tlasBytes + st.instanceBytes + st.blasBytes + st.triangleBytes + st.wideTlasBytes + st.wideBlasBytes);
+        std::printf("acceleration structures: %.1f MB (tlas %zu B, instances %zu B, blas %zu B, triangles %zu B, the CPU's "
+                    "8-wide copies: tlas %zu B, blas %zu B); %.4f B per instanced triangle, %.1f B per instance; depth tlas %d, "
+                    "blas %d\n",
+                    accelBytes / 1e6, st.tlasBytes, st.instanceBytes, st.blasBytes, st.triangleBytes, st.wideTlasBytes, st.wideBlasBytes,
                     accelBytes / std::max(1.0, st.instancedTriangles), double(st.tlasBytes + st.instanceBytes) / double(std::max<size_t>(1, st.instances)),
                     st.tlasDepth, st.maxBlasDepth);
         if (st.prunedLevels > 0) {

@@ -47,8 +47,10 @@ void placeViewFrame(ViewFrame& frame, const Scene& scene, const glm::vec3& sunRa
     }
     BvhBuildSettings ts;
     ts.maxLeafSize = 2;
+    ts.wide = !rs.tlasWideNodes.empty();   // the host's 8-wide copy, rebuilt with the 4-wide one
     Bvh tlas = buildBvh(boxes, ts);
     rs.tlasNodes = std::move(tlas.nodes);
+    rs.tlasWideNodes = std::move(tlas.wideNodes);
     rs.tlasOrder = std::move(tlas.primOrder);
 
     RenderView& b = rs.base;

@@ -162,7 +162,8 @@ struct EmbreePeer {
 
     EmbreePeer(const RenderScene& rs, const RenderView& v, int threads, RTCBuildQuality quality)
     {
-        const std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+        std::string config = threads > 0 ? "threads=" + std::to_string(threads) : std::string();
+        if (const char* extra = std::getenv("EMBREE_CONFIG")) config += (config.empty() ? "" : ",") + std::string(extra);
         device = rtcNewDevice(config.empty() ? nullptr : config.c_str());
         if (!device) throw std::runtime_error("rtcNewDevice failed");
         rtcSetDeviceErrorFunction(device, embreeError, nullptr);
@@ -400,7 +401,9 @@ void embreeOccluded8(RTCScene scene, const RenderView& v, const Ray* rays, const
 int usage(int rc)
 {
     std::printf("usage: bench_render [--reps N] [--threads N] [--width W] [--height H] [--accel bvh|kdtree]\n"
-                "                    [--no-embree] [--embree-quality medium|high]\n");
+                "                    [--no-embree] [--embree-quality medium|high]\n"
+                "EMBREE_CONFIG (environment) is appended to Embree's device configuration, e.g.\n"
+                "EMBREE_CONFIG=tri_accel=bvh4.triangle4v for its 4-wide BVH instead of the 8-wide default on AVX2.\n");
     return rc;
 }
 
@@ -447,7 +450,10 @@ int main(int argc, char** argv)
     const int W = v.width, H = v.height;
     const size_t pixels = size_t(W) * size_t(H);
     const AccelStats& st = rs.stats();
-    const double ourBytes = double(st.tlasBytes + st.instanceBytes + st.blasBytes + st.triangleBytes);
+    const double ourBytes = double(st.tlasBytes + st.instanceBytes + st.blasBytes + st.triangleBytes + st.wideTlasBytes +
+                                   st.wideBlasBytes);
+    // What the host's traversal reads: the 8-wide copies instead of the 4-wide nodes (the GPU's).
+    const double hostBytes = st.wideBlasBytes > 0 ? ourBytes - double(st.blasBytes + rs.tlasNodes.size() * sizeof(BvhNode)) : ourBytes;
     std::printf("render benchmark: default forest, %dx%d, %d spp, shadows %s, accel %s, %d threads, %d reps (median / min)\n",
                 W, H, v.spp, v.shadows ? "on" : "off", accelName(v.accel), threadsUsed, reps);
     size_t alphaTris = 0;
@@ -574,6 +580,40 @@ int main(int argc, char** argv)
     (void)highQuality;
 #endif
 
+    // The same rays through the 4-wide BVHs (what the GPU traverses), for the 8-wide ones' gain.
+    RenderView v4 = v;
+    v4.blasWideNodes = nullptr;
+    v4.tlasWideNodes = nullptr;
+    const size_t narrowPass = passes.size();
+    std::vector<PrimaryResult> oursNarrow(pixels);
+    std::vector<uint8_t> oursNarrowOcc(pixels, 0);
+    if (v.blasWideNodes) {
+        passes.push_back({"ours primary, 4-wide BVHs", [&] {
+                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+                                  for (int y = y0; y < y1; ++y)
+                                      for (int x = x0; x < x1; ++x) {
+                                          Hit h{};
+                                          traceScene<false>(v4, pixelRay(v4, x, y), h);
+                                          oursNarrow[size_t(y) * size_t(W) + size_t(x)] = {
+                                              h.prim == kGroundPrim ? kGroundPrim : (h.prim == kNoHit ? kNoHit : h.inst), h.t};
+                                      }
+                              });
+                          },
+                          pixels, {}});
+        passes.push_back({"ours shadow, 4-wide BVHs", [&] {
+                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+                                  for (int y = y0; y < y1; ++y)
+                                      for (int x = x0; x < x1; ++x) {
+                                          const size_t i = size_t(y) * size_t(W) + size_t(x);
+                                          if (!shadowActive[i]) continue;
+                                          Hit h{};
+                                          oursNarrowOcc[i] = traceScene<true>(v4, shadowRays[i], h) ? 1 : 0;
+                                      }
+                              });
+                          },
+                          shadowCount, {}});
+    }
+
     std::vector<std::vector<double>> seconds(passes.size());
     for (int r = 0; r < reps; ++r)
         for (size_t p = 0; p < passes.size(); ++p) {
@@ -595,6 +635,17 @@ int main(int argc, char** argv)
     for (const Pass& p : passes)
         std::printf("%-40s %12.2f %12.2f\n", p.name.c_str(), mrays(p.rays, p.timing.median), mrays(p.rays, p.timing.min));
     const double ourPrimary = mrays(pixels, passes[0].timing.median), ourShadow = mrays(shadowCount, passes[1].timing.median);
+    double narrowPrimary = 0.0, narrowShadow = 0.0;
+    if (v.blasWideNodes) {
+        narrowPrimary = mrays(pixels, passes[narrowPass].timing.median);
+        narrowShadow = mrays(shadowCount, passes[narrowPass + 1].timing.median);
+        std::printf("%-40s %12.2f %12.2f\n", "ratio 8-wide / 4-wide primary", ourPrimary / narrowPrimary,
+                    passes[narrowPass].timing.min / passes[0].timing.min);
+        std::printf("%-40s %12.2f %12.2f\n", "ratio 8-wide / 4-wide shadow", ourShadow / narrowShadow,
+                    passes[narrowPass + 1].timing.min / passes[1].timing.min);
+        std::printf("4-wide vs 8-wide: %zu primary hits differ (instance, or t > 1e-3 relative), %zu shadow rays differ\n",
+                    primaryMismatches(ours, oursNarrow), shadowMismatches(oursOccluded, oursNarrowOcc));
+    }
 
     double emPrimary = 0.0, emShadow = 0.0, emPrimary8 = 0.0, emShadow8 = 0.0;
     double emPrimaryMismatch = 0.0, emShadowMismatch = 0.0;
@@ -636,12 +687,21 @@ int main(int argc, char** argv)
         std::printf("%-40s %12.3f %14.4f %14.1f   (species %.3f s + top %.3f s; %.1f MB by memory monitor)\n",
                     "embree (species scenes + instances)", emBuild + emTopBuild, double(emBytes) / std::max(1.0, st.instancedTriangles),
                     double(emTopBytes) / double(std::max<size_t>(1, st.instances)), emBuild, emTopBuild, double(emBytes) / 1e6);
-    std::printf("ours: %.1f MB (tlas %zu B, instances %zu B, blas %zu B, triangles %zu B); depth tlas %d, blas %d\n", ourBytes / 1e6,
-                st.tlasBytes, st.instanceBytes, st.blasBytes, st.triangleBytes, st.tlasDepth, st.maxBlasDepth);
+    std::printf("ours: %.1f MB (tlas %zu B, instances %zu B, blas %zu B, triangles %zu B, host 8-wide copies: tlas %zu B, "
+                "blas %zu B); depth tlas %d, blas %d (8-wide: %d, %d)\n",
+                ourBytes / 1e6, st.tlasBytes, st.instanceBytes, st.blasBytes, st.triangleBytes, st.wideTlasBytes, st.wideBlasBytes,
+                st.tlasDepth, st.maxBlasDepth, st.wideTlasDepth, st.maxWideBlasDepth);
+    std::printf("the host traverses %.1f MB (%.4f B per instanced triangle): 8-wide nodes, instances, triangle blocks\n",
+                hostBytes / 1e6, hostBytes / std::max(1.0, st.instancedTriangles));
 
     std::printf("\nwidth=%d\nheight=%d\nthreads=%d\n", W, H, threadsUsed);
     std::printf("frame_s=%.4f\nframe_min_s=%.4f\n", frame.median, frame.min);
     std::printf("primary_mrays_s=%.3f\nshadow_mrays_s=%.3f\n", ourPrimary, ourShadow);
+    if (v.blasWideNodes) {
+        std::printf("narrow_primary_mrays_s=%.3f\nnarrow_shadow_mrays_s=%.3f\n", narrowPrimary, narrowShadow);
+        std::printf("ratio_wide_narrow_primary=%.3f\nratio_wide_narrow_shadow=%.3f\n", ourPrimary / narrowPrimary,
+                    ourShadow / narrowShadow);
+    }
     std::printf("shadow_rays=%zu\n", shadowCount);
     if (ranEmbree) {
         std::printf("embree_primary_mrays_s=%.3f\nembree_shadow_mrays_s=%.3f\n", emPrimary, emShadow);
@@ -655,6 +715,7 @@ int main(int argc, char** argv)
     }
     std::printf("build_s=%.4f\n", buildSeconds);
     std::printf("accel_bytes_per_instanced_triangle=%.4f\n", ourBytes / std::max(1.0, st.instancedTriangles));
+    std::printf("host_traversal_bytes_per_instanced_triangle=%.4f\n", hostBytes / std::max(1.0, st.instancedTriangles));
     std::printf("accel_bytes_per_instance=%.1f\n",
                 double(st.tlasBytes + st.instanceBytes) / double(std::max<size_t>(1, st.instances)));
     return 0;

@@ -1,4 +1,5 @@
-// Tests of the SAH kd-tree: closest and any hits against brute force and the BVH, short vs full stack.
+// Tests of the SAH kd-tree (closest and any hits against brute force and the BVH, short vs full stack)
+// and of the BVH's 8-wide flattening against its 4-wide one.
 #include <QElapsedTimer>
 #include <QTest>
 
@@ -364,11 +365,12 @@ bool kdAny(const Scene& s, KdView view, const TestRay& r, KdTraversalStats* stat
 // infinite tmax (every box would count as entered and every leaf be visited).
 constexpr float kBvhMaxT = 1e30f;
 
-Result bvhClosest(const Scene& s, const Bvh& bvh, const TestRay& r)
+template <int W>
+Result bvhClosest(const Scene& s, BvhViewT<BvhNodeW<W>> view, const Bvh& bvh, const TestRay& r)
 {
     Result res;
     float tmax = std::min(r.tmax, kBvhMaxT);
-    traverseBvh(BvhView{bvh.nodes.data()}, r.org, r.dir, r.tmin, tmax, [&](uint32_t slot, float& tm) {
+    traverseBvh(view, r.org, r.dir, r.tmin, tmax, [&](uint32_t slot, float& tm) {
         const uint32_t p = bvh.primOrder[slot];
         float t;
         if (hitTriangle(s, p, r, tm, t)) {
@@ -381,14 +383,54 @@ Result bvhClosest(const Scene& s, const Bvh& bvh, const TestRay& r)
     return res;
 }
 
-bool bvhAny(const Scene& s, const Bvh& bvh, const TestRay& r)
+template <int W>
+bool bvhAny(const Scene& s, BvhViewT<BvhNodeW<W>> view, const Bvh& bvh, const TestRay& r)
 {
     float tmax = std::min(r.tmax, kBvhMaxT);
-    return traverseBvh(BvhView{bvh.nodes.data()}, r.org, r.dir, r.tmin, tmax, [&](uint32_t slot, float& tm) {
+    return traverseBvh(view, r.org, r.dir, r.tmin, tmax, [&](uint32_t slot, float& tm) {
         const uint32_t p = bvh.primOrder[slot];
         float t;
         return hitTriangle(s, p, r, tm, t);
     });
+}
+
+Result bvhClosest(const Scene& s, const Bvh& bvh, const TestRay& r) { return bvhClosest(s, BvhView{bvh.nodes.data()}, bvh, r); }
+bool bvhAny(const Scene& s, const Bvh& bvh, const TestRay& r) { return bvhAny(s, BvhView{bvh.nodes.data()}, bvh, r); }
+
+// Leaves (first slot, count) of a flattening, sorted, and the box of everything below each child
+// checked against the child's box (every box encloses its subtree's primitive boxes).
+template <int W>
+std::vector<std::pair<uint32_t, uint32_t>> leavesOf(const std::vector<BvhNodeW<W>>& nodes, const Bvh& bvh,
+                                                   const std::vector<Bounds3>& primBoxes, bool& enclosed)
+{
+    std::vector<std::pair<uint32_t, uint32_t>> leaves;
+    enclosed = true;
+    auto walk = [&](auto&& self, uint32_t index) -> Bounds3 {
+        const BvhNodeW<W>& n = nodes[index];
+        Bounds3 all;
+        for (int k = 0; k < W; ++k) {
+            if (n.child[k] == kNoHit) continue;
+            Bounds3 below;
+            if (n.count[k] > 0) {
+                leaves.emplace_back(n.child[k], n.count[k]);
+                for (uint32_t p = 0; p < n.count[k]; ++p) {
+                    const Bounds3& b = primBoxes[bvh.primOrder[n.child[k] + p]];
+                    below.extend(b.lo);
+                    below.extend(b.hi);
+                }
+            } else {
+                below = self(self, n.child[k]);
+            }
+            const glm::vec3 lo(n.lox[k], n.loy[k], n.loz[k]), hi(n.hix[k], n.hiy[k], n.hiz[k]);
+            if (glm::any(glm::lessThan(below.lo, lo)) || glm::any(glm::greaterThan(below.hi, hi))) enclosed = false;
+            all.extend(below.lo);
+            all.extend(below.hi);
+        }
+        return all;
+    };
+    if (!nodes.empty()) walk(walk, 0);
+    std::sort(leaves.begin(), leaves.end());
+    return leaves;
 }
 
 // Same hit: both miss, or t within 1e-5 relative (a different triangle only at such a tie).
@@ -529,6 +571,8 @@ private Q_SLOTS:
     void matchesBruteForce();
     void largeForest();
     void deterministicAcrossThreads();
+    void wideBvhMatchesFourWide_data();
+    void wideBvhMatchesFourWide();
 };
 
 void TestKdTree::nodeLayout()
@@ -681,6 +725,97 @@ void TestKdTree::deterministicAcrossThreads()
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
         const KdTree single = buildKdTree(s.boxes, settings);
         QVERIFY(sameTree(a, single));
+    }
+}
+
+void TestKdTree::wideBvhMatchesFourWide_data()
+{
+    QTest::addColumn<int>("mesh");
+    const char* names[] = {"random soup", "plane grid", "thin triangles", "duplicates", "degenerate", "forest"};
+    for (int m = 0; m < 6; ++m) QTest::newRow(names[m]) << m;
+}
+
+// The 8-wide flattening (the host renderer's) holds the same leaves under boxes that enclose them,
+// in fewer levels, and finds the same closest hit and the same any-hit answer as the 4-wide one on
+// every ray. Closest hits compare as sameHit does: where two triangles lie within float rounding of
+// each other on a box face, which one the traversal meets first decides whether the other's box is
+// still entered (a hit can round below its box's entry distance), so t may differ in the last bits.
+void TestKdTree::wideBvhMatchesFourWide()
+{
+    QFETCH(int, mesh);
+    TriangleMesh m;
+    switch (mesh) {
+    case 0: m = randomSoup(11, 3000); break;
+    case 1: m = planeGrid(12); break;
+    case 2: m = thinTriangles(13, 1500); break;
+    case 3: m = duplicates(14, 800); break;
+    case 4: m = degenerate(15, 2000); break;
+    default: m = forest(21, 120, 30); break;
+    }
+    const Scene s = makeScene(std::move(m));
+    for (int leafBlock : {1, 4}) {
+        BvhBuildSettings settings;
+        settings.wide = true;
+        settings.leafBlock = leafBlock;
+        settings.maxLeafSize = leafBlock == 4 ? 4 : 8;   // the renderer's species settings, and the defaults
+        const Bvh bvh = buildBvh(s.boxes, settings);
+        QVERIFY(!bvh.wideNodes.empty());
+        bool enclosed4 = false, enclosed8 = false;
+        const auto leaves4 = leavesOf(bvh.nodes, bvh, s.boxes, enclosed4);
+        const auto leaves8 = leavesOf(bvh.wideNodes, bvh, s.boxes, enclosed8);
+        QVERIFY(enclosed4);
+        QVERIFY(enclosed8);
+        QVERIFY(leaves4 == leaves8);
+        uint32_t covered = 0;
+        for (const auto& l : leaves8) {   // every slot in exactly one leaf
+            QCOMPARE(l.first, covered);
+            covered += l.second;
+        }
+        QCOMPARE(size_t(covered), bvh.primOrder.size());
+        QVERIFY(bvh.wideDepth <= bvh.depth);
+        if (s.boxes.size() > 1000) QVERIFY(bvh.wideDepth < bvh.depth);
+        size_t inner = 0, used = 0;
+        for (const BvhNode8& n : bvh.wideNodes) {
+            ++inner;
+            for (int k = 0; k < 8; ++k) used += n.child[k] != kNoHit;
+        }
+
+        const std::vector<TestRay> rays = makeRays(s, 300u + uint32_t(mesh), 50000);
+        std::atomic<uint64_t> tDiffer{0}, tRounding{0}, anyDiffer{0}, otherTriangle{0}, hits{0};
+        std::atomic<int> firstBad{-1};
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& range) {
+            for (size_t i = range.begin(); i < range.end(); ++i) {
+                const TestRay& r = rays[i];
+                const Result a = bvhClosest(s, BvhView{bvh.nodes.data()}, bvh, r);
+                const Result b = bvhClosest(s, BvhView8{bvh.wideNodes.data()}, bvh, r);
+                const bool aa = bvhAny(s, BvhView{bvh.nodes.data()}, bvh, r);
+                const bool ab = bvhAny(s, BvhView8{bvh.wideNodes.data()}, bvh, r);
+                hits += a.prim != kNoHit;
+                bool bad = false;
+                if (!sameHit(a, b)) ++tDiffer, bad = true;
+                else if (a.prim != b.prim) ++otherTriangle;
+                if (std::memcmp(&a.t, &b.t, 4) != 0) ++tRounding;
+                if (aa != ab) ++anyDiffer, bad = true;
+                int expected = -1;
+                if (bad) firstBad.compare_exchange_strong(expected, int(i));
+            }
+        });
+        qInfo("%s, leaf block %d: %zu leaves; depth 4-wide %d, 8-wide %d; %zu 8-wide nodes, %.2f children each; "
+              "%llu of %zu rays hit, %llu ties won by another triangle (%llu closest t differ in the last bits)",
+              QTest::currentDataTag(), leafBlock, leaves8.size(), bvh.depth, bvh.wideDepth, inner,
+              double(used) / double(std::max<size_t>(1, inner)), (unsigned long long)hits.load(), rays.size(),
+              (unsigned long long)otherTriangle.load(), (unsigned long long)tRounding.load());
+        if (firstBad >= 0) {
+            qWarning("first differing ray %d: %s", firstBad.load(), qPrintable(rayText(rays[size_t(firstBad)])));
+            const TestRay& r = rays[size_t(firstBad)];
+            const Result a = bvhClosest(s, BvhView{bvh.nodes.data()}, bvh, r);
+            const Result b = bvhClosest(s, BvhView8{bvh.wideNodes.data()}, bvh, r);
+            const Result c = bruteClosest(s, r);
+            qWarning("4-wide t %.9g prim %u; 8-wide t %.9g prim %u; brute t %.9g prim %u", a.t, a.prim, b.t, b.prim, c.t, c.prim);
+        }
+        QCOMPARE(tDiffer.load(), uint64_t(0));
+        QCOMPARE(anyDiffer.load(), uint64_t(0));
+        QVERIFY(hits > rays.size() / 10);
     }
 }
 
