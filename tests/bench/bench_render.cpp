@@ -468,20 +468,22 @@ int main(int argc, char** argv)
     std::printf("\n%-40s %10.4f s  %10.4f s   (target 0.25 s on 2 cores)\n", "full frame (renderFilm)", frame.median, frame.min);
 
     // Our primary hits (an untimed pass that also warms the caches) and the shadow rays shadeRay would cast from them.
-    std::vector<Hit> hits(pixels);
-    std::vector<PrimaryResult> ours(pixels);
-    auto oursPrimaryPass = [&] {
+    // A pass of our camera rays through `view` (hits kept when asked), and of the shadow rays below.
+    auto primaryPass = [&](const RenderView& view, std::vector<PrimaryResult>& out, std::vector<Hit>* hitsOut) {
         forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
             for (int y = y0; y < y1; ++y)
                 for (int x = x0; x < x1; ++x) {
                     const size_t i = size_t(y) * size_t(W) + size_t(x);
                     Hit h{};
-                    traceScene<false>(v, pixelRay(v, x, y), h);
-                    hits[i] = h;
-                    ours[i] = {h.prim == kGroundPrim ? kGroundPrim : (h.prim == kNoHit ? kNoHit : h.inst), h.t};
+                    traceScene<false>(view, pixelRay(view, x, y), h);
+                    if (hitsOut) (*hitsOut)[i] = h;
+                    out[i] = {h.prim == kGroundPrim ? kGroundPrim : (h.prim == kNoHit ? kNoHit : h.inst), h.t};
                 }
         });
     };
+    std::vector<Hit> hits(pixels);
+    std::vector<PrimaryResult> ours(pixels);
+    auto oursPrimaryPass = [&] { primaryPass(v, ours, &hits); };
     oursPrimaryPass();
     std::vector<Ray> shadowRays(pixels);
     std::vector<uint8_t> shadowActive(pixels, 0), oursOccluded(pixels, 0);
@@ -494,17 +496,18 @@ int main(int argc, char** argv)
             skyCount += ours[i].inst == kNoHit;
             groundCount += ours[i].inst == kGroundPrim;
         }
-    auto oursShadowPass = [&] {
+    auto shadowPass = [&](const RenderView& view, std::vector<uint8_t>& occluded) {
         forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
             for (int y = y0; y < y1; ++y)
                 for (int x = x0; x < x1; ++x) {
                     const size_t i = size_t(y) * size_t(W) + size_t(x);
                     if (!shadowActive[i]) continue;
                     Hit h{};
-                    oursOccluded[i] = traceScene<true>(v, shadowRays[i], h) ? 1 : 0;
+                    occluded[i] = traceScene<true>(view, shadowRays[i], h) ? 1 : 0;
                 }
         });
     };
+    auto oursShadowPass = [&] { shadowPass(v, oursOccluded); };
 
     // The passes to time: (b) primary and (c) shadow rays, ours and (d) Embree's, interleaved rep by rep so
     // that load from other processes on a shared machine falls on every pass alike.
@@ -588,30 +591,8 @@ int main(int argc, char** argv)
     std::vector<PrimaryResult> oursNarrow(pixels);
     std::vector<uint8_t> oursNarrowOcc(pixels, 0);
     if (v.blasWideNodes) {
-        passes.push_back({"ours primary, 4-wide BVHs", [&] {
-                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
-                                  for (int y = y0; y < y1; ++y)
-                                      for (int x = x0; x < x1; ++x) {
-                                          Hit h{};
-                                          traceScene<false>(v4, pixelRay(v4, x, y), h);
-                                          oursNarrow[size_t(y) * size_t(W) + size_t(x)] = {
-                                              h.prim == kGroundPrim ? kGroundPrim : (h.prim == kNoHit ? kNoHit : h.inst), h.t};
-                                      }
-                              });
-                          },
-                          pixels, {}});
-        passes.push_back({"ours shadow, 4-wide BVHs", [&] {
-                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
-                                  for (int y = y0; y < y1; ++y)
-                                      for (int x = x0; x < x1; ++x) {
-                                          const size_t i = size_t(y) * size_t(W) + size_t(x);
-                                          if (!shadowActive[i]) continue;
-                                          Hit h{};
-                                          oursNarrowOcc[i] = traceScene<true>(v4, shadowRays[i], h) ? 1 : 0;
-                                      }
-                              });
-                          },
-                          shadowCount, {}});
+        passes.push_back({"ours primary, 4-wide BVHs", [&] { primaryPass(v4, oursNarrow, nullptr); }, pixels, {}});
+        passes.push_back({"ours shadow, 4-wide BVHs", [&] { shadowPass(v4, oursNarrowOcc); }, shadowCount, {}});
     }
 
     std::vector<std::vector<double>> seconds(passes.size());

@@ -207,6 +207,20 @@ TriangleMesh forest(uint32_t seed, int terrainCells, int trees)
     return m;
 }
 
+// The meshes the brute-force comparisons run on: 0 random soup, 1 plane grid, 2 thin triangles,
+// 3 duplicates, 4 degenerate, 5 a small forest.
+TriangleMesh testMesh(int kind)
+{
+    switch (kind) {
+    case 0: return randomSoup(11, 3000);
+    case 1: return planeGrid(12);
+    case 2: return thinTriangles(13, 1500);
+    case 3: return duplicates(14, 800);
+    case 4: return degenerate(15, 2000);
+    default: return forest(21, 120, 30);
+    }
+}
+
 // ---- rays ----
 
 struct TestRay {
@@ -661,15 +675,7 @@ void TestKdTree::matchesBruteForce()
 {
     QFETCH(int, mesh);
     QFETCH(bool, clip);
-    TriangleMesh m;
-    switch (mesh) {
-    case 0: m = randomSoup(11, 3000); break;
-    case 1: m = planeGrid(12); break;
-    case 2: m = thinTriangles(13, 1500); break;
-    case 3: m = duplicates(14, 800); break;
-    default: m = degenerate(15, 2000); break;
-    }
-    const Scene s = makeScene(std::move(m));
+    const Scene s = makeScene(testMesh(mesh));
     KdBuildSettings settings;
     if (clip) settings.clip = kdTriangleClipper(s.mesh);
     QElapsedTimer timer;
@@ -743,16 +749,7 @@ void TestKdTree::wideBvhMatchesFourWide_data()
 void TestKdTree::wideBvhMatchesFourWide()
 {
     QFETCH(int, mesh);
-    TriangleMesh m;
-    switch (mesh) {
-    case 0: m = randomSoup(11, 3000); break;
-    case 1: m = planeGrid(12); break;
-    case 2: m = thinTriangles(13, 1500); break;
-    case 3: m = duplicates(14, 800); break;
-    case 4: m = degenerate(15, 2000); break;
-    default: m = forest(21, 120, 30); break;
-    }
-    const Scene s = makeScene(std::move(m));
+    const Scene s = makeScene(testMesh(mesh));
     for (int leafBlock : {1, 4}) {
         BvhBuildSettings settings;
         settings.wide = true;
