@@ -1,4 +1,4 @@
-// Binned-SAH bounding volume hierarchy over boxes: host build, flat 64-byte nodes, stack traversal (host and device).
+// Binned-SAH bounding volume hierarchy over boxes: host build, flat 4-wide (every backend) and 8-wide (host) nodes, stack traversal.
 #pragma once
 
 #include <cstdint>
