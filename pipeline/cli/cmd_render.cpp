@@ -1,0 +1,150 @@
+// sylva render: a scene file (or the bundled default forest) to a picture, whole or in bands of rows.
+#include <cstdio>
+#include <filesystem>
+
+#include "core/scene/quality.h"
+#include "pipeline/cli/cli_util.h"
+#include "pipeline/cli/commands.h"
+#include "pipeline/cli/common_options.h"
+#include "pipeline/io/output_path.h"
+#include "pipeline/lighting_job.h"
+#include "pipeline/render/render_job.h"
+#include "pipeline/scene/scene_file.h"
+#include "pipeline/services/render_stats.h"
+
+namespace fs = std::filesystem;
+
+namespace sylva::cli {
+namespace {
+
+// The scene of the positional argument (or the default forest) with the options' overrides applied;
+// stem: the output's default name.
+Scene sceneForArgs(const Args& args, std::string* stem)
+{
+    Scene scene;
+    *stem = "default_forest";
+    if (args.positional().empty()) {
+        scene = defaultScene();
+    } else {
+        const std::string path = args.positional()[0];
+        requireReadable(path, "scene file");
+        scene = readSceneFile(path);
+        *stem = fs::path(path).stem().string();
+        if (stem->size() > 6 && stem->substr(stem->size() - 6) == ".sylva") stem->resize(stem->size() - 6);
+    }
+    RenderSettings& r = scene.render;
+    if (args.has("--quality")) {
+        const QualityPreset* q = findQualityPreset(args.get("--quality"));
+        if (!q) throw UsageError("option --quality: expected preview, final or reference, got '" + args.get("--quality") + "'");
+        applyQuality(scene, *q);
+    }
+    if (args.has("--width")) r.width = int(parseInteger("--width", args.get("--width"), 1, 32768));
+    if (args.has("--height")) r.height = int(parseInteger("--height", args.get("--height"), 1, 32768));
+    if (args.has("--spp")) r.spp = int(parseInteger("--spp", args.get("--spp"), 1, 4096));
+    if (args.has("--mode") && !parseRenderMode(args.get("--mode"), &r.mode))
+        throw UsageError("option --mode: expected full, local, ambient or lb, got '" + args.get("--mode") + "'");
+    if (args.has("--accel") && !parseAccel(args.get("--accel"), &r.accel))
+        throw UsageError("option --accel: expected bvh or kdtree, got '" + args.get("--accel") + "'");
+    if (args.has("--no-shadows")) r.shadows = false;
+    for (auto [option, field] : {std::pair{"--alpha-distance", &r.alphaDistance}, std::pair{"--prune-distance", &r.pruneDistance}}) {
+        if (!args.has(option)) continue;
+        const double m = parseNumber(option, args.get(option));
+        if (m < 0.0 || m > 1e30) throw UsageError(std::string("option ") + option + ": expected metres >= 0 (0: off), got " + args.get(option));
+        *field = float(m);
+    }
+    return scene;
+}
+
+void printStats(const AccelStats& st, const RenderTimings& timings, const RenderSettings& r, float ambient)
+{
+    std::printf("time: assets %.3f s, build %.3f s, trace %.3f s\n", timings.assets, timings.build, timings.trace);
+    const AccelSummary s = summarizeAccel(st);
+    std::printf("acceleration structures: %.1f MB (tlas %zu B, instances %zu B, blas %zu B, triangles %zu B, the CPU's "
+                "8-wide copies: tlas %zu B, blas %zu B); %.4f B per instanced triangle, %.1f B per instance; depth tlas %d, "
+                "blas %d\n",
+                s.totalBytes / 1e6, st.tlasBytes, st.instanceBytes, st.blasBytes, st.triangleBytes, st.wideTlasBytes, st.wideBlasBytes,
+                s.bytesPerInstancedTriangle, s.bytesPerInstance, st.tlasDepth, st.maxBlasDepth);
+    if (st.prunedLevels > 0) {
+        std::printf("pruning from %g m: %zu pruned levels built (%.1f MB); instances per level (kept 1, 1/2, 1/4, ...):",
+                    double(r.pruneDistance), st.prunedLevels, double(st.pruneBytes) / 1e6);
+        for (size_t n : st.instancesPerLevel) std::printf(" %zu", n);
+        std::printf("\n");
+    }
+    if (r.mode == RenderMode::Ambient) std::printf("ambient constant %.4f\n", ambient);
+}
+
+int runRender(const Args& args)
+{
+    auto threads = threadLimit(args);
+    const std::string backend = backendName(args);
+    std::string stem;
+    const Scene scene = sceneForArgs(args, &stem);
+    const RenderSettings& r = scene.render;
+    const std::string out = args.get("--output", stem + ".png");
+    const std::string ext = lowerExtension(out);
+    if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff")
+        throw UsageError("output " + out + ": unknown image extension (use .png, .exr, .tif or .tiff)");
+    requireReplaceableFile(out);
+    int bandRows = 0;   // 0: the whole frame at once
+    if (args.has("--band-rows")) bandRows = int(parseInteger("--band-rows", args.get("--band-rows"), 1, 32768));
+    else if (!frameFitsMemory(r)) bandRows = bandRowsFor(r);
+    if (bandRows >= r.height) bandRows = 0;
+    auto compute = openBackend(backend);
+    auto cache = openCache(args);
+    JobLog log;
+    AccelStats st;
+    RenderTimings timings;
+    float ambient = 0.0f;
+    std::string device = compute->name();
+    if (bandRows > 0) {
+        const int bands = (r.height + bandRows - 1) / bandRows;
+        std::fprintf(stderr, "note: tracing the %dx%d frame in %d bands of %d rows%s\n", r.width, r.height, bands, bandRows,
+                     args.has("--band-rows") ? "" : " (the whole frame does not fit in the available memory)");
+        if (device != "cpu") std::fprintf(stderr, "note: a frame in bands is traced on the CPU (the LB solves still run on %s)\n", device.c_str());
+        ProgressPrinter bar("render", args.has("--quiet"));
+        const BandedRender result = renderSceneInBands(scene, out, bandRows, cache.get(), &bar.progress(), &log, compute.get());
+        bar.finish();
+        st = result.stats;
+        timings = result.timings;
+        ambient = result.ambient;
+        device = "cpu, " + std::to_string(bands) + " bands";
+    } else {
+        ProgressPrinter bar("render", args.has("--quiet"));
+        const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get());
+        bar.finish();
+        const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, scene.sky, &ambient);
+        writeRender(out, linear, r.width, r.height, r.exposureKey);
+        st = result.stats;
+        timings = result.timings;
+    }
+    for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+    std::printf("rendered %dx%d, %d spp, mode %s, %zu instances of %zu species (%.0f instanced triangles) on %s\nwrote %s\n",
+                r.width, r.height, r.spp, renderModeName(r.mode), st.instances, scene.species.size(), st.instancedTriangles,
+                device.c_str(), out.c_str());
+    if (args.has("--stats")) printStats(st, timings, r, ambient);
+    return kOk;
+}
+
+} // namespace
+
+Command renderCommand()
+{
+    return {"render", "[SCENE.sylva.json] [-o OUT.png|.exr|.tif]",
+            "render a scene (the bundled default forest when none is given)",
+            {{"--quality", "preview|final|reference", "quality preset: LB grid, steps and storage of every species, samples and distance knobs (docs/ACCURACY.md); the options below override it"},
+             {"--width", "W", "image width in pixels (default: the scene's)"},
+             {"--height", "H", "image height in pixels (default: the scene's)"},
+             {"--spp", "N", "samples per pixel, 1..4096 (default: the scene's)"},
+             {"--mode", "M", "full (LB indirect + sun), local (sun only), ambient (sun + matched constant), lb"},
+             {"--accel", "bvh|kdtree", "acceleration structure (default: the scene's, bvh)"},
+             {"--no-shadows", "", "no shadow rays"},
+             {"--alpha-distance", "M", "skip leaf cut-out tests beyond M metres from the camera (0: off, default)"},
+             {"--prune-distance", "M", "prune leaves of plants beyond M metres, area-preserving (0: off, default)"},
+             kBackend,
+             {"--band-rows", "N", "trace and write the frame in bands of N rows (default: only when the whole frame does not fit in memory)"},
+             {"--stats", "", "print timings and acceleration structure sizes"},
+             kOutput, kCache, kNoCache, kThreads, kQuiet},
+            0, 1, &runRender};
+}
+
+} // namespace sylva::cli

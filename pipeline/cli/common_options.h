@@ -1,0 +1,35 @@
+// Options that several commands share (threads, output, cache, backend) and what they turn into.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <tbb/global_control.h>
+
+#include "core/backend/backend.h"
+#include "pipeline/cache/grid_cache.h"
+#include "pipeline/cli/args.h"
+
+namespace sylva::cli {
+
+inline const OptionSpec kQuiet{"--quiet", "", "no progress output"};
+inline const OptionSpec kThreads{"--threads", "N", "worker threads (default: all cores)"};
+inline const OptionSpec kOutput{"--output", "FILE", "output file (also -o)"};
+inline const OptionSpec kCache{"--cache", "DIR", "grid cache folder (default $XDG_CACHE_HOME/sylva or ~/.cache/sylva)"};
+inline const OptionSpec kNoCache{"--no-cache", "", "neither read nor write the grid cache"};
+inline const OptionSpec kBackend{"--backend", "auto|cpu|cuda", "compute backend (default auto)"};
+
+// --threads N: the limit lives as long as the returned object (null without the option).
+std::unique_ptr<tbb::global_control> threadLimit(const Args& args);
+// The grid cache of --cache DIR (or the default folder); null with --no-cache.
+std::unique_ptr<GridCache> openCache(const Args& args);
+// Throws Error "PATH: no such WHAT" / "PATH: is a folder, not a WHAT".
+void requireReadable(const std::string& path, const char* what);
+// --backend, checked (UsageError for another name); "auto" without the option.
+std::string backendName(const Args& args);
+// The backend of that name; notes (CUDA requested but absent, ...) go to stderr as "note: ...".
+std::unique_ptr<Backend> openBackend(const std::string& name);
+// ".PNG" -> ".png".
+std::string lowerExtension(const std::string& path);
+
+} // namespace sylva::cli
