@@ -96,4 +96,16 @@ void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuth
     *azimuthDeg = az;
 }
 
+CameraDesc framingCamera(const CameraDesc& current, const Bounds3& b)
+{
+    CameraDesc c = current;
+    const glm::dvec3 centre = glm::dvec3(b.center());
+    const double radius = std::max(0.1, 0.5 * double(glm::length(b.extent())));
+    const double dist = 1.15 * radius / std::sin(double(c.fovY) * 0.5 * 3.14159265358979323846 / 180.0);
+    c.target = centre;
+    c.position = centre + dist * glm::normalize(glm::dvec3(-0.35, 0.2, -1.0));
+    c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    return c;
+}
+
 } // namespace sylva

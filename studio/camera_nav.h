@@ -1,6 +1,7 @@
-// Viewport navigation on a scene camera: orbit about the target, pan in the image plane, dolly zoom.
+// Viewport navigation on a scene camera: orbit about the target, pan in the image plane, dolly zoom, fly, framing.
 #pragma once
 
+#include "core/mesh/triangle_mesh.h"
 #include "core/scene/scene.h"
 
 namespace sylva {
@@ -25,6 +26,10 @@ CameraDesc flyLook(const CameraDesc& camera, double yawDeg, double pitchDeg);
 // Fly navigation: moves eye and target together by `right` metres along the camera's right axis
 // (horizontal), `up` metres along world +Y and `forward` metres along the view direction.
 CameraDesc flyMove(const CameraDesc& camera, double right, double up, double forward);
+
+// A camera that shows world box b whole, from the front-left and a little above (current's field of
+// view; up is world +Y): what the studio frames the first instances of a scene with.
+CameraDesc framingCamera(const CameraDesc& current, const Bounds3& b);
 
 // Elevation and azimuth (degrees, scene.h's convention) of a direction toward the sun.
 void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg);

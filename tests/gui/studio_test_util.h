@@ -14,8 +14,16 @@
 #include <QTemporaryDir>
 #include <QTest>
 
+#include "studio/autosave_controller.h"
+#include "studio/export_controller.h"
+#include "studio/inspector_controller.h"
 #include "studio/job_manager.h"
+#include "studio/lighting_scheduler.h"
 #include "studio/main_window.h"
+#include "studio/materials_controller.h"
+#include "studio/recent_files.h"
+#include "studio/scatter_tool.h"
+#include "studio/species_importer.h"
 #include "studio/viewport.h"
 
 namespace sylva::test {
@@ -37,7 +45,7 @@ inline void isolate(const QTemporaryDir& dir)
     QApplication::setApplicationName("sylva-studio-test");
     QSettings().clear();   // test mode keeps its files between runs (~/.qttest)
     // No crash recovery left over from an earlier run (its question would block the test).
-    QDir(QFileInfo(MainWindow::recoveryFilePath()).absolutePath()).removeRecursively();
+    QDir(QFileInfo(AutosaveController::recoveryFilePath()).absolutePath()).removeRecursively();
     qputenv("XDG_CACHE_HOME", dir.filePath("cache").toLocal8Bit());
     QApplication::setStyle("Fusion");
 }

@@ -57,11 +57,11 @@ private Q_SLOTS:
             ++m_prompts;
             return m_answer;
         });
-        m_win->setAutoLighting(false);
+        m_win->lighting()->setAutoLighting(false);
         m_win->resize(1100, 700);
         m_win->show();
         QVERIFY(QTest::qWaitForWindowExposed(m_win.get()));
-        QVERIFY(m_win->recentFiles().isEmpty());   // isolated settings
+        QVERIFY(m_win->recentFiles()->files().isEmpty());   // isolated settings
     }
 
     void cleanupTestCase()
@@ -105,7 +105,7 @@ private Q_SLOTS:
         const std::string before = sceneToJson(scene(), "/");
         const int steps = m_win->document()->undoStack()->count();
         Job::State state;
-        QVERIFY(!waitForJob(m_win->importMesh(path), 30000, &state));
+        QVERIFY(!waitForJob(m_win->importer()->importMesh(path), 30000, &state));
         QCOMPARE(state, Job::State::Failed);
         QCOMPARE(reported.count(), 1);
         QCOMPARE(m_errors.size(), 1);
@@ -117,7 +117,7 @@ private Q_SLOTS:
 
     void importTree()
     {
-        QVERIFY(waitForJob(m_win->importMesh(sharedTree()), 30000));
+        QVERIFY(waitForJob(m_win->importer()->importMesh(sharedTree()), 30000));
         QCOMPARE(scene().species.size(), size_t(1));
         QCOMPARE(QString::fromStdString(scene().species[0].name), QStringLiteral("Tree_1"));
         QCOMPARE(scene().instances.size(), size_t(1));
@@ -138,8 +138,8 @@ private Q_SLOTS:
         QCOMPARE(m_win->propertyPanel()->item().kind, OutlinerItem::Kind::Species);
         m_win->propertyPanel()->speciesGrid()->setValue(16);
         QCOMPARE(scene().species[0].grid, 16);
-        QSignalSpy finished(m_win.get(), &MainWindow::lightingFinished);
-        Job* job = m_win->computeLighting();
+        QSignalSpy finished(m_win->lighting(), &LightingScheduler::lightingFinished);
+        Job* job = m_win->lighting()->computeLighting();
         QVERIFY(job);
         QSignalSpy progress(job, &Job::progressChanged);
         QCOMPARE(m_win->jobPanel()->rowCount(), 1);
@@ -156,7 +156,7 @@ private Q_SLOTS:
 
         finished.clear();
         m_win->clearLog();
-        QVERIFY(m_win->computeLighting(true));
+        QVERIFY(m_win->lighting()->computeLighting(true));
         QVERIFY(finished.wait(60000));
         QVERIFY(finished.at(0).at(0).toBool());
         QVERIFY2(m_win->logText().contains("Tree_1: light (cache hit)"), qPrintable(m_win->logText()));
@@ -189,7 +189,7 @@ private Q_SLOTS:
     {
         select({OutlinerItem::Kind::Species, 0});
         m_win->clearLog();
-        QSignalSpy updated(m_win.get(), &MainWindow::inspectorUpdated);
+        QSignalSpy updated(m_win->inspectorController(), &InspectorController::updated);
         m_win->inspectorDock()->show();
         QTRY_VERIFY_WITH_TIMEOUT(m_win->inspector()->grids() != nullptr, 30000);
         const auto grids = m_win->inspector()->grids();
@@ -214,8 +214,8 @@ private Q_SLOTS:
         Scene moved = first;
         moved.sun.direction = sunDirection(30.0, 200.0);
         m_win->document()->edit(moved, "sun");
-        QSignalSpy relitSpy(m_win.get(), &MainWindow::lightingFinished);
-        QVERIFY(m_win->computeLighting());
+        QSignalSpy relitSpy(m_win->lighting(), &LightingScheduler::lightingFinished);
+        QVERIFY(m_win->lighting()->computeLighting());
         m_win->inspectorDock()->show();
         QVERIFY(!m_win->inspector()->grids());   // waiting
         QVERIFY(relitSpy.wait(60000));
@@ -231,7 +231,7 @@ private Q_SLOTS:
         moved.sun.direction = sunDirection(50.0, 100.0);
         m_win->document()->edit(moved, "sun again");
         relitSpy.clear();
-        QVERIFY(m_win->computeLighting());
+        QVERIFY(m_win->lighting()->computeLighting());
         m_win->inspectorDock()->show();
         QVERIFY(!m_win->inspector()->grids());
         m_win->document()->undoStack()->undo();
@@ -250,7 +250,7 @@ private Q_SLOTS:
     {
         const QString folder = m_dir.filePath("grids");
         QVERIFY(QDir().mkpath(folder));
-        QVERIFY(waitForJob(m_win->exportSpeciesGrids(0, folder), 60000));
+        QVERIFY(waitForJob(m_win->exporter()->exportSpeciesGrids(0, folder), 60000));
         const Scene& s = scene();
         const AssetsPtr lit = m_win->assetStore()->find(assetKey(s.species[0], s.sun, true));
         QVERIFY(lit);
@@ -280,9 +280,9 @@ private Q_SLOTS:
         for (int c = 0; c < 3; ++c) QCOMPARE(float(p["sun"].toArray()[c].toDouble()), sun[c]);
         // No species: an error, no job.
         m_errors.clear();
-        QVERIFY(!m_win->exportSpeciesGrids(5, folder));
+        QVERIFY(!m_win->exporter()->exportSpeciesGrids(5, folder));
         QCOMPARE(m_errors.size(), 1);
-        QCOMPARE(MainWindow::gridFileBase("Tree 1 (2)/x"), QStringLiteral("Tree_1__2__x"));
+        QCOMPARE(ExportController::gridFileBase("Tree 1 (2)/x"), QStringLiteral("Tree_1__2__x"));
     }
 
     void eventLoopLatencyDuringLighting()
@@ -303,10 +303,10 @@ private Q_SLOTS:
             last = now;
             ++ticks;
         });
-        QSignalSpy finished(m_win.get(), &MainWindow::lightingFinished);
+        QSignalSpy finished(m_win->lighting(), &LightingScheduler::lightingFinished);
         clock.start();
         probe.start();
-        QVERIFY(m_win->computeLighting());
+        QVERIFY(m_win->lighting()->computeLighting());
         QVERIFY(finished.wait(120000));
         probe.stop();
         QVERIFY(finished.at(0).at(0).toBool());
@@ -332,7 +332,7 @@ private Q_SLOTS:
         Scene s = scene();
         s.species[0].grid = 40;
         m_win->document()->edit(s, "grid 40");
-        Job* job = m_win->computeLighting();
+        Job* job = m_win->lighting()->computeLighting();
         QVERIFY(job);
         job->cancel();
         Job::State state;
@@ -435,7 +435,7 @@ private Q_SLOTS:
         QVERIFY(m_win->saveFile(path));
         QVERIFY(!m_win->document()->isModified());
         QVERIFY(QFile::exists(path));
-        QCOMPARE(m_win->recentFiles().value(0), path);
+        QCOMPARE(m_win->recentFiles()->files().value(0), path);
         QCOMPARE(QSettings().value("recentFiles").toStringList().value(0), path);
         const std::string base = m_dir.path().toStdString();
         const std::string saved = sceneToJson(scene(), base);
@@ -463,13 +463,13 @@ private Q_SLOTS:
         m_errors.clear();
         if (!name.endsWith(".png")) {
             const QString path = m_dir.filePath(name);
-            QVERIFY(waitForJob(m_win->exportRender({path, 32, 18, 1}), 60000));
+            QVERIFY(waitForJob(m_win->exporter()->exportRender({path, 32, 18, 1}), 60000));
             QVERIFY(QFileInfo(path).size() > 0);
             return;
         }
         const QString path = m_dir.filePath("out/render.png");
         ExportSettings es{path, 160, 90, 1};
-        QVERIFY(waitForJob(m_win->exportRender(es), 60000));
+        QVERIFY(waitForJob(m_win->exporter()->exportRender(es), 60000));
         QImage img(path);
         QCOMPARE(img.size(), QSize(160, 90));
         double mean = 0.0, sd = 0.0;
@@ -479,7 +479,7 @@ private Q_SLOTS:
         QCOMPARE(m_errors.size(), 0);
         // A bad extension is an error report, not a crash.
         m_errors.clear();
-        QVERIFY(!waitForJob(m_win->exportRender({m_dir.filePath("render.bmpx"), 32, 18, 1}), 60000));
+        QVERIFY(!waitForJob(m_win->exporter()->exportRender({m_dir.filePath("render.bmpx"), 32, 18, 1}), 60000));
         QCOMPARE(m_errors.size(), 1);
     }
 
@@ -490,7 +490,7 @@ private Q_SLOTS:
         g.species = "shrub";
         g.seed = 3;
         g.triangles = 2000;
-        m_win->growSpecies(g);
+        m_win->importer()->growSpecies(g);
         QCOMPARE(scene().species.size(), size_t(2));
         QCOMPARE(QString::fromStdString(scene().species[1].name), QStringLiteral("shrub 3"));
         QVERIFY(scene().species[1].grow.has_value());
@@ -499,8 +499,8 @@ private Q_SLOTS:
         s.species[1].grid = 16;
         s.instances.back().position = {3.0, 0.0, 0.0};
         m_win->document()->edit(s, "small grid");
-        QSignalSpy finished(m_win.get(), &MainWindow::lightingFinished);
-        QVERIFY(m_win->computeLighting());
+        QSignalSpy finished(m_win->lighting(), &LightingScheduler::lightingFinished);
+        QVERIFY(m_win->lighting()->computeLighting());
         QVERIFY(finished.wait(60000));
         QVERIFY(finished.at(0).at(0).toBool());
         QVERIFY(m_win->logText().contains("shrub 3: grow"));

@@ -35,7 +35,7 @@ private Q_SLOTS:
         Viewport* v = win.viewport();
         v->setFixedSize(640, 360);
         QVERIFY(QTest::qWaitForWindowExposed(&win));
-        QSignalSpy lit(&win, &MainWindow::lightingFinished);
+        QSignalSpy lit(win.lighting(), &LightingScheduler::lightingFinished);
         win.loadExampleForest();
         QCOMPARE(win.document()->scene().instances.size(), size_t(962));
         // 32-node grids instead of 64 keep a first run (fresh cache) short; render time does not

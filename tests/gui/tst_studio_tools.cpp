@@ -40,17 +40,17 @@ class TstStudioTools : public QObject {
     std::unique_ptr<MainWindow> window(std::function<bool(const QString&, const QDateTime&)> recover = {})
     {
         auto w = std::make_unique<MainWindow>();
-        w->setAutoLighting(false);
+        w->lighting()->setAutoLighting(false);
         w->setErrorReporter([](const QString&, const QString& m) { qWarning("error: %s", qPrintable(m)); });
         w->setSavePrompt([](const QString&) { return QMessageBox::Discard; });
-        w->setRecoveryPrompt(recover ? recover : [](const QString&, const QDateTime&) { return false; });
+        w->autosave()->setRecoveryPrompt(recover ? recover : [](const QString&, const QDateTime&) { return false; });
         return w;
     }
 
     // A small scene: one grown shrub, two instances.
     static void compose(MainWindow& w)
     {
-        w.growSpecies(GrowSpec{"shrub", 3, 2000, 0.0f});
+        w.importer()->growSpecies(GrowSpec{"shrub", 3, 2000, 0.0f});
         Scene s = w.document()->scene();
         InstanceDesc in = s.instances[0];
         in.position = {2.5, 0.0, -1.0};
@@ -72,7 +72,7 @@ private Q_SLOTS:
     // scene; a clean save deletes the recovery file.
     void autosaveAndRecoverUntitled()
     {
-        const QString rec = MainWindow::recoveryFilePath();
+        const QString rec = AutosaveController::recoveryFilePath();
         std::string want;
         {
             auto a = window();
@@ -80,15 +80,15 @@ private Q_SLOTS:
             compose(*a);
             QVERIFY(a->document()->isModified());
             QVERIFY(!QFile::exists(rec));
-            QSignalSpy saved(a.get(), &MainWindow::autosaved);
-            a->setAutosaveInterval(50);
+            QSignalSpy saved(a->autosave(), &AutosaveController::autosaved);
+            a->autosave()->setInterval(50);
             QVERIFY(saved.wait(5000));
             QCOMPARE(saved.at(0).at(0).toString(), rec);
             QVERIFY(QFile::exists(rec));
             // Unchanged since: no second write.
-            QVERIFY(!a->autosaveNow());
+            QVERIFY(!a->autosave()->autosaveNow());
             want = json(a->document()->scene());
-            a->setAutosaveInterval(0);
+            a->autosave()->setInterval(0);
         }   // destroyed without a close: what a crash leaves behind
         QVERIFY(QFile::exists(rec));
 
@@ -108,7 +108,7 @@ private Q_SLOTS:
         QVERIFY(!QFile::exists(rec));   // offered once
 
         // It autosaves again; a clean save removes the file.
-        QVERIFY(b->autosaveNow());
+        QVERIFY(b->autosave()->autosaveNow());
         QVERIFY(QFile::exists(rec));
         QVERIFY(b->saveFile(m_dir.filePath("recovered.sylva.json")));
         QVERIFY(!QFile::exists(rec));
@@ -119,7 +119,7 @@ private Q_SLOTS:
     // saved scene); declining deletes the recovery and leaves the window empty.
     void recoverOnTopOfTheSavedFile()
     {
-        const QString rec = MainWindow::recoveryFilePath();
+        const QString rec = AutosaveController::recoveryFilePath();
         const QString file = m_dir.filePath("forest.sylva.json");
         std::string saved, modified;
         {
@@ -132,7 +132,7 @@ private Q_SLOTS:
             s.instances[1].scale = 1.7f;
             s.sun.direction = sunDirection(25.0, 140.0);
             a->document()->edit(s, "edit");
-            QVERIFY(a->autosaveNow());
+            QVERIFY(a->autosave()->autosaveNow());
             modified = json(a->document()->scene());
         }
         QVERIFY(QFile::exists(rec));
@@ -151,7 +151,7 @@ private Q_SLOTS:
 
         // Declined: gone, nothing loaded.
         b->document()->undoStack()->redo();
-        QVERIFY(b->autosaveNow());
+        QVERIFY(b->autosave()->autosaveNow());
         b.reset();
         QVERIFY(QFile::exists(rec));
         bool asked = false;
@@ -162,7 +162,7 @@ private Q_SLOTS:
         QVERIFY(!c->document()->isModified());
         // A clean close deletes a recovery file too.
         compose(*c);
-        QVERIFY(c->autosaveNow());
+        QVERIFY(c->autosave()->autosaveNow());
         QVERIFY(QFile::exists(rec));
         c->show();
         QVERIFY(c->close());
@@ -250,7 +250,7 @@ private Q_SLOTS:
         spec.scaleMin = 0.7f;
         spec.scaleMax = 1.3f;
         spec.seed = 11;
-        QVERIFY(w->scatter(spec));
+        QVERIFY(w->scatterTool()->scatter(spec));
         const Scene after = w->document()->scene();
         QCOMPARE(after.instances.size(), base.instances.size() + 250);
         QCOMPARE(w->document()->undoStack()->index(), index0 + 1);
@@ -275,11 +275,11 @@ private Q_SLOTS:
         // One undo removes all 250; the same seed again gives the same scene.
         w->document()->undoStack()->undo();
         QCOMPARE(json(w->document()->scene()), before);
-        QVERIFY(w->scatter(spec));
+        QVERIFY(w->scatterTool()->scatter(spec));
         QCOMPARE(json(w->document()->scene()), json(after));
         w->document()->undoStack()->undo();
         spec.seed = 12;
-        QVERIFY(w->scatter(spec));
+        QVERIFY(w->scatterTool()->scatter(spec));
         QVERIFY(json(w->document()->scene()) != json(after));
         QCOMPARE(w->document()->scene().instances.size(), after.instances.size());
         w->document()->undoStack()->undo();
@@ -287,16 +287,16 @@ private Q_SLOTS:
         // Bad specs: an error, no change.
         ScatterSpec bad = spec;
         bad.scaleMin = 0.0f;
-        QVERIFY(!w->scatter(bad));
+        QVERIFY(!w->scatterTool()->scatter(bad));
         bad = spec;
         bad.species = 3;
-        QVERIFY(!w->scatter(bad));
+        QVERIFY(!w->scatterTool()->scatter(bad));
         QCOMPARE(errors.size(), 2);
         QCOMPARE(json(w->document()->scene()), before);
         QCOMPARE(w->document()->undoStack()->index(), index0);
 
         // The form: what it is given comes back; corners typed in either order.
-        ScatterSpec init = w->defaultScatter();
+        ScatterSpec init = w->scatterTool()->defaultScatter();
         QCOMPARE(init.height, -0.5);
         QVERIFY(init.min.x < -1.0 && init.max.x > 1.0);   // around the instances
         init.count = 33;
@@ -329,8 +329,8 @@ private Q_SLOTS:
         w->document()->edit(s, "grid");
         Viewport* v = w->viewport();
         v->worker()->setPasses({{2, 1}});
-        QSignalSpy lit(w.get(), &MainWindow::lightingFinished);
-        QVERIFY(w->computeLighting());
+        QSignalSpy lit(w->lighting(), &LightingScheduler::lightingFinished);
+        QVERIFY(w->lighting()->computeLighting());
         QVERIFY(lit.wait(60000));
         QVERIFY(lit.at(0).at(0).toBool());
         QVERIFY(waitForFinalImage(v, 60000));
@@ -375,10 +375,10 @@ private Q_SLOTS:
         auto w = window();
         QStringList errors;
         w->setErrorReporter([&](const QString&, const QString& m) { errors << m; });
-        QVERIFY(waitForJob(w->importMesh(sharedTree()), 30000));
+        QVERIFY(waitForJob(w->importer()->importMesh(sharedTree()), 30000));
         QVERIFY(w->document()->scene().species[0].leafMaterials.empty());
         std::vector<MaterialChoice> seen;
-        w->setMaterialEditor([&](const QString& species, const std::vector<MaterialChoice>& m) {
+        w->materials()->setMaterialEditor([&](const QString& species, const std::vector<MaterialChoice>& m) {
             seen = m;
             MaterialDialog d(species, m);
             const int bark = m[0].name == "Bark" ? 0 : 1;
@@ -388,7 +388,7 @@ private Q_SLOTS:
             return std::optional(d.leafMaterials());
         });
         const int index0 = w->document()->undoStack()->index();
-        QVERIFY(waitForJob(w->editMaterials(0), 30000));
+        QVERIFY(waitForJob(w->materials()->editMaterials(0), 30000));
         QCOMPARE(seen.size(), size_t(2));
         QStringList names{seen[0].name, seen[1].name};
         names.sort();
@@ -404,13 +404,13 @@ private Q_SLOTS:
         QVERIFY(QString::fromStdString(sceneToJson(w->document()->scene(), "/")).contains("leaf_materials"));
 
         // Again: the dialog starts from the list; back to the importer's rules = an empty list.
-        w->setMaterialEditor([&](const QString& species, const std::vector<MaterialChoice>& m) {
+        w->materials()->setMaterialEditor([&](const QString& species, const std::vector<MaterialChoice>& m) {
             seen = m;
             MaterialDialog d(species, m);
             d.resetToRules();
             return std::optional(d.leafMaterials());
         });
-        QVERIFY(waitForJob(w->editMaterials(0), 30000));
+        QVERIFY(waitForJob(w->materials()->editMaterials(0), 30000));
         for (const MaterialChoice& c : seen) QVERIFY(c.leaf);
         QVERIFY(w->document()->scene().species[0].leafMaterials.empty());
         QCOMPARE(w->document()->undoStack()->index(), index0 + 2);
@@ -420,8 +420,8 @@ private Q_SLOTS:
         QVERIFY(w->document()->scene().species[0].leafMaterials.empty());
 
         // Cancelled: nothing changes.
-        w->setMaterialEditor([](const QString&, const std::vector<MaterialChoice>&) { return std::optional<std::vector<std::string>>(); });
-        QVERIFY(waitForJob(w->editMaterials(0), 30000));
+        w->materials()->setMaterialEditor([](const QString&, const std::vector<MaterialChoice>&) { return std::optional<std::vector<std::string>>(); });
+        QVERIFY(waitForJob(w->materials()->editMaterials(0), 30000));
         QCOMPARE(w->document()->undoStack()->index(), index0);
 
         // No leaf at all cannot be said (an empty list means the rules): OK is disabled.
@@ -433,8 +433,8 @@ private Q_SLOTS:
         QVERIFY(!d.okButton()->isEnabled());
 
         // A grown species has no materials to assign.
-        w->growSpecies(GrowSpec{"shrub", 1, 2000, 0.0f});
-        QVERIFY(!w->editMaterials(1));
+        w->importer()->growSpecies(GrowSpec{"shrub", 1, 2000, 0.0f});
+        QVERIFY(!w->materials()->editMaterials(1));
         QCOMPARE(errors.size(), 1);
         QVERIFY(errors[0].contains("grown"));
         w->document()->undoStack()->setClean();

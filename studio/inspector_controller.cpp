@@ -1,0 +1,100 @@
+// InspectorController: the selected species' grids into the volume inspector.
+#include "studio/inspector_controller.h"
+
+#include <memory>
+
+#include <QDockWidget>
+
+#include "pipeline/render/render_job.h"
+#include "studio/asset_store.h"
+#include "studio/job_manager.h"
+#include "studio/lighting_scheduler.h"
+#include "studio/scene_document.h"
+#include "studio/volume_inspector.h"
+
+namespace sylva {
+
+InspectorController::InspectorController(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache,
+                                         LightingScheduler* lighting, VolumeInspector* inspector, QDockWidget* dock,
+                                         std::function<int()> selectedSpecies, QObject* parent)
+    : StudioController(parent),
+      m_doc(doc),
+      m_jobs(jobs),
+      m_assets(assets),
+      m_cache(cache),
+      m_lighting(lighting),
+      m_inspector(inspector),
+      m_dock(dock),
+      m_selectedSpecies(std::move(selectedSpecies))
+{
+    connect(m_dock, &QDockWidget::visibilityChanged, this, [this](bool visible) {
+        if (visible) refresh();
+    });
+}
+
+void InspectorController::refresh()
+{
+    if (!m_dock->isVisible()) return;
+    const int species = m_selectedSpecies();
+    if (species < 0) {
+        if (m_job) m_job->cancel();
+        m_inspectedKey.clear();
+        m_inspector->setMessage(tr("Select a species (or one of its instances) to inspect its lighting grids."));
+        Q_EMIT updated();
+        return;
+    }
+    const Scene& s = m_doc->scene();
+    const std::string key = assetKey(s.species[size_t(species)], s.sun, true);
+    if (key == m_inspectedKey) return;   // shown or loading
+    if (m_lighting->isPending()) {
+        // The lighting job solves these grids (or is about to): read them from the cache when it is
+        // done rather than solve them twice at once.
+        if (m_job) m_job->cancel();
+        m_inspectedKey.clear();
+        m_inspector->setMessage(tr("Waiting for the lighting job..."));
+        return;
+    }
+    inspectSpecies(species);
+}
+
+Job* InspectorController::inspectSpecies(int species)
+{
+    const Scene scene = m_doc->scene();
+    if (species < 0 || size_t(species) >= scene.species.size()) return nullptr;
+    const SpeciesDesc& sp = scene.species[size_t(species)];
+    const std::string key = assetKey(sp, scene.sun, true);
+    if (m_job) m_job->cancel();
+    m_inspectedKey = key;
+    const QString name = QString::fromStdString(sp.name);
+    m_inspector->setMessage(tr("Loading the grids of %1...").arg(name));
+    // The species' mesh when the viewport already holds it (no second import).
+    AssetsPtr held = m_assets->find(assetKey(sp, scene.sun, true));
+    if (!held) held = m_assets->find(assetKey(sp, scene.sun, false));
+    auto result = std::make_shared<std::shared_ptr<const SpeciesGrids>>();
+    GridCache* cache = m_cache;
+    m_job = m_jobs->start(tr("Inspect %1").arg(name),
+                          [scene, species, held, cache, result](Job& job, Progress& progress) {
+                              JobLog log;
+                              SpeciesGrids g = loadSpeciesGrids(scene, size_t(species), cache, &progress, &log,
+                                                                held ? &held->mesh : nullptr);
+                              const std::string& n = scene.species[size_t(species)].name;
+                              for (const std::string& stage : log.stages)
+                                  job.log(QString::fromStdString(stage.rfind(n + ":", 0) == 0 ? stage : n + ": " + stage));
+                              *result = std::make_shared<const SpeciesGrids>(std::move(g));
+                          },
+                          [this, key, name, result](Job* job) {
+                              if (key != m_inspectedKey) return;   // the selection moved on
+                              if (job->state() == Job::State::Succeeded) {
+                                  m_inspector->setGrids(name, *result);
+                              } else {
+                                  m_inspectedKey.clear();
+                                  m_inspector->setMessage(job->state() == Job::State::Failed
+                                                              ? tr("The grids of %1 could not be loaded: %2").arg(name, job->error())
+                                                              : tr("Loading the grids of %1 was cancelled.").arg(name));
+                              }
+                              Q_EMIT updated();
+                          });
+    return m_job;
+}
+
+} // namespace sylva

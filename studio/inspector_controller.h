@@ -1,0 +1,56 @@
+// The lighting inspector's loading: which species the inspector shows (the outliner selection), the
+// Inspect job that reads its grids (loadSpeciesGrids, through the grid cache), and waiting for the
+// lighting job instead of solving the same grids twice.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include <QPointer>
+
+#include "studio/studio_controller.h"
+
+class QDockWidget;
+
+namespace sylva {
+
+class AssetStore;
+class GridCache;
+class Job;
+class JobManager;
+class LightingScheduler;
+class SceneDocument;
+class VolumeInspector;
+
+class InspectorController : public StudioController {
+    Q_OBJECT
+
+public:
+    // selectedSpecies: the species the selection points at (-1: none). The inspector is refreshed
+    // while dock is visible (and when it is shown).
+    InspectorController(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache,
+                        LightingScheduler* lighting, VolumeInspector* inspector, QDockWidget* dock,
+                        std::function<int()> selectedSpecies, QObject* parent = nullptr);
+
+    // Shows the selected species' grids (a job when they are not loaded; a wait while lighting runs).
+    void refresh();
+    // Loads the species' density and lighting grids in a job and shows them. Null for a bad index.
+    Job* inspectSpecies(int species);
+
+Q_SIGNALS:
+    void updated();   // the inspector shows new grids (or a message)
+
+private:
+    SceneDocument* m_doc;
+    JobManager* m_jobs;
+    AssetStore* m_assets;
+    GridCache* m_cache;
+    LightingScheduler* m_lighting;
+    VolumeInspector* m_inspector;
+    QDockWidget* m_dock;
+    std::function<int()> m_selectedSpecies;
+    QPointer<Job> m_job;
+    std::string m_inspectedKey;   // asset key of what the inspector shows (or is loading)
+};
+
+} // namespace sylva

@@ -1,0 +1,70 @@
+// Lighting scheduling: which species assets the viewport needs, the background job that grows/imports,
+// voxelizes and lights the missing ones (ensureAssets: debounced, one at a time, restarted when the
+// scene moves on), and the result into the viewport.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <QPointer>
+#include <QTimer>
+
+#include "studio/studio_controller.h"
+
+namespace sylva {
+
+class AssetStore;
+class GridCache;
+class Job;
+class JobManager;
+class SceneDocument;
+class Viewport;
+
+class LightingScheduler : public StudioController {
+    Q_OBJECT
+
+public:
+    // Fills assets through cache in jobs of jobs; hands the document's scene and its assets to viewport.
+    LightingScheduler(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache, Viewport* viewport,
+                      QObject* parent = nullptr);
+    ~LightingScheduler() override;
+
+    // Lighting starts by itself (debounced) when the viewport lacks assets; off: computeLighting by hand.
+    void setAutoLighting(bool on);
+    bool autoLighting() const { return m_autoLighting; }
+
+    // Loads/grows, voxelizes and lights what the viewport needs (reload: drop the in-memory assets
+    // first, so the grid cache answers). Returns the job, or null when everything is in memory (or a
+    // running job was cancelled to run again when it ends).
+    Job* computeLighting(bool reload = false);
+    // Gives the viewport the scene with its assets, or (assets missing) a status line and, with
+    // automatic lighting, a lighting job a quarter second later.
+    void updateViewport();
+    // Whether the scene's mode (or the viewport's compare mode) needs lighting grids.
+    bool viewNeedsLighting() const;
+    // A lighting job runs or is about to start.
+    bool isPending() const { return m_job || m_timer.isActive(); }
+    // Cancels the running lighting job (New: the old scene's grids are not needed).
+    void cancel();
+
+Q_SIGNALS:
+    void autoLightingChanged(bool on);
+    // A lighting job ended, or computeLighting found everything in memory: who waits for the job's
+    // grids may look again (isPending() says whether another job follows).
+    void settled();
+    void lightingFinished(bool succeeded);
+
+private:
+    SceneDocument* m_doc;
+    JobManager* m_jobs;
+    AssetStore* m_assets;
+    GridCache* m_cache;
+    Viewport* m_viewport;
+    bool m_autoLighting = true;
+    QTimer m_timer;
+    QPointer<Job> m_job;
+    std::vector<std::string> m_target;   // asset keys the running lighting job produces
+    bool m_again = false;
+};
+
+} // namespace sylva

@@ -1,0 +1,32 @@
+// File > Open Recent: the last files opened or saved (settings key recentFiles) and the menu listing them.
+#pragma once
+
+#include <QObject>
+#include <QStringList>
+
+class QMenu;
+
+namespace sylva {
+
+class RecentFiles : public QObject {
+    Q_OBJECT
+
+public:
+    static constexpr int kMaxFiles = 8;
+
+    // Fills menu (and keeps it up to date); its actions ask for the file with openRequested.
+    explicit RecentFiles(QMenu* menu, QObject* parent = nullptr);
+
+    QStringList files() const;
+    // Puts path first (once), keeping the last kMaxFiles.
+    void add(const QString& path);
+
+Q_SIGNALS:
+    void openRequested(const QString& path);
+
+private:
+    void updateMenu();
+    QMenu* m_menu;
+};
+
+} // namespace sylva

@@ -1,0 +1,40 @@
+// Edit > Scatter Instances: many instances of a species over a rectangle of the ground
+// (scatterInstances, pipeline/scene/scatter.h) as one undo step, and its form.
+#pragma once
+
+#include <functional>
+
+#include "pipeline/scene/scatter.h"
+#include "studio/studio_controller.h"
+
+class QWidget;
+
+namespace sylva {
+
+class SceneDocument;
+
+class ScatterTool : public StudioController {
+    Q_OBJECT
+
+public:
+    // selectedSpecies: the species the selection points at (-1: none), the form's first choice.
+    // window: the parent of the form.
+    ScatterTool(SceneDocument* doc, std::function<int()> selectedSpecies, QWidget* window, QObject* parent = nullptr);
+
+    // Adds spec.count instances of a species scattered over a rectangle as one undo step (the first
+    // instances of a scene also frame the camera on the rectangle); false (and an error) for a bad
+    // spec or species.
+    bool scatter(const ScatterSpec& spec);
+    // The form's starting values: the selected species, 100 instances over the instances' footprint
+    // (20 m around the origin when there are none) on the ground.
+    ScatterSpec defaultScatter() const;
+    // The form (ScatterDialog), then scatter; an error when the scene has no species.
+    void scatterDialog();
+
+private:
+    SceneDocument* m_doc;
+    std::function<int()> m_selectedSpecies;
+    QWidget* m_window;
+};
+
+} // namespace sylva
