@@ -1,10 +1,8 @@
-// CPU LB solver: rows along z vectorized 8 nodes wide, rows in parallel with oneTBB, fp32 or fp16 storage.
+// CPU LB device (lb_device.h): rows along z vectorized 8 nodes wide, rows in parallel with oneTBB, fp32 or fp16 storage.
 #include "core/lb/lb_solver.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <map>
 #include <memory>
@@ -24,6 +22,7 @@
 #include "core/base/memory.h"
 #include "core/base/error.h"
 #include "core/base/half.h"
+#include "core/lb/lb_device.h"
 #include "core/lb/lb_node.h"
 
 namespace sylva::lb {
@@ -196,7 +195,7 @@ struct Scratch {
 };
 
 template <typename S>
-class Solver {
+class Solver final : public LbGrid {
 public:
     Solver(const DensityGrid& density, const LbParams& params, const std::vector<ChannelParams>& solves)
         : m_params(params), m_dims(density.geometry.dims)
@@ -240,7 +239,7 @@ public:
     // fresh pages cost ~15% of a 128^3 solve). With interiorFollows the caller writes the interior of
     // the current copy next (prolongateFrom), so only new memory is initialized; the other copy's
     // interior is overwritten by the first step and its boundary keeps the boundary condition.
-    void setSolves(const std::vector<ChannelParams>& solves, bool interiorFollows)
+    void setSolves(const std::vector<ChannelParams>& solves, bool interiorFollows) override
     {
         // Boundary condition for unit intensity; the solve is linear in intensity (scaled at the end).
         const std::vector<float> bc = boundaryDistribution(m_params.sun);
@@ -294,7 +293,7 @@ public:
     // read ahead of the next overwrite. Each node update is the same arithmetic as a plain step, so the
     // result is bit-identical for any block depth. With compareLevel >= 1, level compareLevel-1 stores the
     // node totals and level compareLevel returns the relative L2 change between the two (else 0).
-    double advanceBlock(int levels, int compareLevel)
+    double advanceBlock(int levels, int compareLevel) override
     {
         const size_t rows = size_t(m_X) * size_t(m_Y);
         if (compareLevel >= 1 && m_totals.empty()) m_totals.assign(m_fields.size() * rows * size_t(m_Z), 0.0f);
@@ -339,7 +338,7 @@ public:
     }
 
     // Slab depth of the wavefront: as many levels as keep (levels + 3) slabs of both copies in ~12 MB.
-    int autoLevels() const
+    int autoLevels() const override
     {
         const double slab = double(m_Y) * m_Z * kDirections * sizeof(S);
         return std::clamp(int(12.0e6 / (2.0 * slab)) - 3, 1, 16);
@@ -350,8 +349,9 @@ public:
     // x and y per coarse row, then linear in z); boundary nodes keep the boundary condition the
     // constructor set. Only the current copy's interior is written: the first step overwrites the other
     // copy's interior and its boundary already holds the boundary condition.
-    void prolongateFrom(const Solver<S>& coarse)
+    void prolongateFrom(const LbGrid& coarseGrid) override
     {
+        const Solver<S>& coarse = dynamic_cast<const Solver<S>&>(coarseGrid);
         const int cX = coarse.m_X, cY = coarse.m_Y, cZ = coarse.m_Z;
         for (size_t c = 0; c < m_fields.size(); ++c) {
             const ChannelField<S>& cf = *coarse.m_fields[c];
@@ -406,7 +406,7 @@ public:
     }
 
     // Node totals sum_m f_m of the current state, for channel solve c.
-    void totals(size_t c, std::vector<float>& out) const
+    void totals(size_t c, std::vector<float>& out) override
     {
         const ChannelField<S>& f = *m_fields[c];
         const S* cur = f.flip ? f.b.data() : f.a.data();
@@ -583,214 +583,28 @@ private:
     tbb::enumerable_thread_specific<Scratch> m_scratch;
 };
 
-// Coarse start: a grid of half the resolution whose node I sits on fine node 2I (the last one may
-// lie past the fine edge). Density is the full-weighting average of the fine nodes around 2I,
-// doubled (a coarse step crosses two fine cells) and capped at 1; wood fraction is averaged.
-DensityGrid coarsen(const DensityGrid& fine)
-{
-    const glm::ivec3 fd = fine.geometry.dims;
-    DensityGrid c;
-    c.geometry.dims = fd / 2 + 1;
-    c.geometry.origin = fine.geometry.origin;
-    c.geometry.spacing = fine.geometry.spacing * 2.0;
-    const glm::ivec3 cd = c.geometry.dims;
-    c.density.assign(c.geometry.nodeCount(), 0.0f);
-    const bool wood = !fine.woodFraction.empty();
-    if (wood) c.woodFraction.assign(c.geometry.nodeCount(), 0.0f);
-    tbb::parallel_for(1, cd.x - 1, [&](int I) {
-        for (int J = 1; J < cd.y - 1; ++J)
-            for (int K = 1; K < cd.z - 1; ++K) {
-                double rho = 0.0, w = 0.0, sum = 0.0;
-                for (int a = -1; a <= 1; ++a)
-                    for (int b = -1; b <= 1; ++b)
-                        for (int e = -1; e <= 1; ++e) {
-                            const int i = 2 * I + a, j = 2 * J + b, k = 2 * K + e;
-                            if (i < 0 || j < 0 || k < 0 || i >= fd.x || j >= fd.y || k >= fd.z) continue;
-                            const double weight = (a ? 0.5 : 1.0) * (b ? 0.5 : 1.0) * (e ? 0.5 : 1.0);
-                            const size_t n = fine.geometry.index(i, j, k);
-                            rho += weight * fine.density[n];
-                            if (wood) w += weight * fine.woodFraction[n];
-                            sum += weight;
-                        }
-                const size_t n = c.geometry.index(I, J, K);
-                c.density[n] = sum > 0.0 ? float(std::min(1.0, 2.0 * rho / sum)) : 0.0f;
-                if (wood) c.woodFraction[n] = sum > 0.0 ? float(w / sum) : 0.0f;
-            }
-    });
-    return c;
-}
-
-struct StepResult {
-    int steps = 0;
-    bool converged = false;
-};
-
-// Advances a solver in wavefront blocks until the step budget is spent or (tolerance mode) the
-// relative change per step falls under the tolerance. report(done) is called after each block.
-template <typename S, typename Report>
-StepResult runSteps(Solver<S>& solver, const LbParams& params, int steps, SolveStats& stats, Report&& report)
-{
-    const bool tolMode = params.tolerance > 0.0;
-    // Fixed steps run in wavefront blocks of the cache-sized depth. In tolerance mode the last two
-    // levels of a block measure the change per step; that check costs about a step, so by default
-    // it runs on the last block of every ~16 steps rather than on every block.
-    const int depth = params.blockSteps > 0 ? params.blockSteps : solver.autoLevels();
-    const int block = tolMode && params.checkEvery > 0 ? std::max(2, params.checkEvery) : std::max(tolMode ? 2 : 1, depth);
-    const int checkBlocks = tolMode && params.checkEvery <= 0 ? std::max(1, (16 + block - 1) / block) : 1;
-    stats.blockSteps = block;
-    StepResult r;
-    int blocksRun = 0;
-    while (r.steps < steps) {
-        const int levels = std::min(block, steps - r.steps);
-        ++blocksRun;
-        const bool checkNow = tolMode && (blocksRun % checkBlocks == 0 || r.steps + levels >= steps);
-        const int compare = checkNow && levels >= 2 ? levels - 1 : 0;
-        const double change = solver.advanceBlock(levels, compare);
-        r.steps += levels;
-        if (compare > 0) {
-            stats.changeHistory.emplace_back(r.steps, change);
-            stats.lastChange = change;
-            if (change < params.tolerance) {
-                r.converged = true;
-                break;
-            }
-        }
-        report(r.steps);
-    }
-    return r;
-}
-
-// Coarse start: the same solves run to the tolerance on the coarsened grid, itself coarse-started
-// while it has at least 32 nodes on its longest edge, then interpolated as the start of the fine
-// solve. The levels' grids and solvers are made once and reused for every channel group.
-template <typename S>
-class CoarseChain {
+// The CPU device: grids are Solvers of the storage type params.storage asks for, memory what the
+// machine has available.
+class CpuDevice final : public LbDevice {
 public:
-    CoarseChain(const DensityGrid& fine, const LbParams& params) : m_params(params)
+    double availableBytes() const override { return availableMemoryBytes(); }
+    std::string memoryName() const override { return "memory"; }
+    std::unique_ptr<LbGrid> makeGrid(const DensityGrid& density, const LbParams& params,
+                                     const std::vector<ChannelParams>& solves, Progress* progress) override
     {
-        m_grids.push_back(coarsen(fine));
-        while (m_grids.back().geometry.longestEdge() >= 32) m_grids.push_back(coarsen(m_grids.back()));
-        m_solvers.resize(m_grids.size());
-    }
-
-    // Sets the state of `solver` (whose interior is to be written) for `solves`; returns the steps run
-    // on all coarse levels. The coarse solves check `progress` for cancel like the fine one.
-    int start(Solver<S>& solver, const std::vector<ChannelParams>& solves, Progress* progress)
-    {
-        int steps = 0;
-        for (size_t l = m_grids.size(); l-- > 0;) {
-            const bool fromCoarser = l + 1 < m_grids.size();
-            if (!m_solvers[l]) m_solvers[l] = std::make_unique<Solver<S>>(m_grids[l], m_params, solves);
-            else m_solvers[l]->setSolves(solves, fromCoarser);
-            m_solvers[l]->m_progress = progress;
-            if (fromCoarser) m_solvers[l]->prolongateFrom(*m_solvers[l + 1]);
-            SolveStats levelStats;
-            const int maxSteps = m_params.maxSteps > 0 ? m_params.maxSteps : 4 * m_grids[l].geometry.longestEdge();
-            const StepResult r = runSteps(*m_solvers[l], m_params, maxSteps, levelStats, [](int) {});
-            steps += r.steps;
-        }
-        solver.prolongateFrom(*m_solvers[0]);
-        return steps;
-    }
-
-private:
-    const LbParams& m_params;
-    std::vector<DensityGrid> m_grids;   // [0] half the fine resolution, then coarser
-    std::vector<std::unique_ptr<Solver<S>>> m_solvers;
-};
-
-template <typename S>
-LightingGrid runSolve(const DensityGrid& density, const LbParams& params, Progress* progress, SolveStats& stats)
-{
-    // Channels with equal optics share one solve: the result is linear in the sun intensity.
-    std::vector<ChannelParams> solves;
-    int solveOf[3];
-    for (int c = 0; c < 3; ++c) {
-        const ChannelParams& p = params.channels[size_t(c)];
-        int found = -1;
-        for (size_t s = 0; s < solves.size(); ++s)
-            if (solves[s].sigmaA == p.sigmaA && solves[s].sigmaS == p.sigmaS && solves[s].g == p.g) found = int(s);
-        if (found < 0) {
-            found = int(solves.size());
-            solves.push_back(p);
-        }
-        solveOf[c] = found;
-    }
-    stats.channelSolves = int(solves.size());
-
-    // Memory: two copies of 19 values per node for each channel solve advanced together, plus an
-    // eighth of that per level for a coarse start (1/8 + 1/64 + ... < 1/7). One solve at a time by
-    // default: the channels are independent, so advancing them together saves nothing, and one at a
-    // time needs a third of the memory and touches it once (the solver is reused). Refused when even
-    // one does not fit in what the machine has available.
-    const double nodes = double(density.geometry.nodeCount());
-    const bool coarseWanted = params.coarseStart && params.tolerance > 0.0 && density.geometry.longestEdge() >= 32;
-    const double perSolve = 2.0 * nodes * kDirections * sizeof(S) * (coarseWanted ? 8.0 / 7.0 : 1.0);
-    const double other = nodes * (4.0 * 3 + 8.0);   // output grid, padded density and brown mask
-    const double available = availableMemoryBytes();
-    size_t group = params.solvesPerPass > 0 ? std::min(solves.size(), size_t(params.solvesPerPass)) : 1;
-    if (available > 0 && perSolve * double(group) + other > 0.8 * available) group = 1;
-    if (available > 0 && perSolve + other > 0.8 * available) {
-        const glm::ivec3 d = density.geometry.dims;
-        char msg[256];
-        std::snprintf(msg, sizeof msg,
-                      "the %dx%dx%d grid needs %.1f GB for one channel's LB distributions (%s) but %.1f GB of memory is "
-                      "available; use a smaller grid%s",
-                      d.x, d.y, d.z, (perSolve + other) / 1e9, sizeof(S) == 2 ? "fp16" : "fp32", available / 1e9,
-                      sizeof(S) == 2 ? "" : " or fp16 storage");
-        throw Error(msg);
-    }
-    stats.bytesPerStep = 2.0 * nodes * kDirections * sizeof(S) * double(solves.size());
-
-    const int longest = density.geometry.longestEdge();
-    const bool tolMode = params.tolerance > 0.0;
-    const int steps = tolMode ? (params.maxSteps > 0 ? params.maxSteps : 4 * longest)
-                              : fixedSteps(params, density.geometry.dims);
-    LightingGrid out;
-    out.geometry = density.geometry;
-    out.rgb.assign(density.geometry.nodeCount() * 3, 0.0f);
-    std::vector<float> tot;
-    const size_t groups = (solves.size() + group - 1) / group;
-    bool allConverged = true;
-    // One solver (and one coarse chain) for all channel groups: their memory is reused.
-    const bool coarse = params.coarseStart && tolMode && longest >= 32;
-    std::unique_ptr<Solver<S>> solver;
-    std::unique_ptr<CoarseChain<S>> chain;
-    if (coarse) chain = std::make_unique<CoarseChain<S>>(density, params);
-    for (size_t g0 = 0; g0 < solves.size(); g0 += group) {
-        const std::vector<ChannelParams> these(solves.begin() + long(g0), solves.begin() + long(std::min(solves.size(), g0 + group)));
-        if (!solver) {
-            solver = std::make_unique<Solver<S>>(density, params, these);
-            solver->m_progress = progress;
+        std::unique_ptr<LbGrid> grid;
+        if (params.storage == Storage::Fp16) {
+            auto g = std::make_unique<Solver<uint16_t>>(density, params, solves);
+            g->m_progress = progress;
+            grid = std::move(g);
         } else {
-            solver->setSolves(these, coarse);
+            auto g = std::make_unique<Solver<float>>(density, params, solves);
+            g->m_progress = progress;
+            grid = std::move(g);
         }
-        if (coarse) stats.coarseSteps = std::max(stats.coarseSteps, chain->start(*solver, these, progress));
-        const double groupIndex = double(g0 / group);
-        const StepResult r = runSteps(*solver, params, steps, stats, [&](int done) {
-            if (progress)
-                progress->report((groupIndex + double(done) / double(steps)) / double(groups),
-                                 "LB step " + std::to_string(done) + "/" + std::to_string(steps) +
-                                     (groups > 1 ? (group == 1 ? " (channel solve " : " (channel group ") + std::to_string(g0 / group + 1) +
-                                                       "/" + std::to_string(groups) + ")"
-                                                 : ""));
-        });
-        const int done = r.steps;
-        const bool groupConverged = r.converged;
-        stats.steps = std::max(stats.steps, done);
-        allConverged = allConverged && groupConverged;
-        for (size_t s = 0; s < these.size(); ++s) {
-            solver->totals(s, tot);
-            for (int c = 0; c < 3; ++c) {
-                if (solveOf[c] != int(g0 + s)) continue;
-                const float intensity = params.intensity[c];
-                for (size_t n = 0; n < tot.size(); ++n) out.rgb[n * 3 + size_t(c)] = tot[n] * intensity;
-            }
-        }
+        return grid;
     }
-    stats.converged = tolMode && allConverged;
-    return out;
-}
+};
 
 } // namespace
 
@@ -824,18 +638,12 @@ std::vector<float> boundaryDistribution(const glm::vec3& sun)
     return bc;
 }
 
+std::unique_ptr<LbDevice> makeCpuDevice() { return std::make_unique<CpuDevice>(); }
+
 LightingGrid solveLighting(const DensityGrid& density, const LbParams& params, Progress* progress, SolveStats* stats)
 {
-    validate(params);
-    validateDensity(density);
-    SolveStats local;
-    SolveStats& st = stats ? *stats : local;
-    st = SolveStats{};
-    const auto t0 = std::chrono::steady_clock::now();
-    LightingGrid out = params.storage == Storage::Fp16 ? runSolve<uint16_t>(density, params, progress, st)
-                                                       : runSolve<float>(density, params, progress, st);
-    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return out;
+    CpuDevice device;
+    return solveOnDevice(device, density, params, progress, stats);
 }
 
 } // namespace sylva::lb

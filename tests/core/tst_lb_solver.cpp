@@ -1,4 +1,5 @@
-// LB solver against the seed's naive kernel, conservation, diffusion, symmetry, tolerance mode, fp16, validation.
+// LB solver against the seed's naive kernel, conservation, diffusion, symmetry, tolerance mode, fp16, validation;
+// the shared control flow (lb_device.h) against a recording device.
 #include <QTest>
 
 #include <numeric>
@@ -6,12 +7,15 @@
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "core/base/error.h"
 #include "core/base/progress.h"
 #include "core/grid/grid.h"
 #include "core/grid/grid_compare.h"
 #include "core/lb/lattice.h"
+#include "core/lb/lb_device.h"
 #include "core/lb/lb_params.h"
 #include "core/lb/lb_solver.h"
 #include "core/lb/omega.h"
@@ -96,6 +100,133 @@ std::vector<float> pulseState(const DensityGrid& g, glm::ivec3 at, float sigmaA)
         f[((size_t(at.x) * n.y + at.y) * kDirections + m) * n.z + at.z] = float(1000.0 * v / (1.0 + sigmaA));
     }
     return f;
+}
+
+// A device that records what the shared control flow asks of it. No physics: a grid's totals are
+// 1000 x sigma_a of the solve, and the change measured after t steps of a grid is 1/t.
+class RecordingDevice final : public LbDevice {
+public:
+    std::vector<std::string> log;
+    int levels = 7;                 // autoLevels() of every grid
+    double available = 0.0;         // 0: no memory limit
+    bool refuseAll = false;         // checkSupported throws
+
+    void checkSupported(const LbParams&) const override
+    {
+        if (refuseAll) throw Error("the recording device does not run this");
+    }
+    double availableBytes() const override { return available; }
+    std::string memoryName() const override { return "recorded memory"; }
+    std::unique_ptr<LbGrid> makeGrid(const DensityGrid& density, const LbParams&, const std::vector<ChannelParams>& solves,
+                                     Progress*) override;
+    static std::string dims(glm::ivec3 d) { return std::to_string(d.x) + "x" + std::to_string(d.y) + "x" + std::to_string(d.z); }
+};
+
+class RecordingGrid final : public LbGrid {
+public:
+    RecordingGrid(RecordingDevice& device, glm::ivec3 dims, const std::vector<ChannelParams>& solves)
+        : m_device(device), m_dims(dims), m_solves(solves)
+    {
+    }
+    void setSolves(const std::vector<ChannelParams>& solves, bool interiorFollows) override
+    {
+        m_device.log.push_back("set " + name() + " " + std::to_string(solves.size()) + (interiorFollows ? " follows" : ""));
+        m_solves = solves;
+        m_steps = 0;
+    }
+    double advanceBlock(int levels, int compareLevel) override
+    {
+        m_device.log.push_back("advance " + name() + " " + std::to_string(levels) + "/" + std::to_string(compareLevel));
+        const int before = m_steps;
+        m_steps += levels;
+        return compareLevel >= 1 ? 1.0 / double(before + compareLevel) : 0.0;
+    }
+    int autoLevels() const override { return m_device.levels; }
+    void prolongateFrom(const LbGrid& coarse) override
+    {
+        m_device.log.push_back("prolong " + name() + " <- " + dynamic_cast<const RecordingGrid&>(coarse).name());
+    }
+    void totals(size_t s, std::vector<float>& out) override
+    {
+        m_device.log.push_back("totals " + name() + " " + std::to_string(s));
+        out.assign(size_t(m_dims.x) * size_t(m_dims.y) * size_t(m_dims.z), 1000.0f * m_solves.at(s).sigmaA);
+    }
+    std::string name() const { return RecordingDevice::dims(m_dims); }
+
+private:
+    RecordingDevice& m_device;
+    glm::ivec3 m_dims;
+    std::vector<ChannelParams> m_solves;
+    int m_steps = 0;
+};
+
+std::unique_ptr<LbGrid> RecordingDevice::makeGrid(const DensityGrid& density, const LbParams&,
+                                                  const std::vector<ChannelParams>& solves, Progress*)
+{
+    log.push_back("make " + dims(density.geometry.dims) + " " + std::to_string(solves.size()));
+    return std::make_unique<RecordingGrid>(*this, density.geometry.dims, solves);
+}
+
+// A device that forwards to another (the CPU one) and logs the grids made, solves set and prolongations.
+class ForwardingDevice final : public LbDevice {
+public:
+    explicit ForwardingDevice(std::unique_ptr<LbDevice> inner) : m_inner(std::move(inner)) {}
+    std::vector<std::string> log;
+
+    class Grid final : public LbGrid {
+    public:
+        Grid(ForwardingDevice& device, glm::ivec3 dims, std::unique_ptr<LbGrid> inner)
+            : m_device(device), m_dims(dims), m_inner(std::move(inner))
+        {
+        }
+        void setSolves(const std::vector<ChannelParams>& solves, bool interiorFollows) override
+        {
+            m_device.log.push_back("set " + RecordingDevice::dims(m_dims) + " " + std::to_string(solves.size()));
+            m_inner->setSolves(solves, interiorFollows);
+        }
+        double advanceBlock(int levels, int compareLevel) override { return m_inner->advanceBlock(levels, compareLevel); }
+        int autoLevels() const override { return m_inner->autoLevels(); }
+        void prolongateFrom(const LbGrid& coarse) override
+        {
+            m_device.log.push_back("prolong");
+            m_inner->prolongateFrom(*dynamic_cast<const Grid&>(coarse).m_inner);
+        }
+        void totals(size_t s, std::vector<float>& out) override { m_inner->totals(s, out); }
+
+    private:
+        ForwardingDevice& m_device;
+        glm::ivec3 m_dims;
+        std::unique_ptr<LbGrid> m_inner;
+    };
+
+    double availableBytes() const override { return m_inner->availableBytes(); }
+    std::string memoryName() const override { return m_inner->memoryName(); }
+    std::unique_ptr<LbGrid> makeGrid(const DensityGrid& density, const LbParams& params, const std::vector<ChannelParams>& solves,
+                                     Progress* progress) override
+    {
+        log.push_back("make " + RecordingDevice::dims(density.geometry.dims) + " " + std::to_string(solves.size()));
+        return std::make_unique<Grid>(*this, density.geometry.dims, m_inner->makeGrid(density, params, solves, progress));
+    }
+
+private:
+    std::unique_ptr<LbDevice> m_inner;
+};
+
+// The log's entries that start with one of `kinds`.
+std::vector<std::string> only(const std::vector<std::string>& log, std::initializer_list<const char*> kinds)
+{
+    std::vector<std::string> out;
+    for (const std::string& e : log)
+        for (const char* k : kinds)
+            if (e.rfind(k, 0) == 0) out.push_back(e);
+    return out;
+}
+
+QString joined(const std::vector<std::string>& v)
+{
+    QString s;
+    for (const std::string& e : v) s += QString::fromStdString(e) + "; ";
+    return s;
 }
 
 } // namespace
@@ -385,6 +516,185 @@ private Q_SLOTS:
                                             .arg(double(together.rgb[n * 3 + size_t(c)])).arg(double(one.rgb[n * 3 + size_t(c)]))));
             }
         }
+    }
+
+    // Fixed steps: blocks of the device's depth, solves per pass grouped, each channel's output the
+    // totals of its solve times its intensity, progress after each block.
+    void controlDrivesTheDeviceInFixedSteps()
+    {
+        const DensityGrid d = randomDensity({6, 5, 4}, 1, 0.5, 0.0);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));   // three distinct channels
+        p.intensity = {1.0f, 2.0f, 0.5f};
+        p.steps = 20;
+        p.solvesPerPass = 2;
+        RecordingDevice device;
+        std::vector<std::pair<double, std::string>> reports;
+        Progress progress([&](double f, const std::string& m) { reports.emplace_back(f, m); });
+        SolveStats st;
+        const LightingGrid out = solveOnDevice(device, d, p, &progress, &st);
+        const std::vector<std::string> expected = {
+            "make 6x5x4 2",      "advance 6x5x4 7/0", "advance 6x5x4 7/0", "advance 6x5x4 6/0", "totals 6x5x4 0",
+            "totals 6x5x4 1",    "set 6x5x4 1",       "advance 6x5x4 7/0", "advance 6x5x4 7/0", "advance 6x5x4 6/0",
+            "totals 6x5x4 0"};
+        QVERIFY2(device.log == expected, qPrintable(joined(device.log)));
+        QCOMPARE(st.steps, 20);
+        QCOMPARE(st.channelSolves, 3);
+        QCOMPARE(st.blockSteps, 7);
+        QVERIFY(!st.converged);
+        QCOMPARE(st.bytesPerStep, 2.0 * 120 * kDirections * 4 * 3);
+        QCOMPARE(out.rgb.size(), size_t(120 * 3));
+        for (size_t n = 0; n < 120; ++n)
+            for (int c = 0; c < 3; ++c)
+                QCOMPARE(out.rgb[n * 3 + size_t(c)], 1000.0f * p.channels[size_t(c)].sigmaA * p.intensity[c]);
+        QCOMPARE(reports.size(), size_t(6));
+        QCOMPARE(reports.back().first, 1.0);
+        QCOMPARE(QString::fromStdString(reports.back().second), QString("LB step 20/20 (channel group 2/2)"));
+        QCOMPARE(reports[2].first, 0.5);
+    }
+
+    // Tolerance mode: with a check period every block measures the change between its last two
+    // steps and the solve stops under the tolerance; without one, every third block of 7 (~16 steps)
+    // and the last block are checked.
+    void controlDrivesTheDeviceToTheTolerance()
+    {
+        const DensityGrid d = randomDensity({6, 5, 4}, 1, 0.5, 0.0);
+        LbParams p = paramsFromPreset(*findPreset("cloud"));   // one solve for the three channels
+        p.tolerance = 1.0 / 30.0;
+        p.checkEvery = 5;
+        p.maxSteps = 100;
+        RecordingDevice device;
+        SolveStats st;
+        solveOnDevice(device, d, p, nullptr, &st);
+        // The change after t steps is 1/t: checks at t = 4, 9, ..., 34, the first under 1/30.
+        const std::vector<std::string> advances = only(device.log, {"advance"});
+        QCOMPARE(advances.size(), size_t(7));
+        for (const std::string& a : advances) QCOMPARE(QString::fromStdString(a), QString("advance 6x5x4 5/4"));
+        QCOMPARE(st.channelSolves, 1);
+        QVERIFY(st.converged);
+        QCOMPARE(st.steps, 35);
+        QCOMPARE(st.changeHistory.size(), size_t(7));
+        QCOMPARE(st.changeHistory.back().first, 35);
+        QCOMPARE(st.changeHistory.back().second, 1.0 / 34.0);
+        QCOMPARE(st.lastChange, 1.0 / 34.0);
+
+        p.checkEvery = 0;
+        p.tolerance = 1e-9;   // never reached
+        p.maxSteps = 45;
+        device.log.clear();
+        solveOnDevice(device, d, p, nullptr, &st);
+        const std::vector<std::string> expected = {"advance 6x5x4 7/0", "advance 6x5x4 7/0", "advance 6x5x4 7/6",
+                                                   "advance 6x5x4 7/0", "advance 6x5x4 7/0", "advance 6x5x4 7/6",
+                                                   "advance 6x5x4 3/2"};
+        QVERIFY2(only(device.log, {"advance"}) == expected, qPrintable(joined(device.log)));
+        QVERIFY(!st.converged);
+        QCOMPARE(st.steps, 45);
+        QCOMPARE(st.changeHistory.size(), size_t(3));
+    }
+
+    // Coarse start: the levels (half resolution while the longest edge is >= 32) are made once, solved
+    // coarsest first, each started from the next coarser one, and the fine grid from the finest level;
+    // the next channel solve reuses every grid, writing only what the interpolation does not.
+    void controlDrivesTheCoarseStartLevels()
+    {
+        const DensityGrid d = randomDensity({70, 40, 33}, 1, 0.5, 0.0);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.tolerance = 0.2;   // the scripted change 1/t falls under it at the first check
+        p.checkEvery = 7;
+        p.coarseStart = true;
+        RecordingDevice device;
+        SolveStats st;
+        solveOnDevice(device, d, p, nullptr, &st);
+        const std::vector<std::string> expected = {
+            "make 70x40x33 1",          "make 19x11x9 1",
+            "make 36x21x17 1",          "prolong 36x21x17 <- 19x11x9",
+            "prolong 70x40x33 <- 36x21x17",
+            "set 70x40x33 1 follows",   "set 19x11x9 1",
+            "set 36x21x17 1 follows",   "prolong 36x21x17 <- 19x11x9",
+            "prolong 70x40x33 <- 36x21x17",
+            "set 70x40x33 1 follows",   "set 19x11x9 1",
+            "set 36x21x17 1 follows",   "prolong 36x21x17 <- 19x11x9",
+            "prolong 70x40x33 <- 36x21x17"};
+        const std::vector<std::string> structure = only(device.log, {"make", "set", "prolong"});
+        QVERIFY2(structure == expected, qPrintable(joined(structure)));
+        // Each level runs one block of 7 steps to its first check (1/6 < 0.2), the fine grid too.
+        QCOMPARE(st.coarseSteps, 14);
+        QCOMPARE(st.steps, 7);
+        QVERIFY(st.converged);
+        // Without tolerance mode there is no coarse start.
+        p.tolerance = 0.0;
+        p.steps = 3;
+        device.log.clear();
+        solveOnDevice(device, d, p, nullptr, &st);
+        QVERIFY2(only(device.log, {"prolong"}).empty(), qPrintable(joined(device.log)));
+        QCOMPARE(st.coarseSteps, 0);
+    }
+
+    // Memory: a device without room for one channel solve refuses with its message and makes no grid;
+    // with room for one but not all, solves per pass falls back to one. checkSupported comes first.
+    void controlChecksTheDevicesMemoryAndSupport()
+    {
+        const DensityGrid d = randomDensity({10, 10, 10}, 1, 0.5, 0.0);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.steps = 2;
+        p.solvesPerPass = 3;
+        RecordingDevice device;
+        const double perSolve = 2.0 * 1000 * kDirections * 4, other = 1000 * 20.0;
+        device.available = (perSolve + other) / 0.8 * 1.01;
+        solveOnDevice(device, d, p, nullptr, nullptr);
+        QVERIFY2(only(device.log, {"make"}) == std::vector<std::string>{"make 10x10x10 1"}, qPrintable(joined(device.log)));
+        device.available = (perSolve * 3 + other) / 0.8 * 1.01;
+        device.log.clear();
+        solveOnDevice(device, d, p, nullptr, nullptr);
+        QVERIFY2(only(device.log, {"make"}) == std::vector<std::string>{"make 10x10x10 3"}, qPrintable(joined(device.log)));
+        device.available = 1000;
+        device.log.clear();
+        try {
+            solveOnDevice(device, d, p, nullptr, nullptr);
+            QFAIL("a grid too large for the device was accepted");
+        } catch (const Error& e) {
+            QVERIFY2(QString(e.what()).contains("of recorded memory is available"), e.what());
+        }
+        QVERIFY(device.log.empty());
+        device.available = 0;
+        device.refuseAll = true;
+        QVERIFY_THROWS_EXCEPTION(Error, solveOnDevice(device, d, p, nullptr, nullptr));
+        QVERIFY(device.log.empty());
+    }
+
+    // Cancel between blocks stops the solve: no further block is asked for.
+    void controlStopsOnCancel()
+    {
+        const DensityGrid d = randomDensity({6, 5, 4}, 1, 0.5, 0.0);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.steps = 40;
+        RecordingDevice device;
+        Progress progress;
+        progress.setCallback([&](double, const std::string&) { progress.cancel(); });
+        QVERIFY_THROWS_EXCEPTION(Cancelled, solveOnDevice(device, d, p, &progress, nullptr));
+        QCOMPARE(only(device.log, {"advance"}).size(), size_t(1));
+    }
+
+    // The CPU device driven through the interface (a device that forwards to it and logs): the same
+    // bits and stats as solveLighting, with coarse start and two solves per pass.
+    void cpuDeviceThroughTheInterfaceEqualsSolveLighting()
+    {
+        DensityGrid d = randomDensity({34, 20, 18}, 9, 0.5, 0.1);
+        LbParams p = paramsFromPreset(*findPreset("leaf"));
+        p.tolerance = 1e-3;
+        p.coarseStart = true;
+        p.solvesPerPass = 2;
+        SolveStats a, b;
+        const LightingGrid direct = solveLighting(d, p, nullptr, &a);
+        ForwardingDevice device(makeCpuDevice());
+        const LightingGrid driven = solveOnDevice(device, d, p, nullptr, &b);
+        QVERIFY(std::memcmp(direct.rgb.data(), driven.rgb.data(), direct.rgb.size() * sizeof(float)) == 0);
+        QCOMPARE(b.steps, a.steps);
+        QCOMPARE(b.coarseSteps, a.coarseSteps);
+        QVERIFY(a.coarseSteps > 0);
+        QVERIFY(b.changeHistory == a.changeHistory);
+        const std::vector<std::string> expected = {"make 34x20x18 2", "make 18x11x10 2", "prolong", "set 34x20x18 1",
+                                                   "set 18x11x10 1", "prolong"};
+        QVERIFY2(device.log == expected, qPrintable(joined(device.log)));
     }
 
     void invalidParametersAreRefused_data()
