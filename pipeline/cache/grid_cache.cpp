@@ -14,9 +14,9 @@
 #include <QDir>
 #include <QFile>
 #include <QFileInfo>
-#include <QSaveFile>
 
 #include "core/base/error.h"
+#include "pipeline/io/atomic_file.h"
 
 namespace sylva {
 
@@ -332,26 +332,12 @@ void storeEntry(const std::string& path, EntryHeader header, const std::vector<c
     header.checksum = hash.digest();
     encodeHeader(header, raw);
 
-    const QString qpath = QString::fromStdString(path);
-    if (!QDir().mkpath(QFileInfo(qpath).absolutePath())) throw Error(path + ": cannot create the cache folder");
-    // QSaveFile writes a uniquely named temporary file beside the entry and renames it into place.
-    QSaveFile file(qpath);
-    if (!file.open(QIODevice::WriteOnly)) throw Error(path + ": cannot create the cache entry (" + file.errorString().toStdString() + ")");
-    auto write = [&](const void* data, size_t size) {
-        const char* p = static_cast<const char*>(data);
-        while (size > 0) {
-            const qint64 got = file.write(p, qint64(std::min<size_t>(size, size_t(1) << 30)));
-            if (got <= 0) {
-                file.cancelWriting();
-                throw Error(path + ": cannot write the cache entry (" + file.errorString().toStdString() + ")");
-            }
-            p += got;
-            size -= size_t(got);
-        }
-    };
-    write(raw, kHeaderSize);
-    for (const auto* a : le) write(a->data(), a->size() * sizeof(float));
-    if (!file.commit()) throw Error(path + ": cannot move the cache entry into place (" + file.errorString().toStdString() + ")");
+    // A uniquely named temporary file beside the entry, synced, then renamed into place: readers see
+    // the old entry or the new one, and concurrent writers of one key leave one whole entry.
+    AtomicFile file(path, AtomicFile::Sync::Yes, "cache entry");
+    file.write(raw, kHeaderSize);
+    for (const auto* a : le) file.write(a->data(), a->size() * sizeof(float));
+    file.commit();
 }
 
 EntryHeader headerFor(const GridGeometry& g, uint32_t kind, const CacheKey& key)

@@ -15,7 +15,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/base/error.h"
-#include "pipeline/io/output_path.h"
+#include "pipeline/io/atomic_file.h"
 #include "pipeline/io/image_io.h"
 
 namespace sylva {
@@ -23,41 +23,6 @@ namespace sylva {
 namespace fs = std::filesystem;
 
 namespace {
-
-// A file written under a temporary name in the target's folder, renamed into place by commit().
-class AtomicFile {
-public:
-    explicit AtomicFile(const std::string& path) : m_out(path)
-    {
-        m_file = std::fopen(m_out.tempPath().c_str(), "wb");
-        if (!m_file) throw Error(path + ": cannot write (" + std::strerror(errno) + ")");
-    }
-    AtomicFile(const AtomicFile&) = delete;
-    AtomicFile& operator=(const AtomicFile&) = delete;
-    ~AtomicFile()
-    {
-        if (m_file) std::fclose(m_file);
-    }
-
-    void write(const char* data, size_t size)
-    {
-        if (size && std::fwrite(data, 1, size, m_file) != size)
-            throw Error(m_out.target() + ": cannot write (" + std::strerror(errno) + ")");
-    }
-    void write(const std::string& text) { write(text.data(), text.size()); }
-
-    void commit()
-    {
-        const int closed = std::fclose(m_file);
-        m_file = nullptr;
-        if (closed != 0) throw Error(m_out.target() + ": cannot write (" + std::strerror(errno) + ")");
-        m_out.commit();
-    }
-
-private:
-    ReplacingFile m_out;
-    FILE* m_file = nullptr;
-};
 
 // Creates the OBJ's folder first, so a bad folder is reported against the OBJ, not a texture.
 void ensureFolder(const std::string& path)
@@ -177,7 +142,7 @@ void writeMtl(const std::string& mtlPath, const std::vector<Material>& materials
         if (!m.diffuseTexture.empty()) text += "map_Kd " + texturePath(m.diffuseTexture, objDir) + "\n";
         if (!m.alphaTexture.empty()) text += "map_d " + texturePath(m.alphaTexture, objDir) + "\n";
     }
-    AtomicFile file(mtlPath);
+    AtomicFile file(mtlPath, AtomicFile::Sync::No);   // no fsync, as before: regenerable output
     file.write(text);
     file.commit();
 }
@@ -195,7 +160,7 @@ void writeObjWithMaterials(const std::string& objPath, const TriangleMesh& mesh,
     if (hasMaterials) writeMtl((objDir / (stem + ".mtl")).string(), materials, names, objDir);
 
     const bool hasUv = !mesh.uvs.empty(), hasNormal = !mesh.normals.empty();
-    AtomicFile file(objPath);
+    AtomicFile file(objPath, AtomicFile::Sync::No);
     std::string header = "# Sylva OBJ: " + std::to_string(mesh.positions.size()) + " vertices, " +
                          std::to_string(mesh.triangles.size()) + " triangles\n";
     if (hasMaterials) header += "mtllib " + stem + ".mtl\n";

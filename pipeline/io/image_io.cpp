@@ -12,7 +12,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/base/error.h"
-#include "pipeline/io/output_path.h"
+#include "pipeline/io/atomic_file.h"
 
 namespace sylva {
 
@@ -78,8 +78,9 @@ void writeImage(const std::string& path, const ImageRgba& image, int channels)
     const std::string ext = lowerExtension(path);
     const bool isFloat = ext == ".exr" || ext == ".hdr";
     // The temporary name keeps the extension, so OIIO picks the same format.
-    ReplacingFile file(path);
-    auto out = OIIO::ImageOutput::create(file.tempPath());
+    AtomicFile file(path, AtomicFile::Sync::No, "image");
+    const std::string& temp = file.pathForWriter();
+    auto out = OIIO::ImageOutput::create(temp);
     if (!out) throw Error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
     OIIO::ImageSpec spec(image.width, image.height, channels, isFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
     if (channels == 4) {
@@ -92,14 +93,14 @@ void writeImage(const std::string& path, const ImageRgba& image, int channels)
             float v = image.pixels[p * 4 + size_t(c)];
             data[p * size_t(channels) + size_t(c)] = isFloat ? v : std::clamp(v, 0.0f, 1.0f);
         }
-    if (!out->open(file.tempPath(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data.data()) || !out->close())
+    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data.data()) || !out->close())
         throw Error(path + ": cannot write image (" + out->geterror() + ")");
     file.commit();
 }
 
 struct RowImageWriter::Impl {
-    explicit Impl(const std::string& path) : file(path) {}
-    ReplacingFile file;
+    explicit Impl(const std::string& path) : file(path, AtomicFile::Sync::No, "image") {}
+    AtomicFile file;
     std::unique_ptr<OIIO::ImageOutput> out;
     int width = 0, height = 0, next = 0;
     bool isFloat = false, open = false;
@@ -113,7 +114,7 @@ RowImageWriter::RowImageWriter(const std::string& path, int width, int height) :
     m->isFloat = ext == ".exr" || ext == ".hdr";
     m->width = width;
     m->height = height;
-    m->out = OIIO::ImageOutput::create(m->file.tempPath());
+    m->out = OIIO::ImageOutput::create(m->file.pathForWriter());
     if (!m->out) throw Error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
     OIIO::ImageSpec spec(width, height, 3, m->isFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
     if (!m->out->open(m->file.tempPath(), spec)) throw Error(path + ": cannot write image (" + m->out->geterror() + ")");
@@ -122,7 +123,7 @@ RowImageWriter::RowImageWriter(const std::string& path, int width, int height) :
 
 RowImageWriter::~RowImageWriter()
 {
-    if (m && m->out && m->open) m->out->close();   // the temporary file is removed by ReplacingFile
+    if (m && m->out && m->open) m->out->close();   // the temporary file is removed by AtomicFile
 }
 
 void RowImageWriter::writeRows(const float* rgb, int rows)

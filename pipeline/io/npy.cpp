@@ -20,9 +20,9 @@
 #include <QJsonDocument>
 #include <QJsonObject>
 #include <QJsonParseError>
-#include <QSaveFile>
 
 #include "core/base/error.h"
+#include "pipeline/io/atomic_file.h"
 #include "pipeline/io/output_path.h"
 
 namespace sylva {
@@ -249,44 +249,6 @@ uint64_t readLittleEndian(const unsigned char* p, int bytes)
     for (int i = bytes - 1; i >= 0; --i) v = (v << 8) | p[i];
     return v;
 }
-
-// Writes bytes to PATH atomically (QSaveFile: unique temporary file in the same folder, then rename).
-class AtomicFile {
-public:
-    explicit AtomicFile(const std::string& path) : m_path(path), m_file(QString::fromStdString(path))
-    {
-        requireReplaceableFile(path);
-        const QFileInfo info(QString::fromStdString(path));
-        QDir().mkpath(info.absolutePath());
-        if (!m_file.open(QIODevice::WriteOnly))
-            throw Error(path + ": cannot create the file (" + m_file.errorString().toStdString() + ")");
-    }
-
-    void write(const void* data, size_t size)
-    {
-        const char* p = static_cast<const char*>(data);
-        while (size > 0) {
-            const qint64 chunk = qint64(std::min<size_t>(size, size_t(1) << 30));
-            const qint64 written = m_file.write(p, chunk);
-            if (written <= 0) {
-                m_file.cancelWriting();
-                throw Error(m_path + ": cannot write the file (" + m_file.errorString().toStdString() + ")");
-            }
-            p += written;
-            size -= size_t(written);
-        }
-    }
-
-    void commit()
-    {
-        if (!m_file.commit())
-            throw Error(m_path + ": cannot move the written file into place (" + m_file.errorString().toStdString() + ")");
-    }
-
-private:
-    std::string m_path;
-    QSaveFile m_file;
-};
 
 void writeFloats(AtomicFile& file, const std::vector<float>& data)
 {

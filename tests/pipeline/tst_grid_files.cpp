@@ -1,6 +1,7 @@
 // Tests of grid files: .npy reading/writing, JSON sidecars, and the montage picture of grids.
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 
 #include <QDir>
@@ -12,6 +13,7 @@
 #include <QTest>
 
 #include "core/base/error.h"
+#include "pipeline/io/atomic_file.h"
 #include "pipeline/io/grid_picture.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/io/npy.h"
@@ -485,6 +487,58 @@ private Q_SLOTS:
         for (size_t i = 0; i < read.pixels.size(); ++i) worst = std::max(worst, std::abs(read.pixels[i] - expected.pixels[i]));
         QVERIFY2(worst <= 0.5f / 255.0f + 1e-6f, qPrintable(QString::number(worst)));
         QVERIFY_THROWS_EXCEPTION(Error, writeGridMontage(outPath("none.png"), nullptr, nullptr));
+    }
+    // The one atomic writer behind npy, sidecar, cache, scene, OBJ and image files.
+    void atomicFileWriter()
+    {
+        namespace fs = std::filesystem;
+        const std::string dir = outPath("atomic");
+        const std::string path = dir + "/a.npy";
+        auto leftovers = [&] {
+            QStringList names = QDir(QString::fromStdString(dir)).entryList({".tmp.*"}, QDir::Files | QDir::Hidden);
+            return names.join(QLatin1Char(','));
+        };
+        {
+            AtomicFile file(path);   // creates the folder
+            QVERIFY(QFileInfo(QString::fromStdString(file.tempPath())).absolutePath() == QString::fromStdString(dir));
+            QVERIFY(QString::fromStdString(file.tempPath()).endsWith(".a.npy"));   // extension kept
+            file.write(std::string_view("first"));
+            QVERIFY(!QFile::exists(QString::fromStdString(path)));   // nothing in place before commit
+            file.commit();
+        }
+        QCOMPARE(readBytes(path), QByteArray("first"));
+        QCOMPARE(leftovers(), QString());
+        {
+            AtomicFile file(path);   // abandoned: the old file stays, the temporary file goes
+            file.write(std::string_view("second"));
+        }
+        QCOMPARE(readBytes(path), QByteArray("first"));
+        QCOMPARE(leftovers(), QString());
+
+        // Permissions of the replaced file are kept; a link stays a link, its target is replaced.
+        fs::permissions(path, fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read);
+        const std::string link = dir + "/link.npy";
+        fs::create_symlink("a.npy", link);
+        writeNpy(link, NpyArray{{2}, {1.0f, 2.0f}});
+        QVERIFY(fs::is_symlink(link));
+        QCOMPARE(readNpy(path).data, (std::vector<float>{1.0f, 2.0f}));
+        QVERIFY(fs::status(path).permissions() == (fs::perms::owner_read | fs::perms::owner_write | fs::perms::group_read));
+        QCOMPARE(leftovers(), QString());
+
+        // Errors name the target.
+        writeBytes(dir + "/plain", "x");
+        try {
+            AtomicFile file(dir + "/plain/sub/b.npy");
+            QFAIL("a folder below a regular file was accepted");
+        } catch (const Error& e) {
+            QVERIFY2(std::string(e.what()).rfind(dir + "/plain/sub/b.npy: ", 0) == 0, e.what());
+        }
+        try {
+            AtomicFile file(dir);
+            QFAIL("a folder was accepted as a file");
+        } catch (const Error& e) {
+            QVERIFY2(std::string(e.what()).find("is a folder") != std::string::npos, e.what());
+        }
     }
 };
 
