@@ -1,14 +1,16 @@
-// LB kernels: one thread per node and channel, values in registers, Omega in constant memory,
-// ping-pong buffers, fp32 or fp16 storage; the convergence check runs on the device.
+// The CUDA LB device (core/lb/lb_device.h): one thread per node and channel solve, values in registers,
+// Omega in constant memory, ping-pong buffers, fp32 or fp16 storage, the convergence check and the
+// coarse-start interpolation on the device. The control flow is lb::solveOnDevice, shared with the CPU.
 #include "cuda/lb_cuda.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <cuda_fp16.h>
 
+#include "core/lb/lb_device.h"
 #include "core/lb/lb_node.h"
 #include "core/lb/omega.h"
 #include "cuda/cuda_check.h"
@@ -20,8 +22,9 @@ using lb::SymmetricOmega;
 using lb::kDirections;
 
 constexpr int kMaxSolves = 3;
-__constant__ SymmetricOmega c_omega[kMaxSolves][2];   // [solve][green, brown]
+__constant__ SymmetricOmega c_omega[kMaxSolves][2];   // [solve][green, brown] of the grid being stepped
 __constant__ int c_dir[kDirections][3];
+__constant__ float c_bc[kDirections];                 // boundary condition for unit intensity
 
 SYLVA_DEVICE SYLVA_INLINE float loadF(const float* p) { return *p; }
 SYLVA_DEVICE SYLVA_INLINE float loadF(const __half* p) { return __half2float(*p); }
@@ -101,135 +104,199 @@ __global__ void changeKernel(const float* __restrict__ a, const float* __restric
     }
 }
 
+// Every value of the distributions `f` (solves one after another, solveStride apart): the boundary
+// condition c_bc on boundary nodes (everywhere with warm), 0 inside.
 template <typename S>
-S toStorage(float v);
-template <>
-float toStorage<float>(float v)
+__global__ void initKernel(S* __restrict__ f, size_t count, int X, int Y, int Z, int warm)
 {
-    return v;
-}
-template <>
-__half toStorage<__half>(float v)
-{
-    return __float2half_rn(v);
+    const size_t e = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (e >= count) return;
+    const int k = int(e % size_t(Z));
+    const size_t row = e / size_t(Z);
+    const int m = int(row % size_t(kDirections));
+    const size_t ij = row / size_t(kDirections);
+    const int j = int(ij % size_t(Y)), i = int((ij / size_t(Y)) % size_t(X));
+    const bool boundary = i == 0 || j == 0 || k == 0 || i == X - 1 || j == Y - 1 || k == Z - 1;
+    storeF(f + e, warm || boundary ? c_bc[m] : 0.0f);
 }
 
+// Coarse start: the interior of every solve (blockIdx.y) of `fine` interpolated from `coarse` on
+// coarsen() of its grid, as the CPU does: bilinear in x and y at (i/2, j/2), then linear in z at k/2.
 template <typename S>
-LightingGrid solveTyped(const DensityGrid& density, const lb::LbParams& params, Progress* progress, lb::SolveStats* stats)
+__global__ void prolongKernel(const S* __restrict__ coarse, S* __restrict__ fine, int cX, int cY, int cZ, int X, int Y,
+                              int Z, size_t coarseStride, size_t fineStride)
 {
-    const auto t0 = std::chrono::steady_clock::now();
-    const glm::ivec3 dims = density.geometry.dims;
-    const int X = dims.x, Y = dims.y, Z = dims.z;
-    const size_t nodes = density.geometry.nodeCount();
-
-    // Distinct channel solves.
-    std::vector<lb::ChannelParams> solves;
-    int solveOf[3];
-    for (int c = 0; c < 3; ++c) {
-        const lb::ChannelParams& cp = params.channels[size_t(c)];
-        solveOf[c] = -1;
-        for (size_t s = 0; s < solves.size(); ++s)
-            if (solves[s].sigmaA == cp.sigmaA && solves[s].sigmaS == cp.sigmaS && solves[s].g == cp.g) solveOf[c] = int(s);
-        if (solveOf[c] < 0) {
-            solveOf[c] = int(solves.size());
-            solves.push_back(cp);
+    const size_t e = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (e >= fineStride) return;
+    const int k = int(e % size_t(Z));
+    const size_t row = e / size_t(Z);
+    const int m = int(row % size_t(kDirections));
+    const size_t ij = row / size_t(kDirections);
+    const int j = int(ij % size_t(Y)), i = int(ij / size_t(Y));
+    if (i < 1 || j < 1 || k < 1 || i > X - 2 || j > Y - 2 || k > Z - 2) return;
+    const S* cs = coarse + size_t(blockIdx.y) * coarseStride;
+    const int I0 = min(i / 2, cX - 2), J0 = min(j / 2, cY - 2), K0 = min(k / 2, cZ - 2);
+    const float fx = float(i) / 2.0f - float(I0), fy = float(j) / 2.0f - float(J0), fz = float(k) / 2.0f - float(K0);
+    const float w[4] = {(1.0f - fx) * (1.0f - fy), (1.0f - fx) * fy, fx * (1.0f - fy), fx * fy};
+    float xy[2];
+#pragma unroll
+    for (int t = 0; t < 2; ++t) {
+        float v[4];
+#pragma unroll
+        for (int q = 0; q < 4; ++q) {
+            const size_t I = size_t(I0 + (q >> 1)), J = size_t(J0 + (q & 1));
+            v[q] = loadF(cs + ((I * size_t(cY) + J) * kDirections + size_t(m)) * size_t(cZ) + size_t(K0 + t));
         }
+        xy[t] = w[0] * v[0] + w[1] * v[1] + w[2] * v[2] + w[3] * v[3];
     }
-    const int ns = int(solves.size());
-    SymmetricOmega om[kMaxSolves][2];
-    for (int s = 0; s < ns; ++s) {
-        om[s][0] = lb::symmetricOmega(solves[size_t(s)]);
-        om[s][1] = lb::symmetricOmega({solves[size_t(s)].sigmaA, solves[size_t(s)].sigmaS, -1.0f});
+    storeF(fine + size_t(blockIdx.y) * fineStride + e, (1.0f - fz) * xy[0] + fz * xy[1]);
+}
+
+inline unsigned blocksFor(size_t n, int threads)
+{
+    return unsigned((n + size_t(threads) - 1) / size_t(threads));
+}
+
+// The channel solves of one grid on the device (lb::LbGrid): density, brown mask, two copies of f for
+// every solve (a holds the current state), totals for the convergence check. The control flow of the
+// solve is lb::solveOnDevice's, the same as on the CPU.
+template <typename S>
+class CudaGrid final : public lb::LbGrid {
+public:
+    CudaGrid(const DensityGrid& density, const lb::LbParams& params, const std::vector<lb::ChannelParams>& solves,
+             Progress* progress)
+        : m_params(params), m_progress(progress), m_X(density.geometry.dims.x), m_Y(density.geometry.dims.y),
+          m_Z(density.geometry.dims.z), m_nodes(density.geometry.nodeCount())
+    {
+        std::vector<unsigned char> brownHost(m_nodes, 0);
+        if (!density.woodFraction.empty())
+            for (size_t n = 0; n < m_nodes; ++n) brownHost[n] = density.woodFraction[n] > params.brownThreshold ? 1 : 0;
+        m_rho.upload(density.density.data(), m_nodes, "density");
+        m_brown.upload(brownHost.data(), m_nodes, "brown mask");
+        m_acc.allocate(2, "reduction");
+        check(cudaMemcpyToSymbol(c_dir, lb::kC, sizeof(lb::kC)), "lattice to constant memory");
+        setSolves(solves, false);
     }
-    check(cudaMemcpyToSymbol(c_omega, om, sizeof(om)), "Omega to constant memory");
-    check(cudaMemcpyToSymbol(c_dir, lb::kC, sizeof(lb::kC)), "lattice to constant memory");
 
-    // Density and the brown mask.
-    std::vector<unsigned char> brownHost(nodes, 0);
-    if (!density.woodFraction.empty())
-        for (size_t n = 0; n < nodes; ++n) brownHost[n] = density.woodFraction[n] > params.brownThreshold ? 1 : 0;
-    DeviceBuffer<float> rho;
-    rho.upload(density.density.data(), nodes, "density");
-    DeviceBuffer<unsigned char> brown;
-    brown.upload(brownHost.data(), nodes, "brown mask");
+    void setSolves(const std::vector<lb::ChannelParams>& solves, bool interiorFollows) override
+    {
+        (void)interiorFollows;   // both copies are written in full: a kernel, cheap next to the steps
+        if (solves.empty() || solves.size() > size_t(kMaxSolves))
+            throw Error("the CUDA LB grid holds 1 to " + std::to_string(kMaxSolves) + " channel solves, not " +
+                        std::to_string(solves.size()));
+        m_solves = int(solves.size());
+        for (int s = 0; s < m_solves; ++s) {
+            m_omega[s][0] = lb::symmetricOmega(solves[size_t(s)]);
+            m_omega[s][1] = lb::symmetricOmega({solves[size_t(s)].sigmaA, solves[size_t(s)].sigmaS, -1.0f});
+        }
+        const size_t count = stride() * size_t(m_solves);
+        if (m_a.size() < count) {
+            m_a.allocate(0);
+            m_b.allocate(0);
+            m_a.allocate(count, "distributions");
+            m_b.allocate(count, "distributions");
+            m_totA.allocate(m_nodes * size_t(m_solves), "totals");
+            m_totB.allocate(m_nodes * size_t(m_solves), "totals");
+        }
+        // Boundary condition for unit intensity; the solve is linear in intensity (scaled at the end).
+        const std::vector<float> bc = lb::boundaryDistribution(m_params.sun);
+        check(cudaMemcpyToSymbol(c_bc, bc.data(), sizeof(float) * kDirections), "boundary condition to constant memory");
+        for (DeviceBuffer<S>* copy : {&m_a, &m_b})
+            initKernel<S><<<blocksFor(count, kThreads), kThreads>>>(copy->get(), count, m_X, m_Y, m_Z,
+                                                                         m_params.warmStart ? 1 : 0);
+        check(cudaGetLastError(), "LB initial state");
+    }
 
-    // Initial state (unit intensity; scaled at the end): boundary nodes hold the sun, interior 0
-    // (or the unobstructed field with warmStart). Both buffers start equal.
-    const std::vector<float> bc = lb::boundaryDistribution(params.sun);
-    const size_t solveStride = nodes * kDirections;
-    std::vector<S> init(solveStride * size_t(ns), toStorage<S>(0.0f));
-    for (int s = 0; s < ns; ++s)
-        for (int i = 0; i < X; ++i)
-            for (int j = 0; j < Y; ++j)
-                for (int m = 0; m < kDirections; ++m) {
-                    S* row = &init[size_t(s) * solveStride + ((size_t(i) * size_t(Y) + size_t(j)) * kDirections + size_t(m)) * size_t(Z)];
-                    const bool wholeRow = params.warmStart || i == 0 || j == 0 || i == X - 1 || j == Y - 1;
-                    for (int k = 0; k < Z; ++k)
-                        if (wholeRow || k == 0 || k == Z - 1) row[k] = toStorage<S>(bc[size_t(m)]);
-                }
-    DeviceBuffer<S> a, b;
-    a.upload(init.data(), init.size(), "distributions");
-    b.upload(init.data(), init.size(), "distributions");
-    init.clear();
-    init.shrink_to_fit();
-
-    const int threads = 128;
-    const dim3 grid(unsigned((nodes + threads - 1) / threads), unsigned(ns));
-    const int steps = params.tolerance > 0.0 ? (params.maxSteps > 0 ? params.maxSteps : 4 * density.geometry.longestEdge())
-                                             : lb::fixedSteps(params, dims);
-    const int checkEvery = params.checkEvery > 0 ? params.checkEvery : 16;
-    DeviceBuffer<float> totA(nodes * size_t(ns), "totals"), totB(nodes * size_t(ns), "totals");
-    DeviceBuffer<double> acc(2, "reduction");
-    lb::SolveStats st;
-    st.channelSolves = ns;
-    int taken = 0;
-    for (int step = 0; step < steps; ++step) {
-        const bool checkNow = params.tolerance > 0.0 && (step + 1) % checkEvery == 0;
-        // The check measures the change of every solve's output over one step.
-        if (checkNow) totalsKernel<S><<<grid, threads>>>(a.get(), totA.get(), Z, nodes, solveStride);
-        stepKernel<S><<<grid, threads>>>(a.get(), b.get(), rho.get(), brown.get(), X, Y, Z, solveStride,
-                                         params.zeroF0 ? 1 : 0);
-        check(cudaGetLastError(), "LB step kernel");
-        std::swap(a, b);
-        ++taken;
-        if (checkNow) {
-            totalsKernel<S><<<grid, threads>>>(a.get(), totB.get(), Z, nodes, solveStride);
-            check(cudaMemset(acc.get(), 0, 2 * sizeof(double)), "reduction reset");
-            const size_t all = nodes * size_t(ns);
-            changeKernel<<<unsigned((all + 255) / 256), 256>>>(totB.get(), totA.get(), all, acc.get());
-            double h[2];
-            acc.download(h, 2, "convergence check");
-            const double change = h[1] > 0.0 ? std::sqrt(h[0] / h[1]) : 0.0;
-            st.lastChange = change;
-            st.changeHistory.emplace_back(taken, change);
-            if (change < params.tolerance) {
-                st.converged = true;
-                break;
+    double advanceBlock(int levels, int compareLevel) override
+    {
+        // Constant memory is shared by every grid: this grid's Omega goes in before its steps.
+        check(cudaMemcpyToSymbol(c_omega, m_omega, sizeof(m_omega)), "Omega to constant memory");
+        const dim3 grid(blocksFor(m_nodes, kThreads), unsigned(m_solves));
+        const bool compare = compareLevel >= 1 && compareLevel < levels;
+        for (int l = 0; l < levels; ++l) {
+            if (m_progress) m_progress->throwIfCancelled();
+            if (compare && l == compareLevel - 1)
+                totalsKernel<S><<<grid, kThreads>>>(m_a.get(), m_totA.get(), m_Z, m_nodes, stride());
+            if (compare && l == compareLevel) {
+                // The change of every solve's node totals over one step (sum over the solves).
+                totalsKernel<S><<<grid, kThreads>>>(m_a.get(), m_totB.get(), m_Z, m_nodes, stride());
+                check(cudaMemsetAsync(m_acc.get(), 0, 2 * sizeof(double)), "reduction reset");
+                const size_t all = m_nodes * size_t(m_solves);
+                changeKernel<<<blocksFor(all, 256), 256>>>(m_totB.get(), m_totA.get(), all, m_acc.get());
             }
+            stepKernel<S><<<grid, kThreads>>>(m_a.get(), m_b.get(), m_rho.get(), m_brown.get(), m_X, m_Y, m_Z, stride(),
+                                              m_params.zeroF0 ? 1 : 0);
+            check(cudaGetLastError(), "LB step kernel");
+            std::swap(m_a, m_b);
         }
-        if (progress && (step % 8 == 7 || step + 1 == steps)) {
-            check(cudaDeviceSynchronize(), "LB step");
-            progress->report(double(step + 1) / double(steps), "LB step " + std::to_string(step + 1) + "/" + std::to_string(steps));
+        if (!compare) {
+            check(cudaDeviceSynchronize(), "LB steps");
+            return 0.0;
         }
+        double h[2];
+        m_acc.download(h, 2, "convergence check");
+        return h[1] > 0.0 ? std::sqrt(h[0] / h[1]) : 0.0;
     }
-    check(cudaDeviceSynchronize(), "LB solve");
 
-    // Output: total density per node and channel, times the channel's intensity.
-    LightingGrid out;
-    out.geometry = density.geometry;
-    out.rgb.assign(nodes * 3, 0.0f);
-    std::vector<float> tot(nodes * size_t(ns));
-    totalsKernel<S><<<grid, threads>>>(a.get(), totA.get(), Z, nodes, solveStride);
-    check(cudaGetLastError(), "totals kernel");
-    totA.download(tot.data(), tot.size(), "lighting grid");
-    for (int c = 0; c < 3; ++c)
-        for (size_t n = 0; n < nodes; ++n) out.rgb[n * 3 + size_t(c)] = tot[size_t(solveOf[c]) * nodes + n] * params.intensity[c];
-    st.steps = taken;
-    st.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    st.bytesPerStep = double(solveStride) * double(ns) * sizeof(S) * 2.0;
-    if (stats) *stats = st;
-    return out;
-}
+    // Steps between the host's progress and cancel checks (each block ends in a synchronization); the
+    // CPU's wavefront depth on grids up to ~300 nodes a side, so both check convergence at the same steps.
+    int autoLevels() const override { return 16; }
+
+    void prolongateFrom(const lb::LbGrid& coarseGrid) override
+    {
+        const CudaGrid<S>& coarse = dynamic_cast<const CudaGrid<S>&>(coarseGrid);
+        if (coarse.m_solves != m_solves) throw Error("coarse start: the coarse grid holds other channel solves");
+        const dim3 grid(blocksFor(stride(), kThreads), unsigned(m_solves));
+        prolongKernel<S><<<grid, kThreads>>>(coarse.m_a.get(), m_a.get(), coarse.m_X, coarse.m_Y, coarse.m_Z, m_X, m_Y,
+                                             m_Z, coarse.stride(), stride());
+        check(cudaGetLastError(), "coarse start interpolation");
+    }
+
+    void totals(size_t s, std::vector<float>& out) override
+    {
+        totalsKernel<S><<<dim3(blocksFor(m_nodes, kThreads), 1), kThreads>>>(m_a.get() + s * stride(), m_totA.get(), m_Z,
+                                                                                 m_nodes, stride());
+        check(cudaGetLastError(), "totals kernel");
+        out.resize(m_nodes);
+        m_totA.download(out.data(), m_nodes, "lighting grid");
+    }
+
+private:
+    static constexpr int kThreads = 128;
+    size_t stride() const { return m_nodes * kDirections; }
+
+    const lb::LbParams& m_params;
+    Progress* m_progress;
+    int m_X, m_Y, m_Z;
+    size_t m_nodes;
+    int m_solves = 0;
+    SymmetricOmega m_omega[kMaxSolves][2];   // [solve][green, brown]
+    DeviceBuffer<float> m_rho;
+    DeviceBuffer<unsigned char> m_brown;
+    DeviceBuffer<S> m_a, m_b;
+    DeviceBuffer<float> m_totA, m_totB;
+    DeviceBuffer<double> m_acc;
+};
+
+// The CUDA device of the shared control flow: grids in device memory, refused (BackendError, so the
+// job reruns on the CPU) when one channel's distributions do not fit.
+class CudaDevice final : public lb::LbDevice {
+public:
+    double availableBytes() const override
+    {
+        size_t freeBytes = 0, totalBytes = 0;
+        check(cudaMemGetInfo(&freeBytes, &totalBytes), "device memory query");
+        return double(freeBytes);
+    }
+    std::string memoryName() const override { return "device memory"; }
+    [[noreturn]] void refuseMemory(const std::string& message) const override { throw BackendError("CUDA: " + message); }
+    std::unique_ptr<lb::LbGrid> makeGrid(const DensityGrid& density, const lb::LbParams& params,
+                                         const std::vector<lb::ChannelParams>& solves, Progress* progress) override
+    {
+        if (params.storage == lb::Storage::Fp16) return std::make_unique<CudaGrid<__half>>(density, params, solves, progress);
+        return std::make_unique<CudaGrid<float>>(density, params, solves, progress);
+    }
+};
 
 } // namespace
 
@@ -260,10 +327,8 @@ double deviceCopyBandwidth(size_t bytes, int reps)
 LightingGrid solveLightingCuda(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
                                lb::SolveStats* stats)
 {
-    lb::validate(params);
-    lb::validateDensity(density);
-    if (params.storage == lb::Storage::Fp16) return solveTyped<__half>(density, params, progress, stats);
-    return solveTyped<float>(density, params, progress, stats);
+    CudaDevice device;
+    return lb::solveOnDevice(device, density, params, progress, stats);
 }
 
 } // namespace sylva::cuda

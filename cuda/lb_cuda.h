@@ -8,7 +8,9 @@
 
 namespace sylva::cuda {
 
-// Solves all three channels on the current device (channels with equal optics share one solve).
+// Solves all three channels on the current device with the CPU's control flow (lb::solveOnDevice):
+// every LbParams option as on the CPU (channels with equal optics share one solve, solves per pass,
+// coarse start, check period). A grid too large for the free device memory throws BackendError.
 // Throws Error on bad input, BackendError on device trouble, Cancelled when cancelled.
 LightingGrid solveLightingCuda(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
                                lb::SolveStats* stats);

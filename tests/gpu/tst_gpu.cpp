@@ -123,6 +123,82 @@ private Q_SLOTS:
 #endif
     }
 
+    // Coarse start on the GPU: the same levels as the CPU (coarse steps counted), the same answer
+    // within the tolerance's reach, and closer to the steady state than a tolerance run from zero.
+    void lbCoarseStartMatchesCpu_data()
+    {
+        QTest::addColumn<bool>("fp16");
+        QTest::newRow("fp32") << false;
+        QTest::newRow("fp16") << true;
+    }
+    void lbCoarseStartMatchesCpu()
+    {
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
+        QFETCH(bool, fp16);
+        const DensityGrid d = randomDensity({40, 36, 45}, 5, true);
+        lb::LbParams p = lb::paramsFromPreset(*lb::findPreset("leaf"));
+        p.sun = {0.3f, 1.0f, -0.2f};
+        p.storage = fp16 ? lb::Storage::Fp16 : lb::Storage::Fp32;
+        p.tolerance = 1e-4;
+        p.coarseStart = true;
+        lb::SolveStats cs, gs;
+        const LightingGrid cpu = lb::solveLighting(d, p, nullptr, &cs);
+        const LightingGrid gpu = cuda::solveLightingCuda(d, p, nullptr, &gs);
+        const double err = relativeL2(gpu, cpu);
+        qInfo("coarse start: relative L2 GPU vs CPU %.3g (fine steps CPU %d, GPU %d; coarse CPU %d, GPU %d)", err, cs.steps,
+              gs.steps, cs.coarseSteps, gs.coarseSteps);
+        QVERIFY(cs.coarseSteps > 0);
+        QVERIFY(gs.coarseSteps > 0);
+        QCOMPARE(gs.converged, cs.converged);
+        QVERIFY(std::isfinite(err));
+        // Where a check falls on the other side of the tolerance the stop moves by a block: the
+        // difference is then the tolerance's error (~1e-3 here), else float rounding.
+        const bool sameSteps = gs.steps == cs.steps && gs.coarseSteps == cs.coarseSteps;
+        QVERIFY2(err < (fp16 ? 3e-3 : (sameSteps ? 1e-4 : 3e-3)), qPrintable(QString("error %1").arg(err)));
+        // From zero the GPU takes more fine steps to the same tolerance.
+        p.coarseStart = false;
+        lb::SolveStats plain;
+        cuda::solveLightingCuda(d, p, nullptr, &plain);
+        QVERIFY2(gs.steps < plain.steps, qPrintable(QString("coarse %1 vs plain %2 steps").arg(gs.steps).arg(plain.steps)));
+#endif
+    }
+
+    // Solves per pass on the GPU: advancing the three channels together gives each the bits it gets
+    // alone (fixed steps), and the CPU's numbers; in tolerance mode the GPU stops where the CPU does
+    // with the same grouping (the check measures the group's change).
+    void lbSolvesPerPassMatchesCpu()
+    {
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
+        const DensityGrid d = randomDensity({21, 17, 26}, 4, true);
+        lb::LbParams p = lb::paramsFromPreset(*lb::findPreset("leaf"));
+        p.sun = {0.3f, 1.0f, -0.2f};
+        p.solvesPerPass = 1;
+        const LightingGrid one = cuda::solveLightingCuda(d, p, nullptr, nullptr);
+        p.solvesPerPass = 3;
+        lb::SolveStats cs, gs;
+        const LightingGrid three = cuda::solveLightingCuda(d, p, nullptr, &gs);
+        const LightingGrid cpu = lb::solveLighting(d, p, nullptr, &cs);
+        QVERIFY(std::memcmp(one.rgb.data(), three.rgb.data(), one.rgb.size() * sizeof(float)) == 0);
+        QCOMPARE(gs.steps, cs.steps);
+        QCOMPARE(gs.channelSolves, 3);
+        QVERIFY2(relativeL2(three, cpu) < 1e-5, qPrintable(QString("error %1").arg(relativeL2(three, cpu))));
+        p.tolerance = 1e-4;
+        for (int perPass : {1, 2, 3}) {
+            p.solvesPerPass = perPass;
+            lb::SolveStats ct, gt;
+            const LightingGrid c = lb::solveLighting(d, p, nullptr, &ct);
+            const LightingGrid g = cuda::solveLightingCuda(d, p, nullptr, &gt);
+            qInfo("tolerance, %d solves per pass: steps CPU %d, GPU %d, relative L2 %.3g", perPass, ct.steps, gt.steps,
+                  relativeL2(g, c));
+            QCOMPARE(gt.converged, ct.converged);
+            QVERIFY(std::abs(gt.steps - ct.steps) <= gt.blockSteps);   // a check may fall either side of the tolerance
+            QVERIFY2(relativeL2(g, c) < (gt.steps == ct.steps ? 1e-5 : 3e-3), qPrintable(QString("error %1").arg(relativeL2(g, c))));
+        }
+#endif
+    }
+
     // 100k random rays: the GPU finds the same closest hits and any-hit answers as the CPU.
     void raysMatchCpu()
     {
