@@ -16,6 +16,7 @@
 #include "core/base/error.h"
 #include "core/scene/quality.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/scene/scene_fields.h"
 #include "pipeline/scene/scene_file.h"
 
 using namespace sylva;
@@ -236,6 +237,40 @@ Scene fullScene(const QString& sceneDir)
     s.camera = {{10.5, 3.25, -40.0}, {1.0, 4.0, 2.0}, {0.0f, 1.0f, 0.1f}, 33.3f};
     s.render = {1920, 1080, 64, RenderMode::Lb, AccelKind::KdTree, false, 0.75f, 0.3f, 87.5f, 33.25f};
     return s;
+}
+
+// The rows of the "Fields" table of docs/SCENE.md: | `key` | type | default | rule |, keys under a bold
+// section row (**`species[i]`**) written relative to it (`.name`), backticks dropped from defaults.
+std::vector<json::FieldDoc> documentedFields(const QString& markdown)
+{
+    std::vector<json::FieldDoc> rows;
+    const QStringList lines = markdown.split(QLatin1Char('\n'));
+    qsizetype at = lines.indexOf(QStringLiteral("| key | type | default | rule |"));
+    if (at < 0) return rows;
+    std::string section;
+    for (at += 2; at < lines.size() && lines[at].startsWith(QLatin1String("| ")); ++at) {
+        QString line = lines[at].trimmed().mid(1);
+        if (line.endsWith(QLatin1Char('|'))) line.chop(1);
+        const QStringList cells = line.split(QLatin1Char('|'));   // no cell of the table holds a '|'
+
+        if (cells.size() != 4) {
+            rows.push_back({"(malformed row) " + lines[at].toStdString(), "", "", "", false});
+            continue;
+        }
+        json::FieldDoc d;
+        QString key = cells[0].trimmed();
+        d.section = key.startsWith(QLatin1String("**"));
+        key.remove(QLatin1Char('*')).remove(QLatin1Char('`'));
+        if (d.section) section = key.toStdString();
+        if (key.startsWith(QLatin1Char('.'))) d.key = section + key.toStdString();
+        else d.key = key.toStdString();
+        if (!d.section && !key.startsWith(QLatin1Char('.'))) section.clear();
+        d.type = cells[1].trimmed().toStdString();
+        d.defaultValue = QString(cells[2].trimmed()).remove(QLatin1Char('`')).toStdString();
+        d.rule = cells[3].trimmed().toStdString();
+        rows.push_back(d);
+    }
+    return rows;
 }
 
 } // namespace
@@ -609,6 +644,47 @@ private Q_SLOTS:
                                  "grid 96", "tolerance 0.0001", "fp16", "300 steps", "ground: none", "sun: toward", "5200 K", "camera: at",
                                  "render: 1920x1080, 64 spp, mode lb, kdtree, shadows off"})
             QVERIFY2(d.find(part) != std::string::npos, part);
+    }
+    // docs/SCENE.md's field table is the scene field table: every key with its type, default and rule,
+    // in the same order, and no key the table lacks.
+    void sceneDocMatchesFieldTable()
+    {
+        QFile doc(QStringLiteral(SYLVA_SOURCE_DIR "/docs/SCENE.md"));
+        QVERIFY2(doc.open(QIODevice::ReadOnly), qPrintable(doc.fileName()));
+        const std::vector<json::FieldDoc> documented = documentedFields(QString::fromUtf8(doc.readAll()));
+        const std::vector<json::FieldDoc> declared = sceneFieldDocs();
+        QVERIFY(declared.size() > 40);
+        auto find = [](const std::vector<json::FieldDoc>& rows, const std::string& key) {
+            json::FieldDoc none;
+            none.key = "(no such key)";
+            for (const auto& r : rows)
+                if (r.key == key) return r;
+            return none;
+        };
+        for (const json::FieldDoc& d : declared) {
+            const json::FieldDoc row = find(documented, d.key);
+            QVERIFY2(row.key == d.key, qPrintable(QString::fromStdString("docs/SCENE.md does not document " + d.key)));
+            QVERIFY2(row.defaultValue == d.defaultValue,
+                     qPrintable(QString::fromStdString(d.key + ": SCENE.md says default '" + row.defaultValue + "', the table '" + d.defaultValue + "'")));
+            QVERIFY2(row.type == d.type, qPrintable(QString::fromStdString(d.key + ": SCENE.md says type '" + row.type + "', the table '" + d.type + "'")));
+            QVERIFY2(row.rule == d.rule, qPrintable(QString::fromStdString(d.key + ": SCENE.md says rule\n  '" + row.rule + "', the table\n  '" + d.rule + "'")));
+            QVERIFY2(row.section == d.section, qPrintable(QString::fromStdString(d.key + ": a section row in one and not the other")));
+        }
+        for (const json::FieldDoc& row : documented)
+            QVERIFY2(find(declared, row.key).key == row.key,
+                     qPrintable(QString::fromStdString("docs/SCENE.md documents " + row.key + ", which the field table lacks")));
+        QCOMPARE(documented.size(), declared.size());
+        for (size_t i = 0; i < declared.size(); ++i)
+            QVERIFY2(documented[i].key == declared[i].key,
+                     qPrintable(QString::fromStdString("row " + std::to_string(i) + ": SCENE.md has " + documented[i].key + ", the table " + declared[i].key)));
+        // The documented defaults are what a scene without those keys reads as.
+        const Scene s = parseScene(R"({"version": 1, "species": [{"name": "b", "grow": {}}], "instances": [{"species": "b", "position": [0, 0, 0]}]})",
+                                   dir().toStdString(), kName);
+        QCOMPARE(find(declared, "render.width").defaultValue, std::to_string(s.render.width));
+        QCOMPARE(find(declared, "species[i].lighting.grid").defaultValue, std::to_string(s.species[0].grid));
+        QCOMPARE(find(declared, "species[i].lighting.steps_per_edge").defaultValue, std::to_string(s.species[0].lighting.stepsPerEdge));
+        QCOMPARE(find(declared, "species[i].grow.seed").defaultValue, std::to_string(GrowSpec{}.seed));
+        QCOMPARE(QString::fromStdString(find(declared, "render.mode").defaultValue), QStringLiteral("\"%1\"").arg(renderModeName(s.render.mode)));
     }
 };
 

@@ -1,0 +1,406 @@
+// The scene file's field table: each key once, with its type, bounds, default (from the records of
+// core/scene/scene.h), a one-line doc (docs/SCENE.md's rule column) and its words in `sylva info`.
+#include "pipeline/scene/scene_fields.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "pipeline/grow/tree_grower.h"
+#include "pipeline/scene/scene_file.h"
+#include "pipeline/scene/scene_species.h"
+#include "pipeline/scene/summary_text.h"
+
+namespace sylva {
+
+using json::above;
+using json::atLeast;
+using json::Bounds;
+using json::JsonReader;
+using json::JsonWriter;
+using json::KeyPath;
+using json::Layout;
+using json::Table;
+using json::TableBuilder;
+
+namespace {
+
+SceneReadContext& in(JsonReader& r) { return static_cast<SceneReadContext&>(r); }
+SceneWriteContext& out(JsonWriter& w) { return static_cast<SceneWriteContext&>(w); }
+
+constexpr long long kMaxSeed = 1LL << 62;
+const float kNoUpperBound = std::numeric_limits<float>::max();
+
+// A per-channel LB parameter: one number for all channels or [r, g, b].
+json::Field<SpeciesDesc>& channels(TableBuilder<SpeciesDesc>& b, const char* key, float lb::ChannelParams::*member)
+{
+    return b.custom(
+        key,
+        [member](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) {
+            const glm::vec3 rgb = r.perChannel(v, p);
+            for (int c = 0; c < 3; ++c) d.lighting.channels[size_t(c)].*member = rgb[c];
+        },
+        [member](JsonWriter& w, const SpeciesDesc& d, const KeyPath& p, int) {
+            const auto& ch = d.lighting.channels;
+            w.vector3(glm::vec3(ch[0].*member, ch[1].*member, ch[2].*member), p);
+        });
+}
+
+const Table<GrowSpec>& growTable()
+{
+    static const Table<GrowSpec> table = [] {
+        TableBuilder<GrowSpec> b(Layout::Inline);
+        b.custom(
+             "species",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, GrowSpec& g) { g.species = readGrowerSpecies(in(r), v, p); },
+             [](JsonWriter& w, const GrowSpec& g, const KeyPath&, int) { w.string(g.species); })
+            .doc("string", "`broadleaf`, `birch`, `conifer`, `shrub` (any case; stored lower-case)");
+        b.integer("seed", &GrowSpec::seed, 0, kMaxSeed).doc("integer", "0 .. 2^62");
+        b.integer("triangles", &GrowSpec::triangles, (long long)kMinGrowTriangles, (long long)kMaxGrowTriangles)
+            .doc("integer", "1000 .. 1000000");
+        b.number("height", &GrowSpec::height, Bounds{.lo = 0.1, .hi = 150.0, .unit = " metres", .orZero = " (the species' default)"})
+            .doc("number", "metres; 0 = the species' default, else 0.1 .. 150");
+        return b.table;
+    }();
+    return table;
+}
+
+// Over the species: the preset and grid live beside the LB parameters.
+const Table<SpeciesDesc>& lightingTable()
+{
+    static const Table<SpeciesDesc> table = [] {
+        TableBuilder<SpeciesDesc> b(Layout::Inline, defaultSpecies());
+        b.custom(
+             "preset", [](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) { readLightingPreset(in(r), v, p, d); },
+             [](JsonWriter& w, const SpeciesDesc& d, const KeyPath&, int) { w.string(d.preset); })
+            .doc("string", "`leaf`, `dogrose`, `cloud`, `pmma` (LB_MODEL.md presets)")
+            .readWhenAbsent = true;   // first: the overrides below apply to the preset's parameters
+        channels(b, "sigma_a", &lb::ChannelParams::sigmaA)
+            .doc("number or `[r, g, b]`", "absorption per lattice step; one number sets all channels").shown("preset's");
+        channels(b, "sigma_s", &lb::ChannelParams::sigmaS)
+            .doc("number or `[r, g, b]`", "scattering per lattice step").shown("preset's");
+        channels(b, "g", &lb::ChannelParams::g)
+            .doc("number or `[r, g, b]`", "Henyey-Greenstein asymmetry").shown("preset's");
+        b.boolean("zero_f0", [](auto& d) -> auto& { return d.lighting.zeroF0; })
+            .doc("bool", "`true` for plants (zero f_0 each step), `false` keeps absorbed light (clouds, plastics)")
+            .shown("preset's");
+        b.integer("grid", &SpeciesDesc::grid, 8, 512).doc("integer", "LB grid nodes along the longest edge, 8 .. 512");
+        b.custom(
+             "steps",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) {
+                 // A step count (0: steps_per_edge x the longest edge) asks for fixed steps.
+                 d.lighting.steps = int(r.integer(v, p, 0, 1000000));
+                 d.lighting.tolerance = 0.0;
+             },
+             [](JsonWriter& w, const SpeciesDesc& d, const KeyPath&, int) { w.integer((long long)d.lighting.steps); })
+            .doc("integer", "fixed step count, 0 .. 1000000; 0 = `steps_per_edge` x the longest grid edge");
+        b.integer("steps_per_edge", [](auto& d) -> auto& { return d.lighting.stepsPerEdge; }, 1, 64)
+            .doc("integer",
+                 "1 .. 64: with `steps` 0, steps per node of the longest edge (2 = the seed's count). The default 1 is the cheapest "
+                 "solve at its error on the measured fronts ([ACCURACY.md](ACCURACY.md)): the LB's transport error against Monte "
+                 "Carlo (5-11%) dwarfs the under-0.7% the seed's 2 x or a tolerance would change");
+        b.number("tolerance", [](auto& d) -> auto& { return d.lighting.tolerance; }, atLeast(0.0, " (0: fixed step count)"))
+            .doc("number",
+                 "> 0: solve until the relative change per step falls below it (checked about every 16 steps, at most 4 x the "
+                 "longest edge); 0: fixed steps; excludes `steps` > 0");
+        b.custom(
+             "fp16",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) {
+                 d.lighting.storage = r.boolean(v, p) ? lb::Storage::Fp16 : lb::Storage::Fp32;
+             },
+             [](JsonWriter& w, const SpeciesDesc& d, const KeyPath&, int) { w.boolean(d.lighting.storage == lb::Storage::Fp16); })
+            .doc("bool",
+                 "store the distributions in half precision (changes the error against the reference by under 3e-4, half the "
+                 "memory, 0.6-0.8x the time at grids 64-128; false: fp32)");
+        b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& p, SpeciesDesc& d) { checkLighting(in(r), p, d); };
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<SpeciesDesc>& speciesTable()
+{
+    static const Table<SpeciesDesc> table = [] {
+        TableBuilder<SpeciesDesc> b(Layout::Block, defaultSpecies());
+        b.custom(
+             "name", [](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) { readSpeciesName(in(r), v, p, d); },
+             [](JsonWriter& w, const SpeciesDesc& d, const KeyPath&, int) { w.string(d.name); })
+            .doc("string", "non-empty, unique among species")
+            .required("missing (required)")
+            .shown("required")
+            .thenCheck([](JsonReader& r, const QJsonObject& o, const KeyPath& p, SpeciesDesc&) { checkMeshOrGrow(in(r), o, p); });
+        b.custom(
+             "mesh", [](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) { d.meshPath = readMeshPath(in(r), v, p); },
+             [](JsonWriter& w, const SpeciesDesc& d, const KeyPath& p, int) { writeMeshPath(out(w), d, p); })
+            .doc("string",
+                 "mesh file (any format the importer reads); relative paths start at the scene file's folder; must exist and be a "
+                 "regular file")
+            .shown("-")
+            .writtenIf([](const SpeciesDesc& d) { return !d.grow; });
+        b.optionalObject("grow", &SpeciesDesc::grow, growTable())
+            .doc("object", "a procedural tree (`sylva grow`); give `mesh` or `grow`, not both")
+            .shown("-");
+        b.custom(
+             "leaf_materials",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) { readLeafMaterials(in(r), v, p, d); },
+             [](JsonWriter& w, const SpeciesDesc& d, const KeyPath&, int) { writeLeafMaterials(w, d); })
+            .doc("array of strings", "material names that are leaves (overrides the importer's leaf/wood split)");
+        b.object("lighting", [](auto& d) -> auto& { return d; }, lightingTable())
+            .doc("object", "LB lighting of the species' grid")
+            .shown("{}");
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<InstanceDesc>& instanceTable()
+{
+    static const Table<InstanceDesc> table = [] {
+        TableBuilder<InstanceDesc> b(Layout::Inline);
+        b.custom(
+             "species", [](JsonReader& r, const QJsonValue& v, const KeyPath& p, InstanceDesc& i) { readInstanceSpecies(in(r), v, p, i); },
+             [](JsonWriter& w, const InstanceDesc& i, const KeyPath& p, int) { writeInstanceSpecies(out(w), i, p); })
+            .doc("string", "name of a declared species")
+            .required("missing (required: the name of a species)")
+            .shown("required");
+        b.vector("position", &InstanceDesc::position)
+            .doc("`[x, y, z]`", "metres (read as doubles)")
+            .required("missing (required)")
+            .shown("required");
+        b.custom(
+             "rotation", [](JsonReader& r, const QJsonValue& v, const KeyPath& p, InstanceDesc& i) { readRotation(in(r), v, p, i); },
+             [](JsonWriter& w, const InstanceDesc& i, const KeyPath& p, int) { writeRotation(out(w), i, p); })
+            .doc("`[rx, ry, rz]` or number", "degrees, applied X, then Y, then Z; a number is degrees about +Y")
+            .shown("[0, 0, 0]");
+        b.number("scale", &InstanceDesc::scale, above(0.0)).doc("number", "uniform, > 0");
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<GroundDesc>& groundTable()
+{
+    static const Table<GroundDesc> table = [] {
+        TableBuilder<GroundDesc> b(Layout::Inline);
+        b.boolean("enabled", &GroundDesc::enabled).doc("bool", "a ground plane").summarized([](const GroundDesc& g) {
+            return std::string(g.enabled ? "plane" : "none");
+        });
+        b.number("height", &GroundDesc::height)
+            .doc("number", "world y of the plane, metres")
+            .summarized([](const GroundDesc& g) { return g.enabled ? " at y = " + human(g.height) + " m" : std::string(); }, true);
+        b.color("color", &GroundDesc::color, 0.0f, 1.0f).doc("`[r, g, b]`", "albedo, each in [0, 1]").summarized([](const GroundDesc& g) {
+            return g.enabled ? "albedo " + human3(g.color) : std::string();
+        });
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<SunDesc>& sunTable()
+{
+    static const Bounds elevationBounds{.lo = -90.0, .hi = 90.0, .unit = " degrees"};
+    static const Table<SunDesc> table = [] {
+        TableBuilder<SunDesc> b(Layout::Inline);
+        b.vector("direction", &SunDesc::direction, true)
+            .doc("`[x, y, z]`", "toward the sun, any length (non-zero)")
+            .summarized([](const SunDesc& s) {
+                const glm::dvec3 sun(s.direction);   // elevation and azimuth in double
+                const double len = glm::length(sun);
+                const double elevation = len > 0.0 ? std::asin(std::clamp(sun.y / len, -1.0, 1.0)) * 180.0 / M_PI : 0.0;
+                const double azimuth = std::atan2(sun.x, sun.z) * 180.0 / M_PI;
+                char buf[160];
+                std::snprintf(buf, sizeof buf, " (elevation %.1f deg, azimuth %.1f deg)", elevation, azimuth < 0.0 ? azimuth + 360.0 : azimuth);
+                return "toward " + human3(s.direction) + buf;
+            });
+        // Another form of the direction: read together once both are known, never written.
+        b.custom("elevation", nullptr, nullptr).doc("number", "degrees above the horizon, -90 .. 90; needs `azimuth`").shown("-");
+        b.custom("azimuth", nullptr, nullptr)
+            .doc("number", "degrees, 0 = +Z, 90 = +X; needs `elevation`")
+            .shown("-")
+            .thenCheck([](JsonReader& r, const QJsonObject& o, const KeyPath& path, SunDesc& sun) {
+                if (!o.contains(QLatin1String("elevation"))) return;
+                const double elevation = r.number(o.value(QLatin1String("elevation")), path.field("elevation"));
+                const double azimuth = r.number(o.value(QLatin1String("azimuth")), path.field("azimuth"));
+                if (!elevationBounds.holds(elevation))
+                    r.fail(path.field("elevation"), elevationBounds.problem() + ", got " + json::fmt(elevation));
+                sun.direction = sunDirection(elevation, azimuth);
+            });
+        b.number("temperature", &SunDesc::temperature, Bounds{.lo = 1000.0, .hi = 40000.0, .unit = " kelvin"})
+            .doc("number", "blackbody colour temperature, 1000 .. 40000 K")
+            .summarized([](const SunDesc& s) {
+                char buf[64];
+                std::snprintf(buf, sizeof buf, "%.0f K", s.temperature);
+                return std::string(buf);
+            });
+        b.number("intensity", &SunDesc::intensity, atLeast(0.0))
+            .doc("number", "scales the sun's radiance, >= 0")
+            .summarized([](const SunDesc& s) { return "intensity " + human(s.intensity); });
+        b.table.before = [](JsonReader& r, const QJsonObject& o, const KeyPath& path, SunDesc&) {
+            const bool hasDirection = o.contains(QLatin1String("direction"));
+            const bool hasElevation = o.contains(QLatin1String("elevation")), hasAzimuth = o.contains(QLatin1String("azimuth"));
+            if (hasDirection && (hasElevation || hasAzimuth))
+                r.fail(path, "give either \"direction\" or \"elevation\" and \"azimuth\", not both");
+            if (hasElevation && !hasAzimuth) r.fail(path.field("azimuth"), "missing (required with \"elevation\")");
+            if (hasAzimuth && !hasElevation) r.fail(path.field("elevation"), "missing (required with \"azimuth\")");
+        };
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<Scene>& skyTable()
+{
+    static const Table<Scene> table = [] {
+        TableBuilder<Scene> b(Layout::Inline);
+        b.color("color", &Scene::sky, 0.0f, kNoUpperBound).doc("`[r, g, b]`", "background radiance, each >= 0").summarized([](const Scene& s) {
+            return "radiance " + human3(s.sky);
+        });
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<CameraDesc>& cameraTable()
+{
+    static const Table<CameraDesc> table = [] {
+        TableBuilder<CameraDesc> b(Layout::Inline);
+        b.vector("position", &CameraDesc::position).doc("`[x, y, z]`", "metres").summarized([](const CameraDesc& c) {
+            return "at " + human3(c.position);
+        });
+        b.vector("target", &CameraDesc::target)
+            .doc("`[x, y, z]`", "metres; must differ from `position`")
+            .summarized([](const CameraDesc& c) { return " looking at " + human3(c.target); }, true);
+        b.vector("up", &CameraDesc::up)
+            .doc("`[x, y, z]`", "non-zero, not parallel to `target - position`")
+            .summarized([](const CameraDesc& c) { return "up " + human3(c.up); });
+        b.number("fov", &CameraDesc::fovY, Bounds{.lo = 0.0, .hi = 180.0, .loOpen = true, .hiOpen = true, .unit = " degrees"})
+            .doc("number", "vertical field of view, degrees, in (0, 180)")
+            .summarized([](const CameraDesc& c) { return "vertical fov " + human(c.fovY) + " deg"; });
+        b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& path, CameraDesc& cam) {
+            const glm::dvec3 view = cam.target - cam.position;
+            const double viewLength = glm::length(view);
+            if (!(viewLength > 0.0) || !std::isfinite(viewLength))
+                r.fail(path.field("target"), "must differ from camera.position " + json::fmt3(cam.position));
+            if (!(glm::length(cam.up) >= 1e-12f)) r.fail(path.field("up"), "must be a non-zero vector (length >= 1e-12)");
+            const glm::dvec3 up(cam.up);
+            const double upLength = glm::length(up);
+            if (glm::length(glm::cross(view / viewLength, up / upLength)) < 1e-6)
+                r.fail(path.field("up"), json::fmt3(up) + " is parallel to the view direction (target - position) " + json::fmt3(view));
+        };
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<RenderSettings>& renderTable()
+{
+    static const Table<RenderSettings> table = [] {
+        TableBuilder<RenderSettings> b(Layout::Inline);
+        b.integer("width", &RenderSettings::width, 1, 32768).doc("integer", "pixels, 1 .. 32768").summarized([](const RenderSettings& r) {
+            return std::to_string(r.width);
+        });
+        b.integer("height", &RenderSettings::height, 1, 32768)
+            .doc("integer", "pixels, 1 .. 32768")
+            .summarized([](const RenderSettings& r) { return "x" + std::to_string(r.height); }, true);
+        b.integer("spp", &RenderSettings::spp, 1, 4096).doc("integer", "samples per pixel, 1 .. 4096").summarized([](const RenderSettings& r) {
+            return std::to_string(r.spp) + " spp";
+        });
+        b.enumeration("mode", &RenderSettings::mode, parseRenderMode, renderModeName, "mode", "full, local, ambient, lb")
+            .doc("string", "`full`, `local`, `ambient`, `lb`")
+            .summarized([](const RenderSettings& r) { return std::string("mode ") + renderModeName(r.mode); });
+        b.enumeration("accel", &RenderSettings::accel, parseAccel, accelName, "acceleration structure", "bvh, kdtree")
+            .doc("string", "`bvh`, `kdtree`")
+            .summarized([](const RenderSettings& r) { return std::string(accelName(r.accel)); });
+        b.boolean("shadows", &RenderSettings::shadows).doc("bool", "sun shadows").summarized([](const RenderSettings& r) {
+            return std::string("shadows ") + (r.shadows ? "on" : "off");
+        });
+        b.number("indirect", &RenderSettings::indirectScale, atLeast(0.0))
+            .doc("number", "weight of the LB indirect light, >= 0")
+            .summarized([](const RenderSettings& r) { return "indirect " + human(r.indirectScale); });
+        b.number("key", &RenderSettings::exposureKey, above(0.0)).doc("number", "Reinhard key value, > 0").summarized([](const RenderSettings& r) {
+            return "key " + human(r.exposureKey);
+        });
+        b.number("alpha_distance", &RenderSettings::alphaDistance, atLeast(0.0, " (metres; 0 = off)"))
+            .doc("number",
+                 "metres, >= 0; beyond it from the camera leaf cut-outs are not tested (cards opaque); 0 = off "
+                 "([RENDERING.md](RENDERING.md))")
+            .summarized([](const RenderSettings& r) {
+                return r.alphaDistance > 0.0f ? "alpha tests within " + human(r.alphaDistance) + " m" : std::string();
+            });
+        b.number("prune_distance", &RenderSettings::pruneDistance, atLeast(0.0, " (metres; 0 = off)"))
+            .doc("number", "metres, >= 0; stochastic pruning of leaves starts there (half the leaves at twice it, area-preserving); 0 = off")
+            .summarized([](const RenderSettings& r) {
+                return r.pruneDistance > 0.0f ? "leaves pruned from " + human(r.pruneDistance) + " m" : std::string();
+            });
+        return b.table;
+    }();
+    return table;
+}
+
+// "KEY: summary of the object's fields\n" for `sylva info`.
+template <class U, class Get>
+std::function<std::string(const Scene&)> sectionLine(const char* key, Get get, const Table<U>& table)
+{
+    return [key, get, &table](const Scene& s) { return std::string(key) + ": " + json::summarize(get(s), table) + "\n"; };
+}
+
+} // namespace
+
+const Table<Scene>& sceneTable()
+{
+    static const Table<Scene> table = [] {
+        TableBuilder<Scene> b(Layout::Block);
+        b.custom(
+             "version",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, Scene& s) {
+                 const double n = r.number(v, p);
+                 if (n != double(kSceneFileVersion))
+                     r.fail(p, "unsupported version " + json::fmt(n) + " (this build reads version " + std::to_string(kSceneFileVersion) + ")");
+                 s.version = kSceneFileVersion;
+             },
+             [](JsonWriter& w, const Scene&, const KeyPath&, int) { w.integer((long long)kSceneFileVersion); })
+            .doc("integer", "must be 1")
+            .required("missing (required; this build reads version 1)")
+            .shown("required")
+            .summarized([](const Scene& s) {
+                return "scene version " + std::to_string(s.version) + ": " + std::to_string(s.species.size()) + " species, " +
+                       std::to_string(s.instances.size()) + " instances\n";
+            });
+        b.array("species", &Scene::species, speciesTable(), "needs at least one species", size_t(std::numeric_limits<uint32_t>::max()),
+                "too many species")
+            .doc("object", "at least one")
+            .shown("")
+            .summarized(describeSpecies);
+        b.array("instances", &Scene::instances, instanceTable(), "needs at least one instance")
+            .doc("object", "at least one")
+            .shown("")
+            .summarized(describeInstances);
+        b.object("ground", &Scene::ground, groundTable())
+            .doc("object", "")
+            .summarized(sectionLine("ground", [](const Scene& s) -> const GroundDesc& { return s.ground; }, groundTable()));
+        b.object("sun", &Scene::sun, sunTable())
+            .doc("object", "`direction`, or `elevation` with `azimuth`; not both")
+            .summarized(sectionLine("sun", [](const Scene& s) -> const SunDesc& { return s.sun; }, sunTable()));
+        b.object("sky", [](auto& s) -> auto& { return s; }, skyTable())
+            .doc("object", "")
+            .summarized(sectionLine("sky", [](const Scene& s) -> const Scene& { return s; }, skyTable()));
+        b.object("camera", &Scene::camera, cameraTable())
+            .doc("object", "pinhole")
+            .summarized(sectionLine("camera", [](const Scene& s) -> const CameraDesc& { return s.camera; }, cameraTable()));
+        b.object("render", &Scene::render, renderTable())
+            .doc("object", "")
+            .summarized(sectionLine("render", [](const Scene& s) -> const RenderSettings& { return s.render; }, renderTable()));
+        return b.table;
+    }();
+    return table;
+}
+
+std::vector<json::FieldDoc> sceneFieldDocs()
+{
+    std::vector<json::FieldDoc> docs;
+    json::documentFields(sceneTable(), "", docs);
+    return docs;
+}
+
+} // namespace sylva
