@@ -126,76 +126,57 @@ struct DeviceScene::Scratch {
 };
 
 struct DeviceScene::Buffers {
-    std::vector<DeviceBuffer<char>> owned;      // the species part
-    Reusable tlasNodes, tlasOrder, instances, kdTlasNodes, kdTlasRefs;
+    std::vector<DeviceBuffer<char>> owned;      // the scene part
+    // The top level, re-placed per camera: a reusable buffer per array (only the Top ones are used).
+#define SYLVA_X(part, where, T, name, stat) Reusable name;
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
     Scratch scratch;
 };
 
 namespace {
 
-// The species part of `from` (device pointers) into `to`.
-void keepSpeciesPart(RenderView& to, const RenderView& from)
-{
-    to.species = from.species;
-    to.blasNodes = from.blasNodes;
-    to.tris = from.tris;
-    to.blocks = from.blocks;
-    to.kdSpecies = from.kdSpecies;
-    to.kdBlasNodes = from.kdBlasNodes;
-    to.kdBlasRefs = from.kdBlasRefs;
-    to.triVerts = from.triVerts;
-    to.triMaterial = from.triMaterial;
-    to.normals = from.normals;
-    to.uvs = from.uvs;
-    to.materials = from.materials;
-    to.textures = from.textures;
-    to.texels = from.texels;
-    to.alphaMasks = from.alphaMasks;
-    to.alphaBits = from.alphaBits;
-    to.lighting = from.lighting;
-}
+// Whether an array goes to the device (host-only ones stay null there).
+template <ArrayPart P, ArrayWhere W>
+inline constexpr bool kUploaded = W == ArrayWhere::Both;
 
 } // namespace
 
+// The scene part goes up once; the host-only arrays stay null on the device; place() sends the top level.
 DeviceScene::DeviceScene(const RenderScene& s) : m_buffers(std::make_unique<Buffers>())
 {
     auto& o = m_buffers->owned;
     size_t& b = m_speciesBytes;
-    m_view.species = put(o, b, s.species);
-    m_view.blasNodes = put(o, b, s.blasNodes);
-    m_view.tris = put(o, b, s.tris);
-    m_view.blocks = put(o, b, s.blocks);
-    m_view.kdSpecies = put(o, b, s.kdSpecies);
-    m_view.kdBlasNodes = put(o, b, s.kdBlasNodes);
-    m_view.kdBlasRefs = put(o, b, s.kdBlasRefs);
-    m_view.triVerts = put(o, b, s.triVerts);
-    m_view.triMaterial = put(o, b, s.triMaterial);
-    m_view.normals = put(o, b, s.normals);
-    m_view.uvs = put(o, b, s.uvs);
-    m_view.materials = put(o, b, s.materials);
-    m_view.textures = put(o, b, s.textures);
-    m_view.texels = put(o, b, s.texels);
-    m_view.alphaMasks = put(o, b, s.alphaMasks);
-    m_view.alphaBits = put(o, b, s.alphaBits);
-    m_view.lighting = put(o, b, s.lighting);
+#define SYLVA_X(part, where, T, name, stat)                                                                        \
+    if constexpr (ArrayPart::part == ArrayPart::Scene && kUploaded<ArrayPart::part, ArrayWhere::where>) \
+        m_scene.name = put(o, b, s.name);
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
     m_speciesCount = s.species.size();
+    m_geometryCount = s.geometries.size();
     place(s);
 }
 
 void DeviceScene::place(const RenderScene& s)
 {
-    if (s.species.size() != m_speciesCount) throw BackendError("CUDA: the scene's species differ from the uploaded ones");
-    Buffers& b = *m_buffers;
+    if (s.species.size() != m_speciesCount || s.geometries.size() != m_geometryCount)
+        throw BackendError("CUDA: the scene's species differ from the uploaded ones");
+    Buffers& bufs = *m_buffers;
     RenderView v = s.view();   // settings and environment; host pointers replaced below
-    keepSpeciesPart(v, m_view);
-    v.tlasNodes = b.tlasNodes.assign(s.tlasNodes, "instance BVH upload");
-    v.tlasOrder = b.tlasOrder.assign(s.tlasOrder, "instance BVH upload");
-    v.instances = b.instances.assign(s.instances, "instance upload");
-    v.kdTlasNodes = b.kdTlasNodes.assign(s.kdTlasNodes, "instance kd-tree upload");
-    v.kdTlasRefs = b.kdTlasRefs.assign(s.kdTlasRefs, "instance kd-tree upload");
+    size_t topBytes = 0;
+#define SYLVA_X(part, where, T, name, stat)                                                          \
+    if constexpr (!kUploaded<ArrayPart::part, ArrayWhere::where>) {                                     \
+        v.name = nullptr;                                                                              \
+    } else if constexpr (ArrayPart::part == ArrayPart::Scene) {                                         \
+        v.name = m_scene.name;                                                                         \
+    } else {                                                                                           \
+        v.name = bufs.name.assign(s.name, "top level upload (" #name ")");                              \
+        topBytes += bufs.name.capacity;                                                                \
+    }
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
     m_view = v;
-    m_bytes = m_speciesBytes + b.tlasNodes.capacity + b.tlasOrder.capacity + b.instances.capacity + b.kdTlasNodes.capacity +
-              b.kdTlasRefs.capacity;
+    m_bytes = m_speciesBytes + topBytes;
 }
 
 DeviceScene::Scratch& DeviceScene::scratch() const { return m_buffers->scratch; }

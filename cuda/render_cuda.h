@@ -26,7 +26,7 @@ public:
     const RenderView& view() const { return m_view; }
     size_t deviceBytes() const { return m_bytes; }
 
-    // Takes the top level (instances, instance BVH or kd-tree) and the settings (camera, size, samples,
+    // Takes the top level (instances and their BVH) and the settings (camera, size, samples,
     // environment) of `scene`, whose species part must be the one uploaded (the studio's camera moves and
     // instance edits: placeViewFrame on the host, then this). Moves O(instances) bytes; the species
     // arrays stay. Throws BackendError (e.g. a different species count).
@@ -40,8 +40,9 @@ private:
     struct Buffers;
     std::unique_ptr<Buffers> m_buffers;
     RenderView m_view{};
+    RenderView m_scene{};   // device pointers of the scene part (SYLVA_RENDER_ARRAYS part Scene)
     size_t m_speciesBytes = 0, m_bytes = 0;
-    size_t m_speciesCount = 0;
+    size_t m_speciesCount = 0, m_geometryCount = 0;
 };
 
 // Traces every pixel on the device and returns the film on the host. Throws BackendError.

@@ -154,7 +154,9 @@ void RenderWorker::process(const Request& req, Progress& progress)
 
     if (m_gpu) {
         if (m_gpuForget.exchange(false)) m_gpuAssets.clear();
-        if (m_gpuAssets == req.assets) return;   // the viewport has this frame and traces it itself
+        // The viewport has this frame and traces it itself (a frame built while the scene pruned has every
+        // level of detail; one built without pruning is built again when pruning is turned on).
+        if (m_gpuAssets == req.assets && (!(scene.render.pruneDistance > 0.0f) || m_gpuPruned)) return;
         try {
             std::vector<SpeciesAssets> copies;
             copies.reserve(req.assets.size());
@@ -167,6 +169,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
             g->device = std::make_unique<cuda::DeviceScene>(g->frame.rs);
             g->assets = req.assets;
             m_gpuAssets = req.assets;
+            m_gpuPruned = scene.render.pruneDistance > 0.0f;
             Q_EMIT gpuFrameReady(g);
             return;
         } catch (const BackendError& e) {
@@ -189,7 +192,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
         }
     }
 
-    if (!m_frame || m_frameAssets != req.assets) {
+    if (!m_frame || m_frameAssets != req.assets || !viewFrameFits(*m_frame, scene)) {
         m_frame.reset();
         std::vector<SpeciesAssets> copies;
         copies.reserve(req.assets.size());

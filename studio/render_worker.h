@@ -113,6 +113,7 @@ private:
     Film m_lastFilm;
     int m_lastPass = -1;
     std::vector<AssetsPtr> m_gpuAssets;   // what the last GPU frame was built from
+    bool m_gpuPruned = false;             // ... and whether with every level of detail (the scene pruned)
 };
 
 } // namespace sylva

@@ -110,7 +110,8 @@ void Viewport::requestRender()
     if (m_interop) {
         // The device traces in paintGL; the worker only builds and uploads frames for new assets.
         m_gpuPass = 0;
-        if (!m_gpuFrame || m_gpuFrame->assets != m_assets) m_worker->request(m_scene, m_assets, renderSize(), m_compare);
+        if (!m_gpuFrame || m_gpuFrame->assets != m_assets || !viewFrameFits(m_gpuFrame->frame, m_scene))
+            m_worker->request(m_scene, m_assets, renderSize(), m_compare);
         update();
         return;
     }
@@ -284,6 +285,7 @@ void Viewport::drawTexture()
 bool Viewport::paintGpu()
 {
     if (!m_gpuFrame || m_gpuFrame->assets != m_assets || m_scene.instances.empty()) return false;
+    if (!viewFrameFits(m_gpuFrame->frame, m_scene)) return false;   // pruning turned on: the worker builds the levels
     std::vector<int> spps;
     for (const RenderPass& p : m_worker->passes())
         if (p.divisor == 1) spps.push_back(p.spp);

@@ -22,12 +22,18 @@ struct Ray {
 };
 
 // Closest hit so far: t along the ray, barycentrics (u,v) of the triangle, the triangle's index in
-// its mesh and the instance. prim == kNoHit when nothing was hit. 20 bytes.
+// its mesh and the instance path down to it: `inst` indexes the top level's instances; a hit inside
+// instance groups also records the `depth` group instances below it (nested[0] .. nested[depth-1],
+// outermost first, indices into RenderView::groupInstances). prim == kNoHit when nothing was hit.
+// 36 bytes.
+inline constexpr int kMaxNested = 3;   // = kMaxLevels - 1 (core/render/render_view.h)
 struct Hit {
     float t;
     float u, v;
     uint32_t prim;
     uint32_t inst;
+    uint32_t depth;
+    uint32_t nested[kMaxNested];
 };
 
 // min/max that compile to one instruction (fminf/fmaxf handle NaN and become libm calls on x86).

@@ -1,4 +1,5 @@
-// Flattens species, instances, textures and lighting grids into the RenderView arrays; builds the BVHs.
+// Flattens species, pruned levels, instance groups, textures and lighting grids into the RenderView arrays;
+// builds every level's acceleration structure. The one builder of the levels, for every front end.
 #include "core/render/render_scene.h"
 
 #include <array>
@@ -24,6 +25,95 @@ glm::dmat3 rotationDeg(const glm::vec3& deg)
     const glm::dmat3 ry(cy, 0, -sy, 0, 1, 0, sy, 0, cy);
     const glm::dmat3 rz(cz, sz, 0, -sz, cz, 0, 0, 0, 1);
     return rz * ry * rx;
+}
+
+// The parent-frame box of an instance of a geometry whose own-frame bounds are `b`, from the instance's
+// description in double, grown by a relative epsilon so float rounding of the transform never clips geometry.
+Bounds3 instanceBox(const InstanceDesc& d, const Bounds3& b, const glm::dvec3& frameOrigin)
+{
+    Bounds3 box;
+    const glm::dmat3 r = rotationDeg(d.rotationDeg) * double(d.scale);
+    for (int c = 0; c < 8; ++c) {
+        const glm::dvec3 corner((c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z);
+        box.extend(glm::vec3(r * corner + (d.position - frameOrigin)));
+    }
+    const glm::vec3 pad = 1e-5f * (glm::abs(box.lo) + glm::abs(box.hi)) + 1e-6f;
+    box.lo -= pad;
+    box.hi += pad;
+    return box;
+}
+
+// The level of detail of each of the scene's own instances from the distance of its species' box centre
+// to the camera (instances of groups, and every instance when pruning is off: level 0).
+std::vector<int> instanceLevels(const Scene& scene, const std::vector<RenderScene::MeshLevels>& ml)
+{
+    std::vector<int> level(scene.instances.size(), 0);
+    const double start = scene.render.pruneDistance;
+    if (!(start > 0.0)) return level;
+    for (size_t i = 0; i < level.size(); ++i) {
+        const InstanceDesc& d = scene.instances[i];
+        if (d.group != kNoGroup || d.species >= ml.size()) continue;
+        const glm::dvec3 c = rotationDeg(d.rotationDeg) * (double(d.scale) * ml[d.species].centre) + d.position;
+        level[i] = pruneLevelFor(glm::length(c - scene.camera.position), start, ml[d.species].levels);
+    }
+    return level;
+}
+
+// Checks one instance's reference (species or group) against the scene; `where` names it in the message.
+void checkReference(const Scene& scene, const InstanceDesc& d, const std::string& where)
+{
+    if (d.group != kNoGroup) {
+        if (d.group >= scene.groups.size()) throw Error("render: " + where + " names a missing group");
+    } else if (d.species >= scene.species.size()) {
+        throw Error("render: " + where + " names a missing species");
+    }
+}
+
+// Groups in build order (every group after the groups it places), refusing cycles and nesting deeper
+// than the traversal's levels.
+std::vector<uint32_t> groupBuildOrder(const Scene& scene)
+{
+    const size_t ng = scene.groups.size();
+    std::vector<int> height(ng, -1);   // -1 unvisited, -2 on the current path
+    std::vector<uint32_t> order;
+    auto visit = [&](auto&& self, uint32_t g) -> int {
+        if (height[g] == -2) throw Error("render: group '" + scene.groups[g].name + "' contains itself");
+        if (height[g] >= 0) return height[g];
+        height[g] = -2;
+        const GroupDesc& gd = scene.groups[g];
+        if (gd.instances.empty()) throw Error("render: group '" + gd.name + "' has no instances");
+        int h = 1;
+        for (size_t i = 0; i < gd.instances.size(); ++i) {
+            const InstanceDesc& d = gd.instances[i];
+            checkReference(scene, d, "instance " + std::to_string(i) + " of group '" + gd.name + "'");
+            if (d.group != kNoGroup) h = std::max(h, 1 + self(self, d.group));
+        }
+        if (h > kMaxLevels - 1)
+            throw Error("render: group '" + gd.name + "' nests " + std::to_string(h) + " groups deep; at most " +
+                        std::to_string(kMaxLevels - 1) + " levels of groups below the scene's instances are traced");
+        height[g] = h;
+        order.push_back(g);
+        return h;
+    };
+    for (uint32_t g = 0; g < ng; ++g) visit(visit, g);
+    return order;
+}
+
+// The byte figures of AccelStats from the array table: each array counts towards its stat column.
+void countBytes(RenderScene& rs)
+{
+    size_t bytes[size_t(ArrayStat::None) + 1] = {};
+#define SYLVA_X(part, where, T, name, stat) bytes[size_t(ArrayStat::stat)] += rs.name.size() * sizeof(T);
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
+    AccelStats& st = rs.m_stats;
+    const bool kd = rs.accel == AccelKind::KdTree;
+    st.tlasBytes = bytes[size_t(ArrayStat::Tlas)];
+    st.wideTlasBytes = bytes[size_t(ArrayStat::WideTlas)];
+    st.instanceBytes = bytes[size_t(ArrayStat::Instances)];
+    st.blasBytes = bytes[size_t(ArrayStat::Blas)] + bytes[size_t(kd ? ArrayStat::KdBlas : ArrayStat::BvhBlas)];
+    st.wideBlasBytes = bytes[size_t(ArrayStat::WideBlas)];
+    st.triangleBytes = bytes[size_t(kd ? ArrayStat::KdTriangles : ArrayStat::BvhTriangles)];
 }
 
 void addCutout(const ImageRgba& img, RenderScene& rs, MaterialRecord& m)
@@ -79,104 +169,85 @@ InstanceRecord makeInstance(const InstanceDesc& inst, const glm::dvec3& frameOri
     const glm::dvec3 t = -(rt * (inst.position - frameOrigin));
     InstanceRecord r{};
     for (int i = 0; i < 3; ++i) r.row[i] = glm::vec4(float(rt[0][i]), float(rt[1][i]), float(rt[2][i]), float(t[i]));
-    r.species = inst.species;
     r.scale = inst.scale;
-    r.geometry = inst.species;   // the full species; buildRenderScene picks a pruned level where it prunes
+    r.geometry = inst.species;   // the full species; the builder picks a pruned level or the group's record
     return r;
 }
+
 
 RenderView RenderScene::view() const
 {
     RenderView v = base;
-    v.tlasNodes = tlasNodes.data();
-    v.tlasWideNodes = tlasWideNodes.empty() ? nullptr : tlasWideNodes.data();
-    v.tlasOrder = tlasOrder.data();
-    v.instances = instances.data();
+#define SYLVA_X(part, where, T, name, stat) v.name = name.empty() ? nullptr : name.data();
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
     v.instanceCount = uint32_t(instances.size());
-    v.species = species.data();
-    v.blasNodes = blasNodes.data();
-    v.blasWideNodes = blasWideNodes.empty() ? nullptr : blasWideNodes.data();
-    v.tris = tris.data();
-    v.blocks = blocks.data();
-    v.kdTlasNodes = kdTlasNodes.empty() ? nullptr : kdTlasNodes.data();
-    v.kdTlasRefs = kdTlasRefs.data();
-    v.kdSpecies = kdSpecies.data();
-    v.kdBlasNodes = kdBlasNodes.data();
-    v.kdBlasRefs = kdBlasRefs.data();
-    v.triVerts = triVerts.data();
-    v.triMaterial = triMaterial.data();
-    v.normals = normals.data();
-    v.uvs = uvs.data();
-    v.materials = materials.data();
-    v.textures = textures.data();
-    v.texels = texels.data();
-    v.alphaMasks = alphaMasks.data();
-    v.alphaBits = alphaBits.data();
-    v.lighting = lighting.data();
     return v;
 }
 
-RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
-                             Progress* progress)
+RenderScene buildSceneGeometry(const Scene& scene, const std::vector<SpeciesAssets>& assets, LodLevels lod, Progress* progress)
 {
     if (assets.size() != scene.species.size()) throw Error("render: one set of assets per species is required");
     if (scene.instances.empty()) throw Error("render: the scene has no instances");
     RenderScene rs;
+    rs.accel = scene.render.accel;
+    rs.lodLevels = lod;
     const size_t ns = assets.size(), ni = scene.instances.size();
-    const glm::dvec3 origin = scene.camera.position;
     for (size_t s = 0; s < ns; ++s)
         if (assets[s].mesh.triangles.empty()) throw Error("render: species '" + scene.species[s].name + "' has no triangles");
-    for (size_t i = 0; i < ni; ++i)
-        if (scene.instances[i].species >= ns) throw Error("render: instance " + std::to_string(i) + " names a missing species");
+    for (size_t i = 0; i < ni; ++i) checkReference(scene, scene.instances[i], "instance " + std::to_string(i));
+    const std::vector<uint32_t> groupOrder = groupBuildOrder(scene);
 
-    // Stochastic pruning: each instance's level of detail from the distance of its box centre to the camera.
-    const double pruneStart = scene.render.pruneDistance;
-    std::vector<int> instanceLevel(ni, 0);
-    std::vector<LeafElements> leaves(pruneStart > 0.0 ? ns : 0);
+    // Stochastic pruning: the levels each species supports (only analysed when the scene prunes).
+    const bool prune = scene.render.pruneDistance > 0.0;
+    rs.meshLevels.resize(ns);
+    std::vector<LeafElements> leaves(prune ? ns : 0);
     std::vector<std::vector<uint32_t>> orders(leaves.size());
-    if (pruneStart > 0.0) {
-        std::vector<int> levels(ns, 1);
-        std::vector<glm::dvec3> centre(ns);
+    for (RenderScene::MeshLevels& m : rs.meshLevels) std::fill(std::begin(m.geometry), std::end(m.geometry), kNoHit);
+    if (prune) {
         tbb::parallel_for(size_t(0), ns, [&](size_t s) {
             leaves[s] = findLeafElements(assets[s].mesh);
             orders[s] = pruneOrder(leaves[s].count());
-            levels[s] = pruneLevelCount(leaves[s]);
-            centre[s] = glm::dvec3(meshBounds(assets[s].mesh).center());
+            rs.meshLevels[s].levels = pruneLevelCount(leaves[s]);
+            rs.meshLevels[s].centre = glm::dvec3(meshBounds(assets[s].mesh).center());
         });
-        for (size_t i = 0; i < ni; ++i) {
-            const InstanceDesc& d = scene.instances[i];
-            const glm::dvec3 c = rotationDeg(d.rotationDeg) * (double(d.scale) * centre[d.species]) + d.position;
-            instanceLevel[i] = pruneLevelFor(glm::length(c - origin), pruneStart, levels[d.species]);
-        }
+    } else {
+        for (RenderScene::MeshLevels& m : rs.meshLevels) m.levels = 0;   // not analysed: only level 0 exists
     }
 
-    // Geometry records: the species (0 .. ns-1), then every pruned level some instance uses.
-    struct Geometry {
+    // Mesh records: the species (0 .. ns-1), then the pruned levels (in order of first use by an instance,
+    // or every level of every species for LodLevels::All).
+    struct MeshBuild {
         uint32_t species;
         int level;
         PrunedLevel pruned;   // level > 0
         Bvh bvh;
         size_t triangles = 0;
     };
-    std::vector<Geometry> geos(ns);
-    std::vector<std::array<uint32_t, kMaxPruneLevels>> geometryOf(ns);
+    std::vector<MeshBuild> meshes(ns);
     for (size_t s = 0; s < ns; ++s) {
-        geos[s].species = uint32_t(s);
-        geos[s].level = 0;
-        geometryOf[s].fill(kNoHit);
-        geometryOf[s][0] = uint32_t(s);
+        meshes[s].species = uint32_t(s);
+        meshes[s].level = 0;
+        rs.meshLevels[s].geometry[0] = uint32_t(s);
     }
-    for (size_t i = 0; i < ni; ++i) {
-        const uint32_t sp = scene.instances[i].species;
-        const int level = instanceLevel[i];
-        if (geometryOf[sp][size_t(level)] != kNoHit) continue;
-        geometryOf[sp][size_t(level)] = uint32_t(geos.size());
-        geos.push_back(Geometry{sp, level, {}, {}, 0});
+    auto useLevel = [&](uint32_t sp, int level) {
+        uint32_t& g = rs.meshLevels[sp].geometry[size_t(level)];
+        if (g != kNoHit) return;
+        g = uint32_t(meshes.size());
+        meshes.push_back(MeshBuild{sp, level, {}, {}, 0});
+    };
+    if (prune && lod == LodLevels::All) {
+        for (uint32_t sp = 0; sp < ns; ++sp)
+            for (int l = 1; l < rs.meshLevels[sp].levels; ++l) useLevel(sp, l);
+    } else if (prune) {
+        const std::vector<int> level = instanceLevels(scene, rs.meshLevels);
+        for (size_t i = 0; i < ni; ++i)
+            if (scene.instances[i].group == kNoGroup) useLevel(scene.instances[i].species, level[i]);
     }
 
-    // Bottom level: one BVH per geometry record, built in parallel.
-    tbb::parallel_for(size_t(0), geos.size(), [&](size_t g) {
-        Geometry& geo = geos[g];
+    // Bottom level: one BVH per mesh record, built in parallel.
+    tbb::parallel_for(size_t(0), meshes.size(), [&](size_t g) {
+        MeshBuild& geo = meshes[g];
         const TriangleMesh& m = assets[geo.species].mesh;
         std::vector<Bounds3> boxes;
         if (geo.level == 0) {
@@ -197,7 +268,6 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         geo.bvh = buildBvh(boxes, bs);
     });
     if (progress) progress->report(0.7, "species BVHs built");
-
     // A triangle's corner uvs for TriBlock::uv: each axis shifted by the whole units below its smallest
     // corner (the cut-out wraps, so the test sees the same texels), rounded to 1/kBlockUvScale. False
     // when a corner lies 4 units or more above that (no room in 16 bits) or is not finite.
@@ -219,7 +289,7 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
     // Triangles of a geometry record in BVH order, then its leaves as 4-wide blocks. corner(prim, c)
     // is the species-frame position of corner c of BVH primitive prim, meshTri(prim) its mesh triangle.
     std::vector<uint32_t> triBase(ns);
-    auto appendTriangles = [&rs, &packBlockUv](SpeciesRecord& sr, const Bvh& bvh, uint32_t base, auto corner, auto meshTri) {
+    auto appendTriangles = [&rs, &packBlockUv](GeometryRecord& sr, const Bvh& bvh, uint32_t base, auto corner, auto meshTri) {
         sr.nodeOffset = uint32_t(rs.blasNodes.size());
         sr.triOffset = uint32_t(rs.tris.size());
         rs.blasNodes.insert(rs.blasNodes.end(), bvh.nodes.begin(), bvh.nodes.end());
@@ -235,7 +305,7 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
             rs.tris.push_back(ta);
         }
         // BVH leaves become 4-wide triangle blocks: leaf children then index blocks, not slots.
-        sr.blockOffset = uint32_t(rs.blocks.size());
+        sr.primOffset = uint32_t(rs.blocks.size());
         std::vector<uint32_t> blockOfSlot(bvh.wideNodes.empty() ? 0 : bvh.primOrder.size(), kNoHit);
         for (size_t ni2 = sr.nodeOffset; ni2 < rs.blasNodes.size(); ++ni2) {
             BvhNode& node = rs.blasNodes[ni2];
@@ -252,8 +322,8 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
                     blk.alpha[l] = t.alpha;
                     if (t.alpha != 0u && packBlockUv(rs.triVerts[t.tri], rs.uvs, blk.uv[l])) blk.uvPacked |= 1u << l;
                 }
-                if (!blockOfSlot.empty()) blockOfSlot[node.child[k]] = uint32_t(rs.blocks.size() - sr.blockOffset);
-                node.child[k] = uint32_t(rs.blocks.size() - sr.blockOffset);
+                if (!blockOfSlot.empty()) blockOfSlot[node.child[k]] = uint32_t(rs.blocks.size() - sr.primOffset);
+                node.child[k] = uint32_t(rs.blocks.size() - sr.primOffset);
                 rs.blocks.push_back(blk);
             }
         }
@@ -311,10 +381,14 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         }
 
         // Triangles in BVH order.
-        SpeciesRecord sr{};
+        GeometryRecord gr{};
+        gr.kind = GeometryKind::Mesh;
+        gr.species = uint32_t(s);
         appendTriangles(
-            sr, geos[s].bvh, triBase[s], [&m](uint32_t prim, int c) { return m.positions[m.triangles[prim][c]]; },
+            gr, meshes[s].bvh, triBase[s], [&m](uint32_t prim, int c) { return m.positions[m.triangles[prim][c]]; },
             [](uint32_t prim) { return prim; });
+        rs.geometries.push_back(gr);
+        SpeciesRecord sr{};
 
         // Lighting grid, normalized by the unobstructed photon density.
         const LightingGrid& g = a.lighting;
@@ -331,55 +405,51 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
         }
         rs.species.push_back(sr);
         rs.m_stats.speciesTriangles += m.triangles.size();
-        rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, geos[s].bvh.depth);
-        rs.m_stats.maxWideBlasDepth = std::max(rs.m_stats.maxWideBlasDepth, geos[s].bvh.wideDepth);
+        rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, meshes[s].bvh.depth);
+        rs.m_stats.maxWideBlasDepth = std::max(rs.m_stats.maxWideBlasDepth, meshes[s].bvh.wideDepth);
     }
 
     // Pruned levels: own triangles and BVH, the species' shading data and lighting grid.
     const size_t nodesBefore = rs.blasNodes.size(), trisBefore = rs.tris.size(), blocksBefore = rs.blocks.size();
     const size_t wideBefore = rs.blasWideNodes.size();
-    for (size_t gi = ns; gi < geos.size(); ++gi) {
-        const Geometry& geo = geos[gi];
-        SpeciesRecord sr = rs.species[geo.species];
+    for (size_t gi = ns; gi < meshes.size(); ++gi) {
+        const MeshBuild& geo = meshes[gi];
+        GeometryRecord gr{};
+        gr.kind = GeometryKind::Mesh;
+        gr.species = geo.species;
         const PrunedLevel& p = geo.pruned;
         appendTriangles(
-            sr, geo.bvh, triBase[geo.species], [&p](uint32_t prim, int c) { return p.corners[3 * size_t(prim) + size_t(c)]; },
+            gr, geo.bvh, triBase[geo.species], [&p](uint32_t prim, int c) { return p.corners[3 * size_t(prim) + size_t(c)]; },
             [&p](uint32_t prim) { return p.tris[prim]; });
-        rs.species.push_back(sr);
+        rs.geometries.push_back(gr);
         rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, geo.bvh.depth);
         rs.m_stats.maxWideBlasDepth = std::max(rs.m_stats.maxWideBlasDepth, geo.bvh.wideDepth);
     }
-    rs.m_stats.prunedLevels = geos.size() - ns;
+    rs.m_stats.prunedLevels = meshes.size() - ns;
+    rs.m_stats.pruneBytes = (rs.blasNodes.size() - nodesBefore) * sizeof(BvhNode) + (rs.tris.size() - trisBefore) * sizeof(TriAccel) +
+                            (rs.blocks.size() - blocksBefore) * sizeof(TriBlock) +
+                            (rs.blasWideNodes.size() - wideBefore) * sizeof(BvhNode8);
 
-    // Top level over the instances' camera-relative boxes.
-    rs.instances.reserve(ni);
-    std::vector<Bounds3> boxes(ni);
-    for (size_t i = 0; i < ni; ++i) {
-        const InstanceDesc& d = scene.instances[i];
-        InstanceRecord rec = makeInstance(d, origin);
-        rec.geometry = geometryOf[d.species][size_t(instanceLevel[i])];
-        rs.instances.push_back(rec);
-        const Bounds3& lb = geos[rec.geometry].bvh.bounds;
-        const glm::dmat3 r = rotationDeg(d.rotationDeg) * double(d.scale);
-        for (int c = 0; c < 8; ++c) {
-            const glm::dvec3 corner((c & 1) ? lb.hi.x : lb.lo.x, (c & 2) ? lb.hi.y : lb.lo.y, (c & 4) ? lb.hi.z : lb.lo.z);
-            boxes[i].extend(glm::vec3(r * corner + (d.position - origin)));
-        }
-        // Grow by a relative epsilon so float rounding of the transform never clips geometry.
-        const glm::vec3 pad = 1e-5f * (glm::abs(boxes[i].lo) + glm::abs(boxes[i].hi)) + 1e-6f;
-        boxes[i].lo -= pad;
-        boxes[i].hi += pad;
-        rs.m_stats.instancedTriangles += double(geos[rec.geometry].triangles);
-        ++rs.m_stats.instancesPerLevel[size_t(instanceLevel[i])];
+    // Mesh records' bounds and triangle counts; in kd-tree runs their kd-trees (the seed's structure at
+    // the mesh level), indexing triangles by BVH slot (the order of rs.tris) and clipping them to the split
+    // boxes ("perfect splits").
+    const size_t nm = meshes.size();
+    rs.geometryBounds.resize(nm);
+    rs.geometryTriangles.resize(nm);
+    for (size_t g = 0; g < nm; ++g) {
+        GeometryRecord& gr = rs.geometries[g];
+        rs.geometryBounds[g] = meshes[g].bvh.bounds;
+        rs.geometryTriangles[g] = double(meshes[g].triangles);
+        gr.primCount = uint32_t(meshes[g].triangles);
+        gr.lo = meshes[g].bvh.bounds.lo;
+        gr.hi = meshes[g].bvh.bounds.hi;
     }
     if (scene.render.accel == AccelKind::KdTree) {
-        // The seed's structure at both levels. Species trees index triangles by BVH slot (the order
-        // of rs.tris) and clip them to the split boxes ("perfect splits").
         rs.m_stats.maxBlasDepth = 0;
-        std::vector<KdTree> kd(geos.size());
-        tbb::parallel_for(size_t(0), geos.size(), [&](size_t g) {
-            const TriAccel* tris = rs.tris.data() + rs.species[g].triOffset;
-            const size_t n = geos[g].triangles;
+        std::vector<KdTree> kd(nm);
+        tbb::parallel_for(size_t(0), nm, [&](size_t g) {
+            const TriAccel* tris = rs.tris.data() + rs.geometries[g].triOffset;
+            const size_t n = meshes[g].triangles;
             std::vector<Bounds3> triBoxes(n);
             for (size_t t = 0; t < n; ++t) {
                 triBoxes[t].extend(tris[t].v0);
@@ -393,33 +463,115 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
             };
             kd[g] = buildKdTree(triBoxes, ks);
         });
-        for (size_t g = 0; g < geos.size(); ++g) {
-            KdSpeciesRecord r{};
-            r.lo = kd[g].bounds.lo;
-            r.hi = kd[g].bounds.hi;
-            r.nodeOffset = uint32_t(rs.kdBlasNodes.size());
-            r.refOffset = uint32_t(rs.kdBlasRefs.size());
-            rs.kdBlasNodes.insert(rs.kdBlasNodes.end(), kd[g].nodes.begin(), kd[g].nodes.end());
-            rs.kdBlasRefs.insert(rs.kdBlasRefs.end(), kd[g].primRefs.begin(), kd[g].primRefs.end());
-            rs.kdSpecies.push_back(r);
+        for (size_t g = 0; g < nm; ++g) {
+            GeometryRecord& gr = rs.geometries[g];
+            gr.lo = kd[g].bounds.lo;   // the box kd-tree rays are clipped to
+            gr.hi = kd[g].bounds.hi;
+            gr.kdNodeOffset = uint32_t(rs.kdNodes.size());
+            gr.kdRefOffset = uint32_t(rs.kdRefs.size());
+            rs.kdNodes.insert(rs.kdNodes.end(), kd[g].nodes.begin(), kd[g].nodes.end());
+            rs.kdRefs.insert(rs.kdRefs.end(), kd[g].primRefs.begin(), kd[g].primRefs.end());
             rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, kd[g].stats.depth);
         }
-        KdTree top = buildKdTree(boxes);
-        rs.kdTlasNodes = std::move(top.nodes);
-        rs.kdTlasRefs = std::move(top.primRefs);
-        rs.base.kdTlasLo = top.bounds.lo;
-        rs.base.kdTlasHi = top.bounds.hi;
-        rs.m_stats.tlasDepth = top.stats.depth;
+    }
+
+    // Instance groups, each after the groups it places: its instances in its own frame under a BVH.
+    rs.groupGeometry.assign(scene.groups.size(), kNoHit);
+    for (size_t g = 0; g < scene.groups.size(); ++g) {
+        rs.groupGeometry[g] = uint32_t(nm + g);
+        rs.geometries.push_back(GeometryRecord{});
+        rs.geometryBounds.emplace_back();
+        rs.geometryTriangles.push_back(0.0);
+    }
+    for (uint32_t g : groupOrder) {
+        const GroupDesc& gd = scene.groups[g];
+        const uint32_t record = rs.groupGeometry[g];
+        const uint32_t first = uint32_t(rs.groupInstances.size());
+        std::vector<Bounds3> boxes(gd.instances.size());
+        double triangles = 0.0;
+        for (size_t i = 0; i < gd.instances.size(); ++i) {
+            const InstanceDesc& d = gd.instances[i];
+            InstanceRecord rec = makeInstance(d, glm::dvec3(0.0));
+            rec.geometry = d.group != kNoGroup ? rs.groupGeometry[d.group] : uint32_t(d.species);
+            boxes[i] = instanceBox(d, rs.geometryBounds[rec.geometry], glm::dvec3(0.0));
+            triangles += rs.geometryTriangles[rec.geometry];
+            rs.groupInstances.push_back(rec);
+        }
+        BvhBuildSettings gs;
+        gs.maxLeafSize = 2;
+        gs.wide = true;   // the host's 8-wide copy
+        const Bvh bvh = buildBvh(boxes, gs);
+        GeometryRecord& gr = rs.geometries[record];
+        gr.kind = GeometryKind::Group;
+        gr.species = kNoHit;
+        gr.nodeOffset = uint32_t(rs.groupNodes.size());
+        gr.wideNodeOffset = uint32_t(rs.groupWideNodes.size());
+        gr.primOffset = uint32_t(rs.groupOrder.size());
+        gr.primCount = uint32_t(gd.instances.size());
+        gr.lo = bvh.bounds.lo;
+        gr.hi = bvh.bounds.hi;
+        rs.groupNodes.insert(rs.groupNodes.end(), bvh.nodes.begin(), bvh.nodes.end());
+        rs.groupWideNodes.insert(rs.groupWideNodes.end(), bvh.wideNodes.begin(), bvh.wideNodes.end());
+        for (uint32_t slot : bvh.primOrder) rs.groupOrder.push_back(first + slot);
+        rs.geometryBounds[record] = bvh.bounds;
+        rs.geometryTriangles[record] = triangles;
+    }
+    rs.m_stats.groups = scene.groups.size();
+    rs.m_stats.groupInstances = rs.groupInstances.size();
+    countBytes(rs);
+    return rs;
+}
+
+bool hasLevelsFor(const RenderScene& rs, const Scene& scene)
+{
+    if (!(scene.render.pruneDistance > 0.0)) return true;
+    if (rs.meshLevels.size() != scene.species.size()) return false;
+    for (const RenderScene::MeshLevels& m : rs.meshLevels)
+        if (m.levels == 0) return false;   // built without pruning: the levels were never made
+    const std::vector<int> level = instanceLevels(scene, rs.meshLevels);
+    for (size_t i = 0; i < level.size(); ++i) {
+        const InstanceDesc& d = scene.instances[i];
+        if (d.group == kNoGroup && rs.meshLevels[d.species].geometry[size_t(level[i])] == kNoHit) return false;
+    }
+    return true;
+}
+
+void placeTopLevel(RenderScene& rs, const Scene& scene, const glm::vec3& sunRadiance, int width, int height, int spp)
+{
+    const size_t ni = scene.instances.size();
+    if (ni == 0) throw Error("render: the scene has no instances");
+    if (rs.meshLevels.size() != scene.species.size() || rs.groupGeometry.size() != scene.groups.size())
+        throw Error("render: the scene's species or groups differ from the ones the frame was built with");
+    for (size_t i = 0; i < ni; ++i) checkReference(scene, scene.instances[i], "instance " + std::to_string(i));
+    if (!hasLevelsFor(rs, scene)) throw Error("render: the frame was built without the levels of detail this camera needs");
+    const glm::dvec3 origin = scene.camera.position;
+    const std::vector<int> level = instanceLevels(scene, rs.meshLevels);
+
+    AccelStats& st = rs.m_stats;
+    st.instancedTriangles = 0.0;
+    std::fill(std::begin(st.instancesPerLevel), std::end(st.instancesPerLevel), size_t(0));
+    rs.instances.clear();
+    rs.instances.reserve(ni);
+    std::vector<Bounds3> boxes(ni);
+    for (size_t i = 0; i < ni; ++i) {
+        const InstanceDesc& d = scene.instances[i];
+        InstanceRecord rec = makeInstance(d, origin);
+        rec.geometry = d.group != kNoGroup ? rs.groupGeometry[d.group] : rs.meshLevels[d.species].geometry[size_t(level[i])];
+        rs.instances.push_back(rec);
+        boxes[i] = instanceBox(d, rs.geometryBounds[rec.geometry], origin);
+        st.instancedTriangles += rs.geometryTriangles[rec.geometry];
+        if (d.group == kNoGroup) ++st.instancesPerLevel[size_t(level[i])];
     }
     BvhBuildSettings ts;
     ts.maxLeafSize = 2;
-    ts.wide = scene.render.accel == AccelKind::Bvh;
+    ts.wide = true;   // the host's 8-wide copy
     Bvh tlas = buildBvh(boxes, ts);
     rs.tlasNodes = std::move(tlas.nodes);
     rs.tlasWideNodes = std::move(tlas.wideNodes);
     rs.tlasOrder = std::move(tlas.primOrder);
-    if (scene.render.accel != AccelKind::KdTree) rs.m_stats.tlasDepth = tlas.depth;
-    rs.m_stats.wideTlasDepth = tlas.wideDepth;
+    st.tlasDepth = tlas.depth;
+    st.wideTlasDepth = tlas.wideDepth;
+    st.instances = ni;
 
     // Environment, camera, settings.
     RenderView& b = rs.base;
@@ -431,32 +583,22 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
     b.sunDir = glm::normalize(sd);
     b.sunRadiance = sunRadiance;
     b.sky = scene.sky;
-    b.camera = makeCamera(scene.camera, scene.render.width, scene.render.height);
-    b.width = scene.render.width;
-    b.height = scene.render.height;
-    b.spp = scene.render.spp;
-    b.accel = scene.render.accel;
+    b.camera = makeCamera(scene.camera, width, height);
+    b.width = width;
+    b.height = height;
+    b.spp = spp;
+    b.accel = rs.accel;
     b.shadows = scene.render.shadows;
     b.indirectScale = scene.render.indirectScale;
     b.alphaDistance = scene.render.alphaDistance;
+    countBytes(rs);
+}
 
-    AccelStats& st = rs.m_stats;
-    if (scene.render.accel == AccelKind::KdTree) {
-        st.tlasBytes = rs.kdTlasNodes.size() * sizeof(KdNode) + rs.kdTlasRefs.size() * sizeof(uint32_t);
-        st.blasBytes = rs.kdBlasNodes.size() * sizeof(KdNode) + rs.kdBlasRefs.size() * sizeof(uint32_t) +
-                       rs.kdSpecies.size() * sizeof(KdSpeciesRecord);
-    } else {
-        st.tlasBytes = rs.tlasNodes.size() * sizeof(BvhNode) + rs.tlasOrder.size() * sizeof(uint32_t);
-        st.wideTlasBytes = rs.tlasWideNodes.size() * sizeof(BvhNode8);
-        st.blasBytes = rs.blasNodes.size() * sizeof(BvhNode);
-        st.wideBlasBytes = rs.blasWideNodes.size() * sizeof(BvhNode8);
-    }
-    st.instanceBytes = rs.instances.size() * sizeof(InstanceRecord);
-    st.triangleBytes = scene.render.accel == AccelKind::KdTree ? rs.tris.size() * sizeof(TriAccel)
-                                                               : rs.blocks.size() * sizeof(TriBlock);
-    st.pruneBytes = (rs.blasNodes.size() - nodesBefore) * sizeof(BvhNode) + (rs.tris.size() - trisBefore) * sizeof(TriAccel) +
-                    (rs.blocks.size() - blocksBefore) * sizeof(TriBlock) + (rs.blasWideNodes.size() - wideBefore) * sizeof(BvhNode8);
-    st.instances = rs.instances.size();
+RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
+                             Progress* progress)
+{
+    RenderScene rs = buildSceneGeometry(scene, assets, LodLevels::Used, progress);
+    placeTopLevel(rs, scene, sunRadiance, scene.render.width, scene.render.height, scene.render.spp);
     if (progress) progress->report(1.0, "acceleration structures built");
     return rs;
 }

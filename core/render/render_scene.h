@@ -27,64 +27,80 @@ struct SpeciesAssets {
 struct AccelStats {
     size_t tlasBytes = 0, instanceBytes = 0, blasBytes = 0, triangleBytes = 0;   // the structures the run traverses
     size_t wideTlasBytes = 0, wideBlasBytes = 0;   // the host's 8-wide copies of the BVHs (the host traverses them instead)
-    size_t instances = 0, speciesTriangles = 0;
+    size_t instances = 0, speciesTriangles = 0;   // instances: of the top level
     double instancedTriangles = 0.0;     // triangles the instances trace (pruned levels count their own)
     int tlasDepth = 0, maxBlasDepth = 0;
     int wideTlasDepth = 0, maxWideBlasDepth = 0;   // of the host's 8-wide copies
     size_t prunedLevels = 0;             // pruned levels of detail built (only those some instance uses)
     size_t pruneBytes = 0;               // their BVH nodes, triangles and blocks (included in the sizes above)
     size_t instancesPerLevel[kMaxPruneLevels] = {};   // instances per level of detail, 0 = full
+    size_t groups = 0, groupInstances = 0;   // instance groups and the instances inside them
 };
 
-// Owns the flat arrays; view() points into them (valid while this object lives and is not modified).
+// The pruned levels of detail a scene build makes meshes for: those the scene's camera gives some
+// instance (sylva render), or every level each species supports (the studio's viewport, whose camera
+// moves after the build).
+enum class LodLevels { Used, All };
+
+// Owns the flat arrays (SYLVA_RENDER_ARRAYS in render_view.h); view() points into them (valid while this
+// object lives and is not modified). Built in two steps that every front end shares: buildSceneGeometry
+// (meshes, pruned levels, groups: camera-independent) and placeTopLevel (the top level's instances and
+// BVH in the camera-relative frame, environment, camera, settings).
 class RenderScene {
 public:
     RenderView view() const;
     const AccelStats& stats() const { return m_stats; }
 
-    // Everything below is filled by buildRenderScene; the CUDA backend uploads these arrays as they are.
-    std::vector<BvhNode> tlasNodes;
-    std::vector<BvhNode8> tlasWideNodes;   // host only: the same top level under 8-wide nodes (BVH runs)
-    std::vector<uint32_t> tlasOrder;
-    std::vector<InstanceRecord> instances;
-    std::vector<SpeciesRecord> species;
-    std::vector<BvhNode> blasNodes;
-    std::vector<BvhNode8> blasWideNodes;   // host only: the same leaves under 8-wide nodes (BVH runs)
-    std::vector<TriAccel> tris;
-    std::vector<TriBlock> blocks;
-    std::vector<glm::uvec3> triVerts;
-    std::vector<uint32_t> triMaterial;
-    std::vector<glm::vec3> normals;
-    std::vector<glm::vec2> uvs;
-    std::vector<MaterialRecord> materials;
-    std::vector<TextureRecord> textures;
-    std::vector<glm::vec4> texels;
-    std::vector<AlphaMaskRecord> alphaMasks;
-    std::vector<uint32_t> alphaBits;
-    std::vector<float> lighting;
-    // kd-tree alternative, built only when the scene asks for accel kdtree
-    std::vector<KdNode> kdTlasNodes, kdBlasNodes;
-    std::vector<uint32_t> kdTlasRefs, kdBlasRefs;
-    std::vector<KdSpeciesRecord> kdSpecies;
+#define SYLVA_X(part, where, T, name, stat) std::vector<T> name;
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
     RenderView base{};                  // environment, camera and settings (pointers filled by view())
+
+    // What placeTopLevel needs of the camera-independent part (host only, never traced).
+    struct MeshLevels {
+        glm::dvec3 centre{0.0};         // species-frame box centre (distance to the camera for pruning)
+        int levels = 1;                 // levels of detail the species supports
+        uint32_t geometry[kMaxPruneLevels];   // geometry record of each level, kNoHit where not built
+    };
+    std::vector<MeshLevels> meshLevels;        // per species
+    std::vector<uint32_t> groupGeometry;       // per scene group: its geometry record
+    std::vector<Bounds3> geometryBounds;       // per geometry record: bounds in its frame (instance boxes)
+    std::vector<double> geometryTriangles;     // per geometry record: the triangles an instance of it traces
+    AccelKind accel = AccelKind::Bvh;          // the mesh structures built
+    LodLevels lodLevels = LodLevels::Used;
     AccelStats m_stats;
 };
 
-// Builds the arrays for a scene: one BVH (or, for accel kdtree, one kd-tree) per species (in
-// parallel), one over the instances in the
-// camera-relative frame (world minus the camera position, computed in double: precision does not
-// depend on the distance from the world origin). assets[i] belongs to scene.species[i].
-// With render.pruneDistance > 0 each instance gets the level of detail of its distance to the camera
-// (core/render/prune.h) and every level in use gets its own BVH (kd-tree), after the species' records;
-// render.alphaDistance goes to RenderView::alphaDistance.
-// sunRadiance is the sun's linear RGB (colour x intensity). Throws Error on inconsistent input.
+// Step 1: the camera-independent part. One BVH (or, for accel kdtree, one kd-tree) per species and per
+// pruned level (in parallel; with render.pruneDistance > 0 the levels `lod` asks for, core/render/prune.h),
+// one BVH per instance group of scene.groups over its instances in the group's frame (groups nest at most
+// kMaxLevels - 1 deep), textures, cut-outs and lighting grids. assets[i] belongs to scene.species[i].
+// Throws Error on inconsistent input (missing species or group, a cycle or too deep nesting of groups).
+RenderScene buildSceneGeometry(const Scene& scene, const std::vector<SpeciesAssets>& assets, LodLevels lod = LodLevels::Used,
+                               Progress* progress = nullptr);
+
+// Step 2: the top level for `scene` at width x height and spp: instance records and their BVH in the
+// camera-relative frame (world minus the camera position, computed in double: precision does not depend
+// on the distance from the world origin), each instance of a species at the level of detail of its
+// distance to the camera; ground, sun (sunRadiance: linear RGB, colour x intensity), sky, camera and
+// settings. The scene's species and groups must be those `rs` was built from. Costs O(instances); throws
+// Error (no instances, a missing species or group, a degenerate camera, a level the build lacks:
+// see hasLevelsFor).
+void placeTopLevel(RenderScene& rs, const Scene& scene, const glm::vec3& sunRadiance, int width, int height, int spp);
+
+// Whether `rs` holds every level of detail placeTopLevel needs for `scene` (a LodLevels::All build always
+// does; a LodLevels::Used build for the camera it was built with).
+bool hasLevelsFor(const RenderScene& rs, const Scene& scene);
+
+// Both steps at the scene's own size and samples: what sylva render, the banded renders and the exports trace.
 RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
                              Progress* progress = nullptr);
 
 // Camera basis and image extents for a camera and image size (throws Error on a degenerate camera).
 CameraRecord makeCamera(const CameraDesc& camera, int width, int height);
 
-// The instance's world -> species map in the frame whose origin is `frameOrigin` (world metres).
+// The instance's parent -> geometry map in the frame whose origin is `frameOrigin` (parent-frame metres).
+// geometry = the species (buildRenderScene picks a pruned level or the group's record).
 InstanceRecord makeInstance(const InstanceDesc& inst, const glm::dvec3& frameOrigin);
 
 } // namespace sylva

@@ -45,41 +45,58 @@ struct alignas(64) TriBlock {
 };
 static_assert(sizeof(TriBlock) == 256);
 
-// A placed plant: world (camera-relative) -> species frame as a 3x4 row-major affine map
-// (rotation and uniform scale only, so normals map back with the transpose). 64 bytes.
+// The levels a ray descends at most: the top level and up to kMaxLevels - 1 nested instance groups
+// above a mesh (seed 002: terrain cells -> tiles -> plants -> meshes).
+inline constexpr int kMaxLevels = kMaxNested + 1;
+
+// An instance: a geometry placed in its parent's frame by a 3x4 row-major affine map parent -> the
+// geometry's frame (rotation and uniform scale only, so normals map back with the transpose). The top
+// level's instances map the camera-relative world frame (computed in double, so precision does not
+// depend on the distance from the world origin); an instance inside a group maps the group's own frame.
+// 64 bytes.
 struct InstanceRecord {
-    glm::vec4 row[3];        // local = row[i].xyz . world + row[i].w
-    uint32_t species;        // shading: materials, lighting grid (RenderView::species[species])
-    float scale;             // world metres per species metre
-    uint32_t geometry;       // the triangles traced: RenderView::species[geometry] (kdSpecies[geometry]) is the
-                             // species itself or one of its pruned levels of detail
-    uint32_t pad;
+    glm::vec4 row[3];        // local = row[i].xyz . parent + row[i].w
+    uint32_t geometry;       // RenderView::geometries[geometry]: a mesh (a species or one of its pruned
+                             // levels of detail) or an instance group
+    float scale;             // parent metres per geometry metre
+    uint32_t pad[2];
 };
 static_assert(sizeof(InstanceRecord) == 64);
 
-// Per species: where its BVH nodes and triangles start in the flat arrays, its lighting grid. 48 bytes.
-// Records 0 .. species-1 are the species; the records after them are pruned levels of detail of a
-// species (own BVH and triangles, the species' lighting grid), reached only through InstanceRecord::geometry.
+// What an instance can point to. A new kind (height-field terrain, volume grid) adds an enumerator, its
+// fields in GeometryRecord and one case in traceGeometry (core/render/trace.h).
+enum class GeometryKind : uint32_t {
+    Mesh = 0,                // triangles under a BVH (or kd-tree), shaded with a species' data
+    Group = 1,               // instances of other geometries under their own BVH (groups nest)
+};
+
+// One geometry: where its acceleration structure and primitives start in the flat arrays, its bounds in
+// its own frame. 64 bytes.
+struct GeometryRecord {
+    GeometryKind kind;
+    uint32_t species;        // Mesh: RenderView::species[species] (materials, lighting grid); Group: kNoHit
+    uint32_t nodeOffset;     // Mesh: into blasNodes (leaves index blocks); Group: into groupNodes (leaves
+                             // index groupOrder)
+    uint32_t wideNodeOffset; // the host's 8-wide copy: Mesh into blasWideNodes, Group into groupWideNodes
+    uint32_t primOffset;     // Mesh: into blocks; Group: into groupOrder (slot -> index into groupInstances)
+    uint32_t triOffset;      // Mesh: into tris (BVH slot order; kd-tree runs and tests)
+    uint32_t kdNodeOffset;   // Mesh in kd-tree runs: into kdNodes
+    uint32_t kdRefOffset;    // Mesh in kd-tree runs: into kdRefs (slots of tris)
+    glm::vec3 lo;
+    uint32_t primCount;      // Mesh: triangles; Group: instances
+    glm::vec3 hi;
+    uint32_t pad;
+};
+static_assert(sizeof(GeometryRecord) == 64);
+
+// Shading data of one species: its LB lighting grid. 32 bytes.
 struct SpeciesRecord {
-    uint32_t nodeOffset;     // into RenderView::blasNodes (leaves index blocks of RenderView::blocks)
-    uint32_t triOffset;      // into RenderView::tris (BVH slot order; kd-tree runs and tests)
-    uint32_t blockOffset;    // into RenderView::blocks
-    uint32_t wideNodeOffset; // into RenderView::blasWideNodes (host)
     glm::vec3 gridOrigin;    // species frame, metres, node (0,0,0)
     float gridInvSpacing;    // 1 / node spacing; 0 = no lighting grid
     glm::ivec3 gridDims;
     uint32_t gridOffset;     // into RenderView::lighting (3 floats per node, already normalized)
 };
-static_assert(sizeof(SpeciesRecord) == 48);
-
-// The kd-tree of one species (kd-tree runs): offsets into the flat kd arrays and the box rays are
-// clipped to. Its primitive references are slots of RenderView::tris, like the BVH's. 32 bytes.
-struct KdSpeciesRecord {
-    glm::vec3 lo;
-    uint32_t nodeOffset;     // into RenderView::kdBlasNodes
-    glm::vec3 hi;
-    uint32_t refOffset;      // into RenderView::kdBlasRefs
-};
+static_assert(sizeof(SpeciesRecord) == 32);
 
 // A surface material for shading. Texture indices are into RenderView::textures, -1 = none. 48 bytes.
 struct MaterialRecord {
@@ -113,39 +130,53 @@ struct CameraRecord {
     float tanHalfX, tanHalfY;
 };
 
+// The render-scene arrays, once: element type, name, part and where they live. Everything that handles
+// the arrays as a set is generated from this list: RenderScene's vectors, RenderView's pointers,
+// RenderScene::view(), the CUDA upload and re-placement (cuda/render_cuda.cu) and the byte statistics.
+// Adding an array is one line here.
+//   part  Top:    the top level, re-placed for every camera (RenderScene::placeTopLevel);
+//         Scene:  built once per set of species assets.
+//   where Both:   every backend; Host: the host only (null on the device: the 8-wide node copies).
+//   stat  the AccelStats figure its bytes count towards (Bvh*/Kd*: only in runs of that mesh structure;
+//         None: shading data, not counted).
+#define SYLVA_RENDER_ARRAYS(X)                                                                                  \
+    X(Top, Both, BvhNode, tlasNodes, Tlas)                 /* BVH over the top level's instances */            \
+    X(Top, Host, BvhNode8, tlasWideNodes, WideTlas)        /* the same top level under 8-wide nodes */         \
+    X(Top, Both, uint32_t, tlasOrder, Tlas)                /* BVH slot -> index into instances */              \
+    X(Top, Both, InstanceRecord, instances, Instances)     /* the top level (camera-relative) */               \
+    X(Scene, Both, GeometryRecord, geometries, Blas)       /* every mesh and group */                          \
+    X(Scene, Both, InstanceRecord, groupInstances, Instances) /* instances inside groups (group frames) */     \
+    X(Scene, Both, BvhNode, groupNodes, Blas)              /* groups' BVHs */                                  \
+    X(Scene, Host, BvhNode8, groupWideNodes, WideBlas)     /* the same under 8-wide nodes */                   \
+    X(Scene, Both, uint32_t, groupOrder, Blas)             /* group BVH slot -> index into groupInstances */   \
+    X(Scene, Both, SpeciesRecord, species, None)           /* per species: lighting grid */                    \
+    X(Scene, Both, BvhNode, blasNodes, BvhBlas)            /* meshes' BVHs (leaves index blocks) */            \
+    X(Scene, Host, BvhNode8, blasWideNodes, WideBlas)      /* the same leaves under 8-wide nodes */            \
+    X(Scene, Both, TriAccel, tris, KdTriangles)            /* every mesh triangle, BVH slot order */           \
+    X(Scene, Both, TriBlock, blocks, BvhTriangles)         /* BVH leaves' triangles */                         \
+    X(Scene, Both, KdNode, kdNodes, KdBlas)                /* meshes' kd-trees (kd-tree runs) */               \
+    X(Scene, Both, uint32_t, kdRefs, KdBlas)               /* their leaves' slots of tris */                   \
+    X(Scene, Both, glm::uvec3, triVerts, None)             /* shading, by TriAccel::tri: vertex indices */     \
+    X(Scene, Both, uint32_t, triMaterial, None)            /* material index */                                \
+    X(Scene, Both, glm::vec3, normals, None)               /* per vertex, species frame */                     \
+    X(Scene, Both, glm::vec2, uvs, None)                   /* per vertex */                                    \
+    X(Scene, Both, MaterialRecord, materials, None)                                                            \
+    X(Scene, Both, TextureRecord, textures, None)                                                              \
+    X(Scene, Both, glm::vec4, texels, None)                                                                    \
+    X(Scene, Both, AlphaMaskRecord, alphaMasks, None)                                                          \
+    X(Scene, Both, uint32_t, alphaBits, None)                                                                  \
+    X(Scene, Both, float, lighting, None)                  /* normalized LB photon density, 3 per node */
+
+enum class ArrayPart { Top, Scene };
+enum class ArrayWhere { Both, Host };
+enum class ArrayStat { Tlas, WideTlas, Instances, Blas, BvhBlas, KdBlas, WideBlas, KdTriangles, BvhTriangles, None };
+
 // Everything a frame needs, as pointers into flat arrays (host or device memory).
 struct RenderView {
-    // top level (instances) and bottom level (per species) BVHs
-    const BvhNode* tlasNodes;
-    const BvhNode8* tlasWideNodes;   // host only, may be null: the same top level under 8-wide nodes
-    const uint32_t* tlasOrder;       // BVH slot -> instance index
-    const InstanceRecord* instances;
-    uint32_t instanceCount;
-    const SpeciesRecord* species;
-    const BvhNode* blasNodes;
-    const BvhNode8* blasWideNodes;   // host only, may be null: the same leaves under 8-wide nodes
-    const TriAccel* tris;            // every triangle, BVH slot order (kd-tree traversal, tests)
-    const TriBlock* blocks;          // BVH leaves' triangles
-
-    // kd-tree alternative (same instances and triangles); null unless accel == KdTree
-    const KdNode* kdTlasNodes;
-    const uint32_t* kdTlasRefs;      // instance indices
-    glm::vec3 kdTlasLo, kdTlasHi;
-    const KdSpeciesRecord* kdSpecies;
-    const KdNode* kdBlasNodes;
-    const uint32_t* kdBlasRefs;
-
-    // shading data, indexed by TriAccel::tri
-    const glm::uvec3* triVerts;      // global vertex indices
-    const uint32_t* triMaterial;     // global material index
-    const glm::vec3* normals;        // per vertex, species frame
-    const glm::vec2* uvs;            // per vertex
-    const MaterialRecord* materials;
-    const TextureRecord* textures;
-    const glm::vec4* texels;
-    const AlphaMaskRecord* alphaMasks;
-    const uint32_t* alphaBits;
-    const float* lighting;           // normalized LB photon density, 3 floats per node
+#define SYLVA_X(part, where, T, name, stat) const T* name;
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
+    uint32_t instanceCount;          // of the top level
 
     // environment
     bool groundEnabled;

@@ -87,27 +87,41 @@ SYLVA_HD SYLVA_INLINE glm::vec3 offsetPoint(const glm::vec3& p, const glm::vec3&
     return p + ng * (m * 2e-5f);
 }
 
-// Shades the first surface along a camera ray.
-SYLVA_HD inline SampleParts shadeRay(const RenderView& v, const Ray& ray)
+// Shading runs in stages, each a SYLVA_HD function the CPU loop and the GPU kernel chain the same way
+// (shadeRay): intersect -> surface -> volume -> background and lights. A new stage or a new kind of
+// light goes into this chain once and runs on every backend.
+
+// Stage 1, intersect: the first surface along a camera ray (ground, or a mesh reached through the levels).
+SYLVA_HD SYLVA_INLINE bool intersectStage(const RenderView& v, const Ray& ray, Hit& hit) { return traceScene<false>(v, ray, hit); }
+
+// What the surface stage finds at a hit: the point, the normal facing the viewer, the material and the
+// LB lighting sample (species frame) the light stage needs.
+struct SurfacePoint {
+    glm::vec3 p;             // camera-relative
+    glm::vec3 ng;            // unit normal facing the viewer
+    glm::vec3 viewDir;       // toward the camera
+    glm::vec3 albedo;        // diffuse colour (times the texture)
+    glm::vec3 specular;
+    float shininess;
+    float extent;            // the hit's largest species-frame coordinate in world units (offsetPoint); 0 = ground
+    glm::vec3 lighting;      // normalized LB photon density at the point (meshes)
+    bool ground;
+};
+
+// Stage 2, surface: geometry and material at the hit.
+SYLVA_HD inline SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, const Hit& hit)
 {
-    SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f};
-    Hit hit{};
-    if (!traceScene<false>(v, ray, hit)) {
-        out.skyCover = 1.0f;
-        return out;
-    }
-    const glm::vec3 p = ray.org + hit.t * ray.dir;
-    const glm::vec3 viewDir = glm::normalize(-ray.dir);
+    SurfacePoint s{};
+    s.p = ray.org + hit.t * ray.dir;
+    s.viewDir = glm::normalize(-ray.dir);
     if (hit.prim == kGroundPrim) {
-        const glm::vec3 n(0.0f, ray.dir.y < 0.0f ? 1.0f : -1.0f, 0.0f);
-        const float nl = glm::dot(n, v.sunDir);
-        if (nl > 0.0f && sunVisible(v, offsetPoint(p, n))) out.local = v.groundColor * v.sunRadiance * nl;
-        out.indirect = v.groundColor * v.sky;   // Lambertian ground under a uniform sky
-        out.albedo = v.groundColor;
-        return out;
+        s.ground = true;
+        s.ng = glm::vec3(0.0f, ray.dir.y < 0.0f ? 1.0f : -1.0f, 0.0f);
+        s.albedo = v.groundColor;
+        return s;
     }
-    const InstanceRecord& in = v.instances[hit.inst];
-    const SpeciesRecord& sp = v.species[in.species];
+    const InstanceRecord in = hitInstance(v, hit);
+    const SpeciesRecord& sp = v.species[v.geometries[in.geometry].species];
     const glm::uvec3 tv = v.triVerts[hit.prim];
     const MaterialRecord m = v.materials[v.triMaterial[hit.prim]];
     // Geometric normal from the triangle's vertices (species frame) and the interpolated shading normal.
@@ -116,25 +130,65 @@ SYLVA_HD inline SampleParts shadeRay(const RenderView& v, const Ray& ray)
     glm::vec3 ns = b0 * v.normals[tv.x] + hit.u * v.normals[tv.y] + hit.v * v.normals[tv.z];
     glm::vec3 ng = glm::normalize(toWorldNormal(in, ns));
     if (!(glm::dot(ng, ng) > 0.5f)) ng = glm::vec3(0.0f, 1.0f, 0.0f);
-    if (glm::dot(ng, viewDir) < 0.0f) ng = -ng;   // two-sided: face the viewer
+    if (glm::dot(ng, s.viewDir) < 0.0f) ng = -ng;   // two-sided: face the viewer
+    s.ng = ng;
     glm::vec3 kd = m.diffuse;
     if (m.texture >= 0) {
         const glm::vec2 uv = b0 * v.uvs[tv.x] + hit.u * v.uvs[tv.y] + hit.v * v.uvs[tv.z];
         kd *= glm::vec3(sampleTexture(v, m.texture, uv));
     }
-    out.albedo = kd;
-    const float nl = glm::dot(ng, v.sunDir);
-    const float extent = in.scale * fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));
-    if (nl > 0.0f && sunVisible(v, offsetPoint(p, ng, extent))) {
-        glm::vec3 c = kd * nl;
-        if (m.shininess > 0.0f && (m.specular.x > 0.0f || m.specular.y > 0.0f || m.specular.z > 0.0f)) {
-            const glm::vec3 r = 2.0f * nl * ng - v.sunDir;
-            const float vr = glm::dot(viewDir, r);
-            if (vr > 0.0f) c += m.specular * powf(vr, m.shininess);
+    s.albedo = kd;
+    s.specular = m.specular;
+    s.shininess = m.shininess;
+    s.extent = in.scale * fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));
+    s.lighting = sampleLighting(v, sp, lp);
+    return s;
+}
+
+// Stage 3, volume: what participating media along the camera ray's segment [ray.tmin, tEnd] add to
+// and take from the parts behind them (no volume kind yet: the parts pass unchanged).
+SYLVA_HD SYLVA_INLINE void volumeStage(const RenderView& v, const Ray& ray, float tEnd, SampleParts& parts)
+{
+    (void)v, (void)ray, (void)tEnd, (void)parts;
+}
+
+// Stage 4, background and lights: a ray that hit nothing sees the sky; a surface gets the sun (with a
+// shadow ray) and its indirect light (LB on meshes, the uniform sky on the Lambertian ground).
+SYLVA_HD SYLVA_INLINE SampleParts backgroundStage(const RenderView& v, const Ray& ray)
+{
+    (void)v, (void)ray;
+    return SampleParts{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 1.0f};
+}
+
+SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& s)
+{
+    SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f};
+    const float nl = glm::dot(s.ng, v.sunDir);
+    if (s.ground) {
+        if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng))) out.local = v.groundColor * v.sunRadiance * nl;
+        out.indirect = v.groundColor * v.sky;
+        return out;
+    }
+    if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng, s.extent))) {
+        glm::vec3 c = s.albedo * nl;
+        if (s.shininess > 0.0f && (s.specular.x > 0.0f || s.specular.y > 0.0f || s.specular.z > 0.0f)) {
+            const glm::vec3 r = 2.0f * nl * s.ng - v.sunDir;
+            const float vr = glm::dot(s.viewDir, r);
+            if (vr > 0.0f) c += s.specular * powf(vr, s.shininess);
         }
         out.local = c * v.sunRadiance;
     }
-    out.indirect = kd * sampleLighting(v, sp, lp) * v.sunRadiance * v.indirectScale;
+    out.indirect = s.albedo * s.lighting * v.sunRadiance * v.indirectScale;
+    return out;
+}
+
+// Shades one camera ray: the stages in order.
+SYLVA_HD inline SampleParts shadeRay(const RenderView& v, const Ray& ray)
+{
+    Hit hit{};
+    const bool found = intersectStage(v, ray, hit);
+    SampleParts out = found ? lightStage(v, surfaceStage(v, ray, hit)) : backgroundStage(v, ray);
+    volumeStage(v, ray, found ? hit.t : ray.tmax, out);
     return out;
 }
 

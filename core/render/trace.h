@@ -1,4 +1,4 @@
-// Two-level ray queries over instanced species with alpha-tested leaves and a ground plane (host and device).
+// Ray queries through nested instance levels down to meshes with alpha-tested leaves and a ground plane (host and device).
 #pragma once
 
 #include "core/accel/bvh.h"
@@ -142,17 +142,135 @@ SYLVA_HD SYLVA_INLINE glm::vec3 toWorldNormal(const InstanceRecord& in, const gl
     return glm::vec3(in.row[0]) * n.x + glm::vec3(in.row[1]) * n.y + glm::vec3(in.row[2]) * n.z;
 }
 
-// Closest hit along the ray (camera-relative world frame) over instances and the ground, through
-// the BVHs (Kd = false) or the kd-trees (Kd = true) at both levels. AnyHit stops at the first
-// accepted hit (shadow rays). An instance is traced with its geometry record (the species or a pruned
-// level of it); cut-outs are tested up to alphaTestLimit. Returns true on a hit.
+// The composite of two instance maps: `inner` (in the frame `outer` maps to) after `outer`. The result
+// maps outer's parent frame to inner's geometry frame; scales multiply.
+SYLVA_HD SYLVA_INLINE InstanceRecord composeInstances(const InstanceRecord& inner, const InstanceRecord& outer)
+{
+    InstanceRecord r = inner;
+    for (int i = 0; i < 3; ++i) {
+        const glm::vec4& a = inner.row[i];
+        for (int j = 0; j < 4; ++j)
+            r.row[i][j] = a.x * outer.row[0][j] + a.y * outer.row[1][j] + a.z * outer.row[2][j] + (j == 3 ? a.w : 0.0f);
+    }
+    r.scale = inner.scale * outer.scale;
+    return r;
+}
+
+// The hit instance as one map from the camera-relative world frame to the hit mesh's frame (the
+// instances along the hit's path composed) with its mesh geometry and the total scale.
+SYLVA_HD inline InstanceRecord hitInstance(const RenderView& v, const Hit& hit)
+{
+    InstanceRecord m = v.instances[hit.inst];
+    for (uint32_t k = 0; k < hit.depth && k < uint32_t(kMaxNested); ++k) m = composeInstances(v.groupInstances[hit.nested[k]], m);
+    return m;
+}
+
+namespace trace_detail {
+
+// What one query carries down the levels: the view, the ray's limits, the hit and the instance path.
+struct Query {
+    const RenderView& v;
+    float tmin;
+    float tAlpha;
+    Hit& hit;
+    uint32_t path[kMaxLevels];   // path[0]: top-level instance; path[k]: groupInstances index at depth k
+};
+
+// Records a closer hit of triangle `tri` found `depth` levels below the top.
+SYLVA_HD SYLVA_INLINE void recordHit(Query& q, int depth, float t, float u, float w, uint32_t tri)
+{
+    q.hit.t = t;
+    q.hit.u = u;
+    q.hit.v = w;
+    q.hit.prim = tri;
+    q.hit.inst = q.path[0];
+    q.hit.depth = uint32_t(depth);
+    for (int k = 1; k <= depth; ++k) q.hit.nested[k - 1] = q.path[k];
+}
+
+// A mesh in its own frame: its BVH over triangle blocks (Kd = false; the host walks the 8-wide copy when
+// the view has it) or its kd-tree (Kd = true). Returns true when an any-hit query found a hit.
+template <bool AnyHit, bool Kd>
+SYLVA_HD inline bool traceMesh(Query& q, const GeometryRecord& geo, int depth, const glm::vec3& o, const glm::vec3& d,
+                               float& tmax)
+{
+    const RenderView& v = q.v;
+    if constexpr (Kd) {
+        const TriAccel* tris = v.tris + geo.triOffset;
+        auto triFn = [&](uint32_t s, float& t) {
+            float u, w;
+            if (!hitTriangle(v, tris[s], o, d, q.tmin, t, u, w, q.tAlpha)) return false;
+            if (!AnyHit) recordHit(q, depth, t, u, w, tris[s].tri);
+            return AnyHit;
+        };
+        const KdView view{v.kdNodes + geo.kdNodeOffset, v.kdRefs + geo.kdRefOffset, geo.lo, geo.hi};
+        return traverseKd(view, o, d, q.tmin, tmax, triFn);
+    } else {
+        const TriBlock* blocks = v.blocks + geo.primOffset;
+        auto blockFn = [&](uint32_t block, uint32_t count, float& t) {
+            float u, w;
+            uint32_t tri;
+            if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, q.tmin, t, u, w, tri, q.tAlpha)) return false;
+            if (!AnyHit) recordHit(q, depth, t, u, w, tri);
+            return AnyHit;
+        };
+        const char* leafData = reinterpret_cast<const char*>(blocks);
+#if !defined(__CUDACC__)
+        // The host's 8-wide flattening of the same tree when the scene has it (same leaves; the same
+        // closest hit up to which of two triangles at exactly the same t wins).
+        if (v.blasWideNodes)
+            return traverseBvh(BvhView8{v.blasWideNodes + geo.wideNodeOffset, leafData, sizeof(TriBlock)}, o, d, q.tmin, tmax,
+                               blockFn);
+#endif
+        return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset, leafData, sizeof(TriBlock)}, o, d, q.tmin, tmax, blockFn);
+    }
+}
+
+// The instances of one level (the top level, or a group at `Depth` > 0) under their BVH: each entered
+// instance maps the ray into its geometry's frame and descends into it. The chain of levels is bounded at
+// compile time (kMaxLevels); the builder refuses deeper nesting. Returns true when an any-hit query found a hit.
+template <bool AnyHit, bool Kd, int Depth>
+SYLVA_HD inline bool traceLevel(Query& q, const BvhNode* nodes, const BvhNode8* wideNodes, const uint32_t* order,
+                                const InstanceRecord* instances, const glm::vec3& o,
+                                const glm::vec3& d, float& tmax)
+{
+    const RenderView& v = q.v;
+    auto instanceFn = [&](uint32_t slot, float& t) {
+        const uint32_t index = order[slot];
+        const InstanceRecord& in = instances[index];
+        q.path[Depth] = index;
+        const glm::vec3 lo = toLocalPoint(in, o), ld = toLocalDir(in, d);
+        const GeometryRecord& geo = v.geometries[in.geometry];
+        if (geo.kind == GeometryKind::Mesh) return traceMesh<AnyHit, Kd>(q, geo, Depth, lo, ld, t);
+        if constexpr (Depth + 1 < kMaxLevels) {
+            if (geo.kind == GeometryKind::Group)
+                return traceLevel<AnyHit, Kd, Depth + 1>(q, v.groupNodes + geo.nodeOffset,
+                                                         v.groupWideNodes ? v.groupWideNodes + geo.wideNodeOffset : nullptr,
+                                                         v.groupOrder + geo.primOffset, v.groupInstances, lo, ld, t);
+        }
+        return false;
+    };
+#if !defined(__CUDACC__)
+    if (wideNodes) return traverseBvh(BvhView8{wideNodes}, o, d, q.tmin, tmax, instanceFn);
+#else
+    (void)wideNodes;
+#endif
+    return traverseBvh(BvhView{nodes}, o, d, q.tmin, tmax, instanceFn);
+}
+
+} // namespace trace_detail
+
+// Closest hit along the ray (camera-relative world frame) over the ground and the top level's instances,
+// descending through instance groups to meshes traced through their BVHs (Kd = false) or kd-trees
+// (Kd = true; groups and the top level always use BVHs). AnyHit stops at the first accepted hit (shadow
+// rays). Cut-outs are tested up to alphaTestLimit. Returns true on a hit.
 template <bool AnyHit, bool Kd>
 SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hit)
 {
     hit.prim = kNoHit;
     hit.inst = kNoHit;
+    hit.depth = 0;
     float tmax = ray.tmax;
-    const float tAlpha = alphaTestLimit(v, ray);
     if (v.groundEnabled && ray.dir.y != 0.0f) {
         const float tg = (v.groundY - ray.org.y) / ray.dir.y;
         if (tg > ray.tmin && tg < tmax) {
@@ -163,66 +281,10 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
             hit.u = hit.v = 0.0f;
         }
     }
-    auto instanceFn = [&](uint32_t inst, float& tlasMax) {
-        const InstanceRecord& in = v.instances[inst];
-        const glm::vec3 o = toLocalPoint(in, ray.org), d = toLocalDir(in, ray.dir);
-        const SpeciesRecord& geo = v.species[in.geometry];
-        const TriAccel* tris = v.tris + geo.triOffset;
-        auto triFn = [&](uint32_t s, float& blasMax) {
-            float u, w;
-            if (!hitTriangle(v, tris[s], o, d, ray.tmin, blasMax, u, w, tAlpha)) return false;
-            if (!AnyHit) {
-                hit.t = blasMax;
-                hit.u = u;
-                hit.v = w;
-                hit.prim = tris[s].tri;
-                hit.inst = inst;
-            }
-            return AnyHit;
-        };
-        if constexpr (Kd) {
-            const KdSpeciesRecord& k = v.kdSpecies[in.geometry];
-            const KdView view{v.kdBlasNodes + k.nodeOffset, v.kdBlasRefs + k.refOffset, k.lo, k.hi};
-            return traverseKd(view, o, d, ray.tmin, tlasMax, triFn);
-        } else {
-            const TriBlock* blocks = v.blocks + geo.blockOffset;
-            auto blockFn = [&](uint32_t block, uint32_t count, float& blasMax) {
-                float u, w;
-                uint32_t tri;
-                if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, ray.tmin, blasMax, u, w, tri, tAlpha)) return false;
-                if (!AnyHit) {
-                    hit.t = blasMax;
-                    hit.u = u;
-                    hit.v = w;
-                    hit.prim = tri;
-                    hit.inst = inst;
-                }
-                return AnyHit;
-            };
-            const char* leafData = reinterpret_cast<const char*>(blocks);
-#if !defined(__CUDACC__)
-            // The host's 8-wide flattening of the same tree when the scene has it (same leaves; the same
-            // closest hit up to which of two triangles at exactly the same t wins).
-            if (v.blasWideNodes)
-                return traverseBvh(BvhView8{v.blasWideNodes + geo.wideNodeOffset, leafData, sizeof(TriBlock)}, o, d, ray.tmin,
-                                   tlasMax, blockFn);
-#endif
-            return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset, leafData, sizeof(TriBlock)}, o, d, ray.tmin, tlasMax,
-                               blockFn);
-        }
-    };
-    bool stopped;
-    if constexpr (Kd) {
-        const KdView tlas{v.kdTlasNodes, v.kdTlasRefs, v.kdTlasLo, v.kdTlasHi};
-        stopped = traverseKd(tlas, ray.org, ray.dir, ray.tmin, tmax, instanceFn);
-    } else {
-        auto slotFn = [&](uint32_t slot, float& tlasMax) { return instanceFn(v.tlasOrder[slot], tlasMax); };
-#if !defined(__CUDACC__)
-        if (v.tlasWideNodes) stopped = traverseBvh(BvhView8{v.tlasWideNodes}, ray.org, ray.dir, ray.tmin, tmax, slotFn);
-        else
-#endif
-            stopped = traverseBvh(BvhView{v.tlasNodes}, ray.org, ray.dir, ray.tmin, tmax, slotFn);
-    }
+    if (v.instanceCount == 0) return AnyHit ? false : hit.prim != kNoHit;
+    trace_detail::Query q{v, ray.tmin, alphaTestLimit(v, ray), hit, {}};
+    const bool stopped = trace_detail::traceLevel<AnyHit, Kd, 0>(q, v.tlasNodes, v.tlasWideNodes, v.tlasOrder, v.instances,
+                                                                 ray.org, ray.dir, tmax);
     if (AnyHit) return stopped;
     return hit.prim != kNoHit;
 }

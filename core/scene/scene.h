@@ -41,13 +41,26 @@ struct SpeciesDesc {
     int grid = 64;                       // LB grid nodes along the longest edge
 };
 
-// One placed plant. World metres; rotation in degrees applied X, then Y, then Z (R = Rz * Ry * Rx),
-// then uniform scale, then translation. 64 bytes.
+inline constexpr uint32_t kNoGroup = 0xffffffffu;
+
+// One placed plant (or group of them). Metres of the parent frame (the world, or the group it belongs
+// to); rotation in degrees applied X, then Y, then Z (R = Rz * Ry * Rx), then uniform scale, then
+// translation. 48 bytes.
 struct InstanceDesc {
-    uint32_t species = 0;                // index into Scene::species
+    uint32_t species = 0;                // index into Scene::species (when group == kNoGroup)
+    uint32_t group = kNoGroup;           // else: index into Scene::groups, placed as a whole
     glm::dvec3 position{0.0};            // world metres of the mesh origin (doubles: terrains are km wide)
     glm::vec3 rotationDeg{0.0f};
     float scale = 1.0f;                  // uniform, > 0
+};
+
+// A reusable set of instances in its own frame (a tile of plants, a stand), placed by instances of the
+// scene or of other groups: groups nest, at most 3 deep below the scene's own instances (the renderer's
+// kMaxLevels), and never contain themselves. Each is traced through its own acceleration structure,
+// built once however often it is placed.
+struct GroupDesc {
+    std::string name;
+    std::vector<InstanceDesc> instances;
 };
 
 struct GroundDesc {
@@ -93,6 +106,7 @@ struct Scene {
     int version = 1;
     std::vector<SpeciesDesc> species;
     std::vector<InstanceDesc> instances;
+    std::vector<GroupDesc> groups;       // instance groups (built in code today; scene files hold none yet)
     GroundDesc ground;
     SunDesc sun;
     glm::vec3 sky{0.55f, 0.70f, 0.95f};  // linear RGB radiance of the background

@@ -1,5 +1,5 @@
-// Moving a built RenderScene to a new camera, instance placement or environment without rebuilding the
-// species BVHs: the studio's fast path for camera moves and instance edits.
+// The studio's frame: the camera-independent part of a RenderScene built once per set of species assets,
+// the top level re-placed for every camera move or instance edit, through the same two steps as sylva render.
 #pragma once
 
 #include <vector>
@@ -9,20 +9,23 @@
 
 namespace sylva {
 
-// A RenderScene built once per set of species assets, plus what the fast path needs.
+// A RenderScene whose meshes, every level of detail (when the scene prunes) and groups are built once.
 struct ViewFrame {
     RenderScene rs;
-    std::vector<Bounds3> speciesBounds;   // per species, species frame
 };
 
-// Builds the species part (buildRenderScene with the scene's BVH accel) and records species bounds.
-// Throws Error (e.g. a scene without instances).
+// buildSceneGeometry with the BVH and every level of detail (the camera moves after the build), then
+// placeTopLevel at the scene's camera and size. Throws Error (e.g. a scene without instances).
 ViewFrame buildViewFrame(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance);
 
-// Re-places the frame for `scene` at width x height: instance records and the instance BVH in the
-// camera-relative frame of scene.camera, ground, sun, sky, camera and settings, exactly as
-// buildRenderScene lays them out. The species (list and assets) must be those the frame was built with.
-// Costs O(instances); throws Error on a degenerate camera or a missing species.
+// Whether `frame` can be re-placed for `scene` (the same species and groups assumed): false when the
+// scene prunes and the frame was built without its levels of detail (then build it again).
+bool viewFrameFits(const ViewFrame& frame, const Scene& scene);
+
+// placeTopLevel for `scene` at width x height and spp: exactly the top level sylva render builds for the
+// same camera (the levels of detail included). The species (list and assets) and groups must be those the
+// frame was built with. Costs O(instances); throws Error on a degenerate camera, a missing species, or a
+// frame that does not fit (viewFrameFits).
 void placeViewFrame(ViewFrame& frame, const Scene& scene, const glm::vec3& sunRadiance, int width, int height, int spp);
 
 } // namespace sylva

@@ -171,9 +171,9 @@ struct EmbreePeer {
         const long long base = g_embreeBytes.load();
 
         double t0 = now();
-        for (size_t s = 0; s < rs.species.size(); ++s) {
-            const uint32_t first = rs.species[s].triOffset;
-            const uint32_t last = s + 1 < rs.species.size() ? rs.species[s + 1].triOffset : uint32_t(rs.tris.size());
+        for (const GeometryRecord& g : rs.geometries) {   // the forest's geometries are meshes only
+            if (g.kind != GeometryKind::Mesh) throw std::runtime_error("the Embree peer takes meshes only");
+            const uint32_t first = g.triOffset, last = g.triOffset + g.primCount;
             RTCScene scene = rtcNewScene(device);
             rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
             rtcSetSceneBuildQuality(scene, quality);
@@ -236,7 +236,7 @@ struct EmbreePeer {
                 for (int r = 0; r < 3; ++r) xfm[c * 3 + r] = float(ai[c][r]);
             for (int r = 0; r < 3; ++r) xfm[9 + r] = float(ti[r]);
             RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
-            rtcSetGeometryInstancedScene(geom, species[in.species]);
+            rtcSetGeometryInstancedScene(geom, species[in.geometry]);
             rtcSetGeometryTimeStepCount(geom, 1);
             rtcSetGeometryTransform(geom, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
             rtcCommitGeometry(geom);

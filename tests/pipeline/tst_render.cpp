@@ -53,7 +53,7 @@ float bruteForce(const RenderView& v, size_t triCount, const Ray& ray, uint32_t*
     *prim = kNoHit;
     for (uint32_t i = 0; i < v.instanceCount; ++i) {
         const InstanceRecord& in = v.instances[i];
-        const SpeciesRecord& sp = v.species[in.species];
+        const GeometryRecord& sp = v.geometries[in.geometry];
         const glm::vec3 o = toLocalPoint(in, ray.org), d = toLocalDir(in, ray.dir);
         for (size_t t = 0; t < triCount; ++t) {
             float u, w;

@@ -49,8 +49,8 @@ double triangleArea(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c)
 // Leaf area of a geometry record of a built scene (its triangles whose material is a leaf).
 double recordLeafArea(const RenderScene& rs, size_t record)
 {
-    const size_t begin = rs.species[record].triOffset;
-    const size_t end = record + 1 < rs.species.size() ? rs.species[record + 1].triOffset : rs.tris.size();
+    const size_t begin = rs.geometries[record].triOffset;
+    const size_t end = begin + rs.geometries[record].primCount;
     double area = 0.0;
     for (size_t i = begin; i < end; ++i) {
         const TriAccel& t = rs.tris[i];
@@ -202,11 +202,11 @@ private Q_SLOTS:
         }
         const RenderScene rs = buildRenderScene(s, assets, glm::vec3(1.0f));
         QCOMPARE(rs.stats().prunedLevels, size_t(4));   // levels 1, 2, 3 and 5 in use; level 0 is the species itself
-        QCOMPARE(rs.species.size(), size_t(5));
+        QCOMPARE(rs.geometries.size(), size_t(5));
         const double fullArea = recordLeafArea(rs, 0);
         for (size_t i = 0; i < distances.size(); ++i) {
             const uint32_t g = rs.instances[i].geometry;
-            QCOMPARE(rs.instances[i].species, 0u);
+            QCOMPARE(rs.geometries[g].species, 0u);
             if (expected[i] == 0) QCOMPARE(g, 0u);
             else QVERIFY(g >= 1);
             const double a = recordLeafArea(rs, g);
@@ -243,7 +243,7 @@ private Q_SLOTS:
             const RenderView v = rs.view();
             const InstanceRecord& inst = rs.instances[0];
             QVERIFY(inst.geometry == 1u);
-            const size_t begin = rs.species[1].triOffset, end = rs.tris.size();
+            const size_t begin = rs.geometries[1].triOffset, end = rs.tris.size();
             std::mt19937 rng(3);
             std::uniform_real_distribution<float> u(-1.0f, 1.0f);
             int hits = 0;
