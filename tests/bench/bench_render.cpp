@@ -50,10 +50,11 @@ Timing timeReps(int reps, F&& f)
 }
 
 // The renderer's schedule: oneTBB over 8x8 pixel tiles, 4 tiles per task. f(x0, y0, x1, y1).
+constexpr int kTile = 8;
+
 template <class F>
 void forTiles(int width, int height, F&& f)
 {
-    constexpr int kTile = 8;
     const int tilesX = (width + kTile - 1) / kTile, tilesY = (height + kTile - 1) / kTile;
     tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 4), [&](const tbb::blocked_range<int>& r) {
         for (int tile = r.begin(); tile < r.end(); ++tile) {
@@ -396,6 +397,89 @@ void embreeOccluded8(RTCScene scene, const RenderView& v, const Ray* rays, const
         if (valid[k] == -1) out[k] = r.tfar[k] < 0.0f ? 1 : 0;
 }
 
+// Embree's stream mode: the rays of one 8x8 tile as one rtcIntersect1M / rtcOccluded1M call with the coherent flag
+// (Embree regroups a stream into packets itself). Ground plane outside Embree as in the other modes.
+constexpr int kStreamMax = kTile * kTile;
+
+void embreeRayFrom(RTCRay& r, const Ray& ray, float tfar, unsigned id)
+{
+    r.org_x = ray.org.x;
+    r.org_y = ray.org.y;
+    r.org_z = ray.org.z;
+    r.tnear = ray.tmin;
+    r.dir_x = ray.dir.x;
+    r.dir_y = ray.dir.y;
+    r.dir_z = ray.dir.z;
+    r.time = 0.0f;
+    r.tfar = tfar;
+    r.mask = 0xffffffffu;
+    r.id = id;
+    r.flags = 0;
+}
+
+// Camera rays of the tile [x0, x1) x [y0, y1) (at most kStreamMax pixels) into `image` (row length W).
+void embreePrimaryStream(RTCScene scene, const RenderView& v, int W, int x0, int y0, int x1, int y1, PrimaryResult* image)
+{
+    RTCRayHit rh[kStreamMax];
+    PrimaryResult* dst[kStreamMax];
+    unsigned n = 0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x, ++n) {
+            const Ray ray = pixelRay(v, x, y);
+            PrimaryResult& out = image[size_t(y) * size_t(W) + size_t(x)];
+            out = {kNoHit, 0.0f};
+            float tmax = ray.tmax;
+            if (v.groundEnabled && ray.dir.y != 0.0f) {
+                const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+                if (tg > ray.tmin && tg < tmax) {
+                    tmax = tg;
+                    out = {kGroundPrim, tg};
+                }
+            }
+            embreeRayFrom(rh[n].ray, ray, tmax, n);
+            rh[n].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rh[n].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            dst[n] = &out;
+        }
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcIntersect1M(scene, &ctx, rh, n, sizeof(RTCRayHit));
+    for (unsigned k = 0; k < n; ++k)
+        if (rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID) *dst[k] = {rh[k].hit.instID[0], rh[k].ray.tfar};
+}
+
+// The active shadow rays of the same tile (those not already stopped by the ground) as one stream.
+void embreeOccludedStream(RTCScene scene, const RenderView& v, int W, int x0, int y0, int x1, int y1, const Ray* rays,
+                          const uint8_t* active, uint8_t* occluded)
+{
+    RTCRay r[kStreamMax];
+    size_t index[kStreamMax];
+    unsigned n = 0;
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            const size_t i = size_t(y) * size_t(W) + size_t(x);
+            if (!active[i]) continue;
+            const Ray& ray = rays[i];
+            occluded[i] = 0;
+            if (v.groundEnabled && ray.dir.y != 0.0f) {
+                const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+                if (tg > ray.tmin && tg < ray.tmax) {
+                    occluded[i] = 1;
+                    continue;
+                }
+            }
+            embreeRayFrom(r[n], ray, ray.tmax, n);
+            index[n++] = i;
+        }
+    if (n == 0) return;
+    RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    rtcOccluded1M(scene, &ctx, r, n, sizeof(RTCRay));
+    for (unsigned k = 0; k < n; ++k) occluded[index[k]] = r[k].tfar < 0.0f ? 1 : 0;
+}
+
 #endif // SYLVA_HAVE_EMBREE
 
 int usage(int rc)
@@ -526,8 +610,8 @@ int main(int argc, char** argv)
     bool ranEmbree = false;
 #ifdef SYLVA_HAVE_EMBREE
     std::unique_ptr<EmbreePeer> peer;
-    std::vector<PrimaryResult> em(pixels), em8(pixels);
-    std::vector<uint8_t> emOcc(pixels, 0), em8Occ(pixels, 0);
+    std::vector<PrimaryResult> em(pixels), em8(pixels), emStream(pixels);
+    std::vector<uint8_t> emOcc(pixels, 0), em8Occ(pixels, 0), emStreamOcc(pixels, 0);
     if (useEmbree) {
         peer = std::make_unique<EmbreePeer>(rs, v, threads, highQuality ? RTC_BUILD_QUALITY_HIGH : RTC_BUILD_QUALITY_MEDIUM);
         emBuild = peer->speciesBuildSeconds;
@@ -573,6 +657,19 @@ int main(int argc, char** argv)
                                           const size_t i = size_t(y) * size_t(W) + size_t(x);
                                           embreeOccluded8(es, v, &shadowRays[i], &shadowActive[i], std::min(8, x1 - x), &em8Occ[i]);
                                       }
+                              });
+                          },
+                          shadowCount, {}});
+        passes.push_back({"embree primary (rtcIntersect1M, 8x8)", [&, es] {
+                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+                                  embreePrimaryStream(es, v, W, x0, y0, x1, y1, emStream.data());
+                              });
+                          },
+                          pixels, {}});
+        passes.push_back({"embree shadow (rtcOccluded1M, 8x8)", [&, es] {
+                              forTiles(W, H, [&](int x0, int y0, int x1, int y1) {
+                                  embreeOccludedStream(es, v, W, x0, y0, x1, y1, shadowRays.data(), shadowActive.data(),
+                                                       emStreamOcc.data());
                               });
                           },
                           shadowCount, {}});
@@ -628,8 +725,9 @@ int main(int argc, char** argv)
                     primaryMismatches(ours, oursNarrow), shadowMismatches(oursOccluded, oursNarrowOcc));
     }
 
-    double emPrimary = 0.0, emShadow = 0.0, emPrimary8 = 0.0, emShadow8 = 0.0;
+    double emPrimary = 0.0, emShadow = 0.0, emPrimary8 = 0.0, emShadow8 = 0.0, emPrimaryStream = 0.0, emShadowStream = 0.0;
     double emPrimaryMismatch = 0.0, emShadowMismatch = 0.0;
+    size_t streamPrimaryVsSingle = 0, streamShadowVsSingle = 0;
 #ifdef SYLVA_HAVE_EMBREE
     if (ranEmbree) {
         emPrimary = mrays(pixels, passes[2].timing.median);
@@ -640,6 +738,16 @@ int main(int argc, char** argv)
                     passes[2].timing.min / passes[0].timing.min);
         std::printf("%-40s %12.2f %12.2f\n", "ratio ours / embree shadow (single)", ourShadow / emShadow,
                     passes[3].timing.min / passes[1].timing.min);
+        emPrimaryStream = mrays(pixels, passes[6].timing.median);
+        emShadowStream = mrays(shadowCount, passes[7].timing.median);
+        std::printf("%-40s %12.2f %12.2f\n", "ratio ours / embree primary (packets)", ourPrimary / emPrimary8,
+                    passes[4].timing.min / passes[0].timing.min);
+        std::printf("%-40s %12.2f %12.2f\n", "ratio ours / embree shadow (packets)", ourShadow / emShadow8,
+                    passes[5].timing.min / passes[1].timing.min);
+        std::printf("%-40s %12.2f %12.2f\n", "ratio ours / embree primary (stream)", ourPrimary / emPrimaryStream,
+                    passes[6].timing.min / passes[0].timing.min);
+        std::printf("%-40s %12.2f %12.2f\n", "ratio ours / embree shadow (stream)", ourShadow / emShadowStream,
+                    passes[7].timing.min / passes[1].timing.min);
 
         const size_t pm = primaryMismatches(ours, em), pm8 = primaryMismatches(ours, em8);
         const size_t sm = shadowMismatches(oursOccluded, emOcc), sm8 = shadowMismatches(oursOccluded, em8Occ);
@@ -650,6 +758,13 @@ int main(int argc, char** argv)
                     "(%.4f%%); shadow rays differing: %zu single (%.4f%%), %zu packet (%.4f%%)\n",
                     pm, 100.0 * emPrimaryMismatch, pm8, 100.0 * double(pm8) / double(pixels), sm, 100.0 * emShadowMismatch, sm8,
                     100.0 * double(sm8) / shadows);
+        const size_t pmS = primaryMismatches(ours, emStream), smS = shadowMismatches(oursOccluded, emStreamOcc);
+        streamPrimaryVsSingle = primaryMismatches(em, emStream);
+        streamShadowVsSingle = shadowMismatches(emOcc, emStreamOcc);
+        std::printf("stream (rtcIntersect1M/rtcOccluded1M, 8x8 tiles, coherent): %zu primary hits (%.4f%%) and %zu shadow rays "
+                    "(%.4f%%) differ from ours; %zu primary hits and %zu shadow rays differ from Embree's single rays\n",
+                    pmS, 100.0 * double(pmS) / double(pixels), smS, 100.0 * double(smS) / shadows, streamPrimaryVsSingle,
+                    streamShadowVsSingle);
         std::printf("embree setup: %s build quality on species and top scenes, RTC_SCENE_FLAG_NONE (robust off), "
                     "per species an opaque and an alpha-filtered triangle geometry, ground plane analytic outside "
                     "Embree (as ours), 8-wide packets %s\n",
@@ -688,6 +803,12 @@ int main(int argc, char** argv)
         std::printf("embree_primary_mrays_s=%.3f\nembree_shadow_mrays_s=%.3f\n", emPrimary, emShadow);
         std::printf("embree_primary8_mrays_s=%.3f\nembree_shadow8_mrays_s=%.3f\n", emPrimary8, emShadow8);
         std::printf("ratio_primary=%.3f\nratio_shadow=%.3f\n", ourPrimary / emPrimary, ourShadow / emShadow);
+        std::printf("embree_stream_primary_mrays_s=%.3f\nembree_stream_shadow_mrays_s=%.3f\n", emPrimaryStream, emShadowStream);
+        std::printf("ratio_primary8=%.3f\nratio_shadow8=%.3f\n", ourPrimary / emPrimary8, ourShadow / emShadow8);
+        std::printf("ratio_primary_stream=%.3f\nratio_shadow_stream=%.3f\n", ourPrimary / emPrimaryStream,
+                    ourShadow / emShadowStream);
+        std::printf("embree_stream_vs_single_primary_mismatches=%zu\nembree_stream_vs_single_shadow_mismatches=%zu\n",
+                    streamPrimaryVsSingle, streamShadowVsSingle);
         std::printf("embree_primary_mismatch_rate=%.6f\nembree_shadow_mismatch_rate=%.6f\n", emPrimaryMismatch, emShadowMismatch);
         std::printf("embree_build_s=%.4f\n", emBuild + emTopBuild);
         std::printf("embree_bytes_per_instanced_triangle=%.4f\nembree_bytes_per_instance=%.1f\n",
