@@ -1,7 +1,6 @@
 // Options shared by several commands (common_options.h).
 #include "pipeline/cli/common_options.h"
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 
@@ -44,13 +43,6 @@ std::string backendName(const Args& args)
 std::unique_ptr<Backend> openBackend(const std::string& name)
 {
     return selectBackend(name, [](const std::string& note) { std::fprintf(stderr, "note: %s\n", note.c_str()); });
-}
-
-std::string lowerExtension(const std::string& path)
-{
-    std::string ext = fs::path(path).extension().string();
-    for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
-    return ext;
 }
 
 } // namespace sylva::cli

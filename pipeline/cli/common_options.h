@@ -9,6 +9,7 @@
 #include "core/backend/backend.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/cli/args.h"
+#include "pipeline/io/file_extension.h"
 
 namespace sylva::cli {
 
@@ -29,7 +30,7 @@ void requireReadable(const std::string& path, const char* what);
 std::string backendName(const Args& args);
 // The backend of that name; notes (CUDA requested but absent, ...) go to stderr as "note: ...".
 std::unique_ptr<Backend> openBackend(const std::string& name);
-// ".PNG" -> ".png".
-std::string lowerExtension(const std::string& path);
+// lowerExtension(path): ".PNG" -> ".png" (the pipeline's one, here for the commands).
+using sylva::lowerExtension;
 
 } // namespace sylva::cli

@@ -1,13 +1,13 @@
 // What a scene, mesh, grid or cache file holds, as text (file_info.h).
 #include "pipeline/services/file_info.h"
 
-#include <cctype>
 #include <cstdio>
 #include <filesystem>
 
 #include "core/base/error.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/import/mesh_import.h"
+#include "pipeline/io/file_extension.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/grid_stats.h"
@@ -16,13 +16,6 @@ namespace fs = std::filesystem;
 
 namespace sylva {
 namespace {
-
-std::string lowerExtension(const std::string& path)
-{
-    std::string ext = fs::path(path).extension().string();
-    for (auto& ch : ext) ch = char(std::tolower((unsigned char)ch));
-    return ext;
-}
 
 // The array's shape and value range, then its sidecar as stored (the first 4095 bytes).
 std::string describeNpy(const std::string& path)
