@@ -8,12 +8,11 @@
 #include <QJsonObject>
 #include <QLocale>
 #include <QMessageBox>
-#include <QSaveFile>
 #include <QSettings>
 #include <QStandardPaths>
 #include <QWidget>
 
-#include "core/base/error.h"
+#include "pipeline/io/atomic_file.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/scene_document.h"
 
@@ -77,12 +76,13 @@ bool AutosaveController::autosaveNow()
     }
     try {
         writeSceneFile(s, recoveryFilePath().toStdString());
-        QSaveFile info(recoveryInfoPath());
         QJsonObject o;
         o["file"] = m_doc->filePath();
         o["saved"] = QDateTime::currentDateTimeUtc().toString(Qt::ISODate);
-        if (!info.open(QIODevice::WriteOnly) || info.write(QJsonDocument(o).toJson()) < 0 || !info.commit())
-            throw Error(info.fileName().toStdString() + ": " + info.errorString().toStdString());
+        const QByteArray text = QJsonDocument(o).toJson();
+        AtomicFile info(recoveryInfoPath().toStdString(), AtomicFile::Sync::Yes, "recovery file");
+        info.write(text.constData(), size_t(text.size()));
+        info.commit();
     } catch (const std::exception& e) {
         log(tr("autosave failed: %1").arg(QString::fromStdString(e.what())));
         return false;

@@ -11,9 +11,9 @@
 #include <QJsonArray>
 #include <QJsonDocument>
 #include <QJsonObject>
-#include <QSaveFile>
 
 #include "core/base/error.h"
+#include "pipeline/io/atomic_file.h"
 
 namespace sylva::study {
 namespace {
@@ -50,10 +50,10 @@ RunInfo runFromJson(const QJsonObject& o)
 
 void save(const std::string& path, const QJsonObject& root)
 {
-    QSaveFile f(qs(path));
-    if (!f.open(QIODevice::WriteOnly)) throw Error(path + ": cannot write: " + f.errorString().toStdString());
-    f.write(QJsonDocument(root).toJson(QJsonDocument::Indented));
-    if (!f.commit()) throw Error(path + ": cannot write: " + f.errorString().toStdString());
+    const QByteArray text = QJsonDocument(root).toJson(QJsonDocument::Indented);
+    AtomicFile f(path);
+    f.write(text.constData(), size_t(text.size()));
+    f.commit();
 }
 
 bool load(const std::string& path, QJsonObject* root)

@@ -10,12 +10,12 @@
 
 #include <QFileInfo>
 #include <QProcess>
-#include <QSaveFile>
 #include <QStandardPaths>
 #include <QTemporaryDir>
 
 #include "core/base/error.h"
 #include "core/scene/scene.h"
+#include "pipeline/io/atomic_file.h"
 #include "pipeline/study/study_parts.h"
 
 namespace sylva::study {
@@ -587,10 +587,9 @@ void writeReport(const Options& options, const ReportInput& in, Result& result)
     md << presetSection(in.lb, in.render);
     if (pl.program.empty() || !pl.note.empty()) md << "Plots: skipped (" << pl.note << ").\n";
 
-    QSaveFile file(QString::fromStdString(mdPath));
-    const std::string text = md.str();
-    if (!file.open(QIODevice::WriteOnly) || file.write(text.data(), qint64(text.size())) != qint64(text.size()) || !file.commit())
-        throw Error(mdPath + ": cannot write: " + file.errorString().toStdString());
+    AtomicFile file(mdPath);
+    file.write(md.str());
+    file.commit();
     result.markdown = mdPath;
     result.plots = pl.written;
     result.plotNote = pl.note;
