@@ -10,17 +10,36 @@ FallbackBackend::FallbackBackend(std::unique_ptr<Backend> primary, std::function
 {
 }
 
-std::string FallbackBackend::name() const { return m_primary ? m_primary->name() : m_cpu.name(); }
+std::shared_ptr<Backend> FallbackBackend::primary() const
+{
+    std::lock_guard lock(m_mutex);
+    return m_primary;
+}
+
+void FallbackBackend::dropPrimary(const std::shared_ptr<Backend>& failed, const std::string& message)
+{
+    {
+        std::lock_guard lock(m_mutex);
+        if (m_primary != failed) return;   // another job fell back first and said so
+        m_primary.reset();
+    }
+    if (m_onFallback) m_onFallback(message);
+}
+
+std::string FallbackBackend::name() const
+{
+    const std::shared_ptr<Backend> p = primary();
+    return p ? p->name() : m_cpu.name();
+}
 
 LightingGrid FallbackBackend::solveLighting(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
                                             lb::SolveStats* stats)
 {
-    if (m_primary) {
+    if (const std::shared_ptr<Backend> p = primary()) {
         try {
-            return m_primary->solveLighting(density, params, progress, stats);
+            return p->solveLighting(density, params, progress, stats);
         } catch (const BackendError& e) {
-            if (m_onFallback) m_onFallback(std::string(e.what()) + "; solving on the CPU");
-            m_primary.reset();
+            dropPrimary(p, std::string(e.what()) + "; solving on the CPU");
         }
     }
     return m_cpu.solveLighting(density, params, progress, stats);
@@ -28,12 +47,11 @@ LightingGrid FallbackBackend::solveLighting(const DensityGrid& density, const lb
 
 Film FallbackBackend::render(const RenderScene& scene, Progress* progress)
 {
-    if (m_primary) {
+    if (const std::shared_ptr<Backend> p = primary()) {
         try {
-            return m_primary->render(scene, progress);
+            return p->render(scene, progress);
         } catch (const BackendError& e) {
-            if (m_onFallback) m_onFallback(std::string(e.what()) + "; rendering on the CPU");
-            m_primary.reset();
+            dropPrimary(p, std::string(e.what()) + "; rendering on the CPU");
         }
     }
     return m_cpu.render(scene, progress);

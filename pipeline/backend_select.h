@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 
 #include "core/backend/backend.h"
@@ -11,7 +12,8 @@ namespace sylva {
 
 // A backend that runs on `primary` (CUDA) and, when it throws BackendError (driver error, out of
 // device memory), reports the message through `onFallback` once and reruns the job on the CPU;
-// every later job goes straight to the CPU. Never a crash, never a half-done result.
+// every later job goes straight to the CPU. Never a crash, never a half-done result. Thread-safe:
+// jobs on several threads may share it (the studio's lighting, inspect and export jobs).
 class FallbackBackend final : public Backend {
 public:
     FallbackBackend(std::unique_ptr<Backend> primary, std::function<void(const std::string&)> onFallback);
@@ -21,7 +23,12 @@ public:
     Film render(const RenderScene& scene, Progress* progress) override;
 
 private:
-    std::unique_ptr<Backend> m_primary;
+    std::shared_ptr<Backend> primary() const;
+    // Drops `failed` (once, if it is still the primary) and reports message.
+    void dropPrimary(const std::shared_ptr<Backend>& failed, const std::string& message);
+
+    mutable std::mutex m_mutex;   // guards m_primary (a running job keeps its own reference)
+    std::shared_ptr<Backend> m_primary;
     CpuBackend m_cpu;
     std::function<void(const std::string&)> m_onFallback;
 };

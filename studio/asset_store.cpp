@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "pipeline/render/render_job.h"
+#include "pipeline/services/exports.h"
 #include "studio/scene_document.h"
 
 namespace sylva {
@@ -85,7 +86,8 @@ size_t AssetStore::size() const
 }
 
 std::vector<AssetsPtr> ensureAssets(const Scene& scene, bool lit, AssetStore& store, GridCache* cache,
-                                    Progress* progress, const std::function<void(const std::string&)>& log)
+                                    Progress* progress, const std::function<void(const std::string&)>& log,
+                                    Backend* backend)
 {
     const std::vector<size_t> missing = store.missingSpecies(scene, lit);
     for (size_t m = 0; m < missing.size(); ++m) {
@@ -100,16 +102,13 @@ std::vector<AssetsPtr> ensureAssets(const Scene& scene, bool lit, AssetStore& st
         JobLog jobLog;
         std::vector<SpeciesAssets> loaded;
         try {
-            loaded = loadSpeciesAssets(one, cache, lit, &sub, &jobLog);
+            loaded = loadSpeciesAssets(one, cache, lit, &sub, &jobLog, backend);
         } catch (...) {
             if (progress && progress->isCancelled()) throw Cancelled();
             throw;
         }
-        if (log) {
-            for (const std::string& stage : jobLog.stages)
-                log(stage.rfind(sp.name + ":", 0) == 0 ? stage : sp.name + ": " + stage);
-            for (const std::string& w : jobLog.warnings) log("warning: " + w);
-        }
+        if (log)
+            for (const std::string& line : speciesLogLines(sp.name, jobLog)) log(line);
         store.insert(assetKey(sp, scene.sun, lit), std::make_shared<const SpeciesAssets>(std::move(loaded.at(0))));
         if (progress) progress->report(double(m + 1) / double(missing.size()), sp.name + ": done");
     }

@@ -14,6 +14,7 @@
 
 namespace sylva {
 
+class Backend;
 class GridCache;
 
 using AssetsPtr = std::shared_ptr<const SpeciesAssets>;
@@ -47,8 +48,10 @@ private:
 // Makes sure the store holds assets for every species of the scene (lit: with lighting grids):
 // missing ones are loaded with loadSpeciesAssets (grow or import, then voxelize and light through the
 // grid cache). Reports progress over the whole scene; log receives "SPECIES: STAGE" lines as they
-// happen (from the calling thread). Returns the scene's assets in species order. Throws Error or Cancelled.
+// happen (from the calling thread). The LB solves run on backend (null = the CPU). Returns the scene's
+// assets in species order. Throws Error or Cancelled.
 std::vector<AssetsPtr> ensureAssets(const Scene& scene, bool lit, AssetStore& store, GridCache* cache,
-                                    Progress* progress, const std::function<void(const std::string&)>& log);
+                                    Progress* progress, const std::function<void(const std::string&)>& log,
+                                    Backend* backend = nullptr);
 
 } // namespace sylva

@@ -1,4 +1,4 @@
-// ExportController: render and grid exports through the pipeline's calls, in jobs.
+// ExportController: render and grid exports through the pipeline's export services, in jobs.
 #include "studio/export_controller.h"
 
 #include <algorithm>
@@ -7,9 +7,9 @@
 #include <QFileDialog>
 #include <QFileInfo>
 
-#include "core/render/render_cpu.h"
-#include "pipeline/io/npy.h"
+#include "core/backend/backend.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/services/exports.h"
 #include "studio/asset_store.h"
 #include "studio/job_manager.h"
 #include "studio/scene_document.h"
@@ -17,8 +17,8 @@
 namespace sylva {
 
 ExportController::ExportController(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache,
-                                   QWidget* window, QObject* parent)
-    : StudioController(parent), m_doc(doc), m_jobs(jobs), m_assets(assets), m_cache(cache), m_window(window)
+                                   Backend* backend, QWidget* window, QObject* parent)
+    : StudioController(parent), m_doc(doc), m_jobs(jobs), m_assets(assets), m_cache(cache), m_backend(backend), m_window(window)
 {
 }
 
@@ -36,29 +36,28 @@ Job* ExportController::exportRender(const ExportSettings& settings)
     const std::string path = settings.path.toStdString();
     GridCache* cache = m_cache;
     AssetStore* store = m_assets;
+    Backend* backend = m_backend;
     log(tr("exporting %1 (%2 x %3, %4 spp)").arg(settings.path).arg(settings.width).arg(settings.height).arg(settings.spp));
     return m_jobs->start(tr("Export %1").arg(QFileInfo(settings.path).fileName()),
-                         [scene, path, store, cache](Job& job, Progress& progress) {
+                         [scene, path, store, cache, backend](Job& job, Progress& progress) {
                              const bool lit = modeNeedsLighting(scene.render.mode);
                              SubProgress assetsPart(&progress, 0.0, 0.4);
                              Progress assetsProgress([&](double f, const std::string& m) { assetsPart.report(f, m); });
                              const std::vector<AssetsPtr> shared = ensureAssets(
                                  scene, lit, *store, cache, &assetsProgress,
-                                 [&job](const std::string& line) { job.log(QString::fromStdString(line)); });
+                                 [&job](const std::string& line) { job.log(QString::fromStdString(line)); }, backend);
                              std::vector<SpeciesAssets> assets;
                              for (const AssetsPtr& a : shared) assets.push_back(*a);
-                             progress.report(0.45, "building");
-                             const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
-                             SubProgress tracePart(&progress, 0.5, 0.98);
-                             Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
-                             const Film film = renderFilm(rs.view(), &traceProgress);
-                             const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, scene.sky);
-                             writeRender(path, linear, film.width, film.height, scene.render.exposureKey);
-                             progress.report(1.0, "written");
+                             SubProgress renderPart(&progress, 0.4, 1.0);
+                             Progress renderProgress([&](double f, const std::string& m) { renderPart.report(f, m); });
+                             sylva::exportRender(scene, assets, path, backend, &renderProgress);
                          },
-                         [this, settings](Job* job) {
+                         [this, settings, backend](Job* job) {
                              if (job->state() == Job::State::Succeeded)
-                                 log(tr("exported %1 in %2 s").arg(settings.path).arg(job->seconds(), 0, 'f', 2));
+                                 log(tr("exported %1 in %2 s (backend: %3)")
+                                         .arg(settings.path)
+                                         .arg(job->seconds(), 0, 'f', 2)
+                                         .arg(QString::fromStdString(backend ? backend->name() : "cpu")));
                              else if (job->state() == Job::State::Failed) fail(tr("Export failed"), job->error());
                              else log(tr("export cancelled"));
                          });
@@ -66,10 +65,7 @@ Job* ExportController::exportRender(const ExportSettings& settings)
 
 QString ExportController::gridFileBase(const QString& speciesName)
 {
-    QString out;
-    for (QChar c : speciesName)
-        out += (c.isLetterOrNumber() && c.unicode() < 128) || c == u'.' || c == u'-' || c == u'_' ? c : QChar(u'_');
-    return out.isEmpty() ? QStringLiteral("species") : out;
+    return QString::fromStdString(sylva::gridFileBase(speciesName.toStdString()));
 }
 
 Job* ExportController::exportSpeciesGrids(int species, const QString& folder)
@@ -80,31 +76,25 @@ Job* ExportController::exportSpeciesGrids(int species, const QString& folder)
         return nullptr;
     }
     const SpeciesDesc& sp = scene.species[size_t(species)];
-    const QString base = QDir(folder).filePath(gridFileBase(QString::fromStdString(sp.name)));
-    const std::string densityPath = (base + QStringLiteral(".density.npy")).toStdString();
-    const std::string lightingPath = (base + QStringLiteral(".lighting.npy")).toStdString();
+    const std::string dir = folder.toStdString();
+    const GridExportFiles files = gridExportFiles(dir, sp.name);
     AssetsPtr held = m_assets->find(assetKey(sp, scene.sun, true));
     if (!held) held = m_assets->find(assetKey(sp, scene.sun, false));
     GridCache* cache = m_cache;
+    Backend* backend = m_backend;
     log(tr("exporting the grids of %1 to %2").arg(QString::fromStdString(sp.name), QDir::toNativeSeparators(folder)));
     return m_jobs->start(tr("Export grids of %1").arg(QString::fromStdString(sp.name)),
-                         [scene, species, held, cache, densityPath, lightingPath](Job& job, Progress& progress) {
-                             const SpeciesDesc& d = scene.species[size_t(species)];
-                             SubProgress loadPart(&progress, 0.0, 0.9);
-                             Progress loadProgress([&](double f, const std::string& m) { loadPart.report(f, m); });
+                         [scene, species, held, cache, backend, dir](Job& job, Progress& progress) {
                              JobLog log;
-                             const SpeciesGrids g = loadSpeciesGrids(scene, size_t(species), cache, &loadProgress, &log,
-                                                                     held ? &held->mesh : nullptr);
-                             for (const std::string& stage : log.stages)
-                                 job.log(QString::fromStdString(stage.rfind(d.name + ":", 0) == 0 ? stage : d.name + ": " + stage));
-                             progress.report(0.9, "writing");
-                             writeDensityGrid(densityPath, g.density);
-                             writeLightingGrid(lightingPath, g.lighting, lightingParamsJson(g.params, d.preset, g.lighting.geometry.dims));
-                             progress.report(1.0, "written");
+                             sylva::exportSpeciesGrids(scene, size_t(species), dir, cache, backend, &progress, &log,
+                                                held ? &held->mesh : nullptr);
+                             for (const std::string& line : speciesLogLines(scene.species[size_t(species)].name, log))
+                                 job.log(QString::fromStdString(line));
                          },
-                         [this, densityPath, lightingPath](Job* job) {
+                         [this, files](Job* job) {
                              if (job->state() == Job::State::Succeeded)
-                                 log(tr("exported %1 and %2").arg(QString::fromStdString(densityPath), QString::fromStdString(lightingPath)));
+                                 log(tr("exported %1 and %2").arg(QString::fromStdString(files.density),
+                                                                  QString::fromStdString(files.lighting)));
                              else if (job->state() == Job::State::Failed) fail(tr("Export failed"), job->error());
                              else log(tr("grid export cancelled"));
                          });

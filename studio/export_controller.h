@@ -1,6 +1,6 @@
-// Exports: File > Export Render (a picture of the scene, renderFilm + composeMode + writeRender) and
-// File > Export Species Grids (a species' density and lighting grids as .npy with sidecars), each a
-// background job, with their dialogs.
+// Exports: File > Export Render (a picture of the scene, the pipeline's exportRender) and File > Export
+// Species Grids (a species' density and lighting grids as .npy with sidecars, exportSpeciesGrids),
+// each a background job on the studio's backend, with their dialogs.
 #pragma once
 
 #include <QString>
@@ -13,6 +13,7 @@ class QWidget;
 namespace sylva {
 
 class AssetStore;
+class Backend;
 class GridCache;
 class Job;
 class JobManager;
@@ -22,9 +23,9 @@ class ExportController : public StudioController {
     Q_OBJECT
 
 public:
-    // window: the parent of the dialogs.
-    ExportController(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache, QWidget* window,
-                     QObject* parent = nullptr);
+    // window: the parent of the dialogs. backend: where the solves and the traces run (null = the CPU).
+    ExportController(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache, Backend* backend,
+                     QWidget* window, QObject* parent = nullptr);
 
     // Renders the scene at the settings' size and samples into settings.path (PNG/TIFF tone-mapped,
     // EXR linear). Null (and an error) for an empty scene.
@@ -33,7 +34,8 @@ public:
     // and NAME.lighting.npy, each with its JSON sidecar (CONTRACTS.md); NAME is gridFileBase of the
     // species name. Null (and an error) for a bad species index.
     Job* exportSpeciesGrids(int species, const QString& folder);
-    // The species name with characters other than letters, digits, '.', '-', '_' replaced by '_'.
+    // The species name with characters other than letters, digits, '.', '-', '_' replaced by '_'
+    // (the pipeline's gridFileBase).
     static QString gridFileBase(const QString& speciesName);
 
     // The Export Render dialog (starting from the last export's settings), then exportRender.
@@ -46,6 +48,7 @@ private:
     JobManager* m_jobs;
     AssetStore* m_assets;
     GridCache* m_cache;
+    Backend* m_backend;
     QWidget* m_window;
     ExportSettings m_lastExport;
 };

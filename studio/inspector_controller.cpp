@@ -6,6 +6,7 @@
 #include <QDockWidget>
 
 #include "pipeline/render/render_job.h"
+#include "pipeline/services/exports.h"
 #include "studio/asset_store.h"
 #include "studio/job_manager.h"
 #include "studio/lighting_scheduler.h"
@@ -15,13 +16,14 @@
 namespace sylva {
 
 InspectorController::InspectorController(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache,
-                                         LightingScheduler* lighting, VolumeInspector* inspector, QDockWidget* dock,
-                                         std::function<int()> selectedSpecies, QObject* parent)
+                                         Backend* backend, LightingScheduler* lighting, VolumeInspector* inspector,
+                                         QDockWidget* dock, std::function<int()> selectedSpecies, QObject* parent)
     : StudioController(parent),
       m_doc(doc),
       m_jobs(jobs),
       m_assets(assets),
       m_cache(cache),
+      m_backend(backend),
       m_lighting(lighting),
       m_inspector(inspector),
       m_dock(dock),
@@ -72,14 +74,14 @@ Job* InspectorController::inspectSpecies(int species)
     if (!held) held = m_assets->find(assetKey(sp, scene.sun, false));
     auto result = std::make_shared<std::shared_ptr<const SpeciesGrids>>();
     GridCache* cache = m_cache;
+    Backend* backend = m_backend;
     m_job = m_jobs->start(tr("Inspect %1").arg(name),
-                          [scene, species, held, cache, result](Job& job, Progress& progress) {
+                          [scene, species, held, cache, backend, result](Job& job, Progress& progress) {
                               JobLog log;
                               SpeciesGrids g = loadSpeciesGrids(scene, size_t(species), cache, &progress, &log,
-                                                                held ? &held->mesh : nullptr);
-                              const std::string& n = scene.species[size_t(species)].name;
-                              for (const std::string& stage : log.stages)
-                                  job.log(QString::fromStdString(stage.rfind(n + ":", 0) == 0 ? stage : n + ": " + stage));
+                                                                held ? &held->mesh : nullptr, backend);
+                              for (const std::string& line : speciesLogLines(scene.species[size_t(species)].name, log))
+                                  job.log(QString::fromStdString(line));
                               *result = std::make_shared<const SpeciesGrids>(std::move(g));
                           },
                           [this, key, name, result](Job* job) {

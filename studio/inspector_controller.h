@@ -15,6 +15,7 @@ class QDockWidget;
 namespace sylva {
 
 class AssetStore;
+class Backend;
 class GridCache;
 class Job;
 class JobManager;
@@ -27,8 +28,9 @@ class InspectorController : public StudioController {
 
 public:
     // selectedSpecies: the species the selection points at (-1: none). The inspector is refreshed
-    // while dock is visible (and when it is shown).
-    InspectorController(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache,
+    // while dock is visible (and when it is shown). backend: where a solve the cache lacks runs (null =
+    // the CPU).
+    InspectorController(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache, Backend* backend,
                         LightingScheduler* lighting, VolumeInspector* inspector, QDockWidget* dock,
                         std::function<int()> selectedSpecies, QObject* parent = nullptr);
 
@@ -45,6 +47,7 @@ private:
     JobManager* m_jobs;
     AssetStore* m_assets;
     GridCache* m_cache;
+    Backend* m_backend;
     LightingScheduler* m_lighting;
     VolumeInspector* m_inspector;
     QDockWidget* m_dock;

@@ -5,6 +5,7 @@
 
 #include <QKeySequence>
 
+#include "core/backend/backend.h"
 #include "pipeline/render/render_job.h"
 #include "studio/asset_store.h"
 #include "studio/job_manager.h"
@@ -14,8 +15,14 @@
 namespace sylva {
 
 LightingScheduler::LightingScheduler(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache,
-                                     Viewport* viewport, QObject* parent)
-    : StudioController(parent), m_doc(doc), m_jobs(jobs), m_assets(assets), m_cache(cache), m_viewport(viewport)
+                                     Backend* backend, Viewport* viewport, QObject* parent)
+    : StudioController(parent),
+      m_doc(doc),
+      m_jobs(jobs),
+      m_assets(assets),
+      m_cache(cache),
+      m_backend(backend),
+      m_viewport(viewport)
 {
     m_timer.setSingleShot(true);
     m_timer.setInterval(250);
@@ -99,18 +106,23 @@ Job* LightingScheduler::computeLighting(bool reload)
     }
     GridCache* cache = m_cache;
     AssetStore* store = m_assets;
+    Backend* backend = m_backend;
     log(lit ? tr("lighting %n species", nullptr, int(m_assets->missingSpecies(scene, lit).size()))
             : tr("loading %n species", nullptr, int(m_assets->missingSpecies(scene, lit).size())));
     m_target = target;
     m_job = m_jobs->start(lit ? tr("Lighting") : tr("Loading"),
-                          [scene, lit, store, cache](Job& job, Progress& progress) {
-                              ensureAssets(scene, lit, *store, cache, &progress,
-                                           [&job](const std::string& line) { job.log(QString::fromStdString(line)); });
+                          [scene, lit, store, cache, backend](Job& job, Progress& progress) {
+                              ensureAssets(
+                                  scene, lit, *store, cache, &progress,
+                                  [&job](const std::string& line) { job.log(QString::fromStdString(line)); }, backend);
                           },
                           [this](Job* job) {
                               m_job = nullptr;
                               const bool ok = job->state() == Job::State::Succeeded;
-                              if (ok) log(tr("lighting done in %1 s").arg(job->seconds(), 0, 'f', 2));
+                              if (ok)
+                                  log(tr("lighting done in %1 s (backend: %2)")
+                                          .arg(job->seconds(), 0, 'f', 2)
+                                          .arg(QString::fromStdString(m_backend ? m_backend->name() : "cpu")));
                               else if (job->state() == Job::State::Cancelled) log(tr("lighting cancelled"));
                               else fail(tr("Lighting failed"), job->error());
                               if (m_again) {

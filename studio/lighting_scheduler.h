@@ -14,6 +14,7 @@
 namespace sylva {
 
 class AssetStore;
+class Backend;
 class GridCache;
 class Job;
 class JobManager;
@@ -24,9 +25,10 @@ class LightingScheduler : public StudioController {
     Q_OBJECT
 
 public:
-    // Fills assets through cache in jobs of jobs; hands the document's scene and its assets to viewport.
-    LightingScheduler(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache, Viewport* viewport,
-                      QObject* parent = nullptr);
+    // Fills assets through cache in jobs of jobs, solving on backend (null = the CPU); hands the
+    // document's scene and its assets to viewport.
+    LightingScheduler(SceneDocument* doc, JobManager* jobs, AssetStore* assets, GridCache* cache, Backend* backend,
+                      Viewport* viewport, QObject* parent = nullptr);
     ~LightingScheduler() override;
 
     // Lighting starts by itself (debounced) when the viewport lacks assets; off: computeLighting by hand.
@@ -59,6 +61,7 @@ private:
     JobManager* m_jobs;
     AssetStore* m_assets;
     GridCache* m_cache;
+    Backend* m_backend;
     Viewport* m_viewport;
     bool m_autoLighting = true;
     QTimer m_timer;

@@ -24,6 +24,7 @@
 #include <QTreeView>
 #include <QVBoxLayout>
 
+#include "pipeline/backend_select.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
 #include "studio/autosave_controller.h"
@@ -111,8 +112,14 @@ MainWindow::MainWindow(QWidget* parent)
     connect(m_viewport, &Viewport::renderFailed, this, [this](const QString& m) { appendLog(tr("viewport: %1").arg(m)); });
 
     // Controllers that need no dock; the inspector's comes with its dock, recent files with the menu.
-    m_lighting = new LightingScheduler(m_doc, m_jobs, &m_assets, m_cache.get(), m_viewport, this);
-    m_export = new ExportController(m_doc, m_jobs, &m_assets, m_cache.get(), this, this);
+    // One backend for every job (selectBackend falls back to the CPU without a device). A fallback
+    // after a device error is reported from the job's thread; the log hears of it on this one.
+    m_backend = selectBackend("auto", [this](const std::string& note) {
+        QMetaObject::invokeMethod(this, [this, line = QString::fromStdString(note)] { appendLog(tr("backend: %1").arg(line)); },
+                                  Qt::QueuedConnection);
+    });
+    m_lighting = new LightingScheduler(m_doc, m_jobs, &m_assets, m_cache.get(), m_backend.get(), m_viewport, this);
+    m_export = new ExportController(m_doc, m_jobs, &m_assets, m_cache.get(), m_backend.get(), this, this);
     m_materials = new MaterialsController(m_doc, m_jobs, this, this);
     m_scatter = new ScatterTool(m_doc, [this] { return selectedSpecies(); }, this, this);
     m_importer = new SpeciesImporter(m_doc, m_jobs, this, this);
@@ -199,13 +206,14 @@ void MainWindow::buildDocks()
     auto* logDock = new QDockWidget(tr("Log"), this);
     logDock->setObjectName("logDock");
     logDock->setWidget(m_log);
+    appendLog(tr("compute backend: %1").arg(QString::fromStdString(m_backend->name())));
 
     m_inspector = new VolumeInspector;
     m_inspectorDock = new QDockWidget(tr("Lighting Inspector"), this);
     m_inspectorDock->setObjectName("inspectorDock");
     m_inspectorDock->setWidget(m_inspector);
-    m_inspection = new InspectorController(m_doc, m_jobs, &m_assets, m_cache.get(), m_lighting, m_inspector, m_inspectorDock,
-                                           [this] { return selectedSpecies(); }, this);
+    m_inspection = new InspectorController(m_doc, m_jobs, &m_assets, m_cache.get(), m_backend.get(), m_lighting, m_inspector,
+                                           m_inspectorDock, [this] { return selectedSpecies(); }, this);
     adopt(m_inspection);
 
     // Outliner over properties on the right, full height; jobs beside the log under the viewport.

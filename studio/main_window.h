@@ -24,6 +24,8 @@ class QTreeView;
 
 namespace sylva {
 
+class Backend;
+
 class AutosaveController;
 class ExportController;
 class GridCache;
@@ -59,6 +61,9 @@ public:
     // the inspector) and the grid cache on disk below them.
     AssetStore* assetStore() { return &m_assets; }
     GridCache* gridCache() const { return m_cache.get(); }
+    // Where the lighting jobs, inspections and exports solve and trace: selectBackend("auto"), the
+    // GPU when there is one, else the CPU (the log says which at start-up and after a fallback).
+    Backend* backend() const { return m_backend.get(); }
     QComboBox* modeSelector() const { return m_modeBox; }
     // Side-by-side compare: the toggle and the second mode (the right half of the viewport).
     QCheckBox* compareToggle() const { return m_compareToggle; }
@@ -127,6 +132,7 @@ private:
     JobManager* m_jobs;
     AssetStore m_assets;
     std::unique_ptr<GridCache> m_cache;
+    std::unique_ptr<Backend> m_backend;
     OutlinerModel* m_model;
     QTreeView* m_outliner;
     PropertyPanel* m_properties;

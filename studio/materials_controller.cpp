@@ -1,11 +1,11 @@
-// MaterialsController: the species' materials from the importer, the question, the undo step.
+// MaterialsController: the species' materials (the pipeline's listMaterials), the question, the undo step.
 #include "studio/materials_controller.h"
 
 #include <iterator>
 #include <memory>
 #include <numeric>
 
-#include "pipeline/import/mesh_import.h"
+#include "pipeline/services/material_list.h"
 #include "studio/job_manager.h"
 #include "studio/scene_document.h"
 
@@ -50,22 +50,8 @@ Job* MaterialsController::editMaterials(int species)
     auto result = std::make_shared<std::vector<MaterialChoice>>();
     return m_jobs->start(tr("Materials of %1").arg(QString::fromStdString(sp.name)),
                          [sp, result](Job&, Progress& progress) {
-                             progress.report(0.0, "reading");
-                             // The rules alone (no override), then what the species' list makes of them.
-                             const TriangleMesh mesh = sylva::importMesh(sp.meshPath, ImportOptions{});
-                             for (const Material& m : mesh.materials) {
-                                 MaterialChoice c;
-                                 c.name = QString::fromStdString(m.name);
-                                 c.leafByRules = m.isLeaf;
-                                 c.leaf = m.isLeaf;
-                                 if (!sp.leafMaterials.empty()) {
-                                     c.leaf = false;
-                                     for (const std::string& n : sp.leafMaterials)
-                                         c.leaf = c.leaf || QString::fromStdString(n).compare(c.name, Qt::CaseInsensitive) == 0;
-                                 }
-                                 result->push_back(c);
-                             }
-                             progress.report(1.0, "read");
+                             for (const MaterialAssignment& m : listMaterials(sp.meshPath, sp.leafMaterials, &progress))
+                                 result->push_back({QString::fromStdString(m.name), m.leafByRules, m.leaf});
                          },
                          [this, species, sp, result](Job* job) {
                              if (job->state() == Job::State::Failed) {

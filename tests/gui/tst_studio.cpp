@@ -13,6 +13,7 @@
 #include <QJsonArray>
 #include <QJsonDocument>
 #include <QJsonObject>
+#include <QRegularExpression>
 #include <QSettings>
 #include <QSpinBox>
 #include <QTimer>
@@ -20,6 +21,8 @@
 
 #include <memory>
 
+#include "core/backend/backend.h"
+#include "cuda/device_query.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/scene/scene_file.h"
@@ -152,6 +155,12 @@ private Q_SLOTS:
         QVERIFY2(log.contains("Tree_1: import"), qPrintable(log));
         QVERIFY2(log.contains("Tree_1: voxelize"), qPrintable(log));
         QVERIFY2(log.contains("Tree_1: light"), qPrintable(log));
+        // The job solved on the window's one backend and says which: the CPU without a device (CI).
+        QVERIFY(m_win->backend());
+        const QString backend = QString::fromStdString(m_win->backend()->name());
+        if (cuda::queryDevices().devices.empty()) QCOMPARE(backend, QStringLiteral("cpu"));
+        QVERIFY2(log.contains(QRegularExpression("lighting done in [0-9.]+ s \\(backend: " + QRegularExpression::escape(backend) + "\\)")),
+                 qPrintable(log));
         QTRY_COMPARE(m_win->jobPanel()->rowCount(), 0);
 
         finished.clear();

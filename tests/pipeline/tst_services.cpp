@@ -8,13 +8,20 @@
 #include <QJsonObject>
 #include <QTest>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/base/error.h"
 #include "core/lb/lb_params.h"
 #include "core/reference/mc_reference.h"
+#include "core/backend/backend.h"
+#include "pipeline/io/file_extension.h"
+#include "pipeline/io/image_io.h"
 #include "pipeline/io/npy.h"
+#include "pipeline/render/render_job.h"
+#include "pipeline/services/exports.h"
 #include "pipeline/services/file_info.h"
+#include "pipeline/services/material_list.h"
 #include "pipeline/services/grid_stats.h"
 #include "pipeline/services/mesh_stats.h"
 #include "pipeline/services/reference_stats.h"
@@ -33,6 +40,33 @@ GridGeometry cube(int n)
 }
 
 bool near(double a, double b, double tol = 1e-12) { return std::fabs(a - b) <= tol * std::max(1.0, std::fabs(b)); }
+
+// One small grown shrub (grid 12) on the ground, a close camera, 40x30 pixels.
+Scene shrubScene(RenderMode mode)
+{
+    Scene s;
+    s.species.resize(1);
+    s.species[0].name = "shrub a";
+    s.species[0].grow = GrowSpec{"shrub", 3, 3000, 1.5f};
+    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    s.species[0].grid = 12;
+    s.instances.resize(1);
+    s.camera.position = {0.0, 1.0, -4.0};
+    s.camera.target = {0.0, 0.7, 0.0};
+    s.sun.direction = sunDirection(40.0, 120.0);
+    s.render.width = 40;
+    s.render.height = 30;
+    s.render.spp = 1;
+    s.render.mode = mode;
+    return s;
+}
+
+void writeText(const QString& path, const char* text)
+{
+    QFile f(path);
+    QVERIFY(f.open(QIODevice::WriteOnly));
+    f.write(text);
+}
 
 lb::LbParams testParams()
 {
@@ -270,6 +304,131 @@ private Q_SLOTS:
         pf.close();
         const std::string m = messageOf(png);
         QVERIFY2(m.rfind(png + ": not a scene, mesh, .npy grid or cache entry", 0) == 0, m.c_str());
+    }
+
+    // One lowerExtension for the commands and the services.
+    void lowerCaseExtension()
+    {
+        QCOMPARE(lowerExtension("out/A.PNG"), std::string(".png"));
+        QCOMPARE(lowerExtension("grid.density.NPY"), std::string(".npy"));
+        QCOMPARE(lowerExtension("dir.d/noext"), std::string());
+    }
+
+    void speciesLogLinesNameTheSpecies()
+    {
+        JobLog log;
+        log.stages = {"grow", "tree: import", "light (cache hit)"};
+        log.warnings = {"cache entry unreadable"};
+        QCOMPARE(speciesLogLines("tree", log), (std::vector<std::string>{"tree: grow", "tree: import", "tree: light (cache hit)",
+                                                                         "warning: cache entry unreadable"}));
+    }
+
+    void gridExportNames()
+    {
+        QCOMPARE(gridFileBase("Tree 1 (2)/x"), std::string("Tree_1__2__x"));
+        QCOMPARE(gridFileBase("a.b-c_D9"), std::string("a.b-c_D9"));
+        QCOMPARE(gridFileBase(""), std::string("species"));
+        QCOMPARE(gridFileBase("B\xc3\xa4um"), std::string("B_um"));   // one '_' for the two bytes of one character
+        const GridExportFiles f = gridExportFiles("/tmp/out", "Tree 1");
+        QCOMPARE(f.density, std::string("/tmp/out/Tree_1.density.npy"));
+        QCOMPARE(f.lighting, std::string("/tmp/out/Tree_1.lighting.npy"));
+    }
+
+    // The files exportSpeciesGrids writes, read back, hold the grids loadSpeciesGrids returns for the
+    // same species (solved separately, no cache), and the sidecar the LB parameters as solved.
+    void exportSpeciesGridsWritesTheGrids()
+    {
+        const Scene s = shrubScene(RenderMode::Full);
+        const SpeciesGrids oracle = loadSpeciesGrids(s, 0, nullptr);
+        const QString folder = m_dir + "/grid_export";
+        CpuBackend cpu;
+        JobLog log;
+        std::vector<double> seen;
+        Progress progress([&](double f, const std::string&) { seen.push_back(f); });
+        const GridExportFiles files = exportSpeciesGrids(s, 0, folder.toStdString(), nullptr, &cpu, &progress, &log);
+        QCOMPARE(files.density, (folder + "/shrub_a.density.npy").toStdString());
+        QCOMPARE(files.lighting, (folder + "/shrub_a.lighting.npy").toStdString());
+        QVERIFY(!seen.empty());
+        QCOMPARE(seen.back(), 1.0);
+        QVERIFY(std::is_sorted(seen.begin(), seen.end()));
+        QVERIFY(std::find(log.stages.begin(), log.stages.end(), "light") != log.stages.end());
+        const DensityGrid density = readDensityGrid(files.density);
+        QCOMPARE(density.geometry, oracle.density.geometry);
+        QVERIFY(density.density == oracle.density.density);
+        QVERIFY(density.woodFraction == oracle.density.woodFraction);
+        const LightingGrid light = readLightingGrid(files.lighting);
+        QCOMPARE(light.geometry, oracle.lighting.geometry);
+        QCOMPARE(light.rgb.size(), oracle.lighting.rgb.size());
+        for (size_t i = 0; i < light.rgb.size(); ++i)
+            QVERIFY2(near(light.rgb[i], oracle.lighting.rgb[i], 1e-5), qPrintable(QString::number(i)));
+        QFile side(QString::fromStdString(files.lighting) + ".json");
+        QVERIFY(side.open(QIODevice::ReadOnly));
+        const QJsonObject p = QJsonDocument::fromJson(side.readAll()).object()["parameters"].toObject();
+        QCOMPARE(p["preset"].toString(), QStringLiteral("leaf"));
+        for (int c = 0; c < 3; ++c) QCOMPARE(float(p["sun"].toArray()[c].toDouble()), oracle.params.sun[c]);
+        // A species the scene lacks: an error, no file.
+        QVERIFY_THROWS_EXCEPTION(Error, exportSpeciesGrids(s, 1, (folder + "/none").toStdString(), nullptr));
+        QVERIFY(!QDir(folder + "/none").exists());
+    }
+
+    // exportRender's picture equals renderScene's film composed and tone-mapped by hand.
+    void exportRenderWritesThePicture()
+    {
+        const Scene s = shrubScene(RenderMode::Local);
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, nullptr, false);
+        const std::string path = (m_dir + "/export.png").toStdString();
+        CpuBackend cpu;
+        double last = -1.0;
+        Progress progress([&](double f, const std::string&) { last = f; });
+        exportRender(s, assets, path, &cpu, &progress);
+        QCOMPARE(last, 1.0);
+        const RenderOutput ref = renderScene(s, nullptr);
+        const ImageRgba expected =
+            toneMapped(composeMode(ref.film, s.render.mode, s.sky), ref.film.width, ref.film.height, s.render.exposureKey);
+        const ImageRgba got = readImage(path);
+        QCOMPARE(got.width, 40);
+        QCOMPARE(got.height, 30);
+        QCOMPARE(got.pixels.size(), expected.pixels.size());
+        int lit = 0;
+        for (size_t i = 0; i < got.pixels.size(); ++i) {
+            QVERIFY2(std::fabs(got.pixels[i] - expected.pixels[i]) <= 0.5f / 255.0f + 1e-6f, qPrintable(QString::number(i)));
+            lit += i % 4 != 3 && got.pixels[i] > 0.02f;
+        }
+        QVERIFY(lit > 0);
+        // Without a backend: the CPU, the same picture.
+        const std::string path2 = (m_dir + "/export_nobackend.png").toStdString();
+        exportRender(s, assets, path2, nullptr);
+        QVERIFY(readImage(path2).pixels == got.pixels);
+        QVERIFY_THROWS_EXCEPTION(Error, exportRender(s, assets, (m_dir + "/export.bmp").toStdString(), &cpu));
+    }
+
+    // The materials of a hand-written OBJ + MTL: the rules mark the leaf-named one, a species list
+    // (any case) replaces the rules.
+    void listMaterialsOfAMesh()
+    {
+        const QString dir = m_dir + "/materials";
+        QDir().mkpath(dir);
+        writeText(dir + "/m.mtl", "newmtl Bark\nKd 0.4 0.3 0.2\nnewmtl Tree_Leaves\nKd 0.2 0.6 0.2\n");
+        writeText(dir + "/m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+                                  "usemtl Bark\nf 1 2 3\nusemtl Tree_Leaves\nf 1 3 4\n");
+        const std::string obj = (dir + "/m.obj").toStdString();
+        auto byName = [](const std::vector<MaterialAssignment>& v, const std::string& n) {
+            for (const MaterialAssignment& m : v)
+                if (m.name == n) return m;
+            return MaterialAssignment{"(missing)", false, false};
+        };
+        const std::vector<MaterialAssignment> rules = listMaterials(obj, {});
+        QCOMPARE(rules.size(), size_t(2));
+        QCOMPARE(byName(rules, "Bark").leafByRules, false);
+        QCOMPARE(byName(rules, "Bark").leaf, false);
+        QCOMPARE(byName(rules, "Tree_Leaves").leafByRules, true);
+        QCOMPARE(byName(rules, "Tree_Leaves").leaf, true);
+        const std::vector<MaterialAssignment> listed = listMaterials(obj, {"bARK"});
+        QCOMPARE(byName(listed, "Bark").leafByRules, false);
+        QCOMPARE(byName(listed, "Bark").leaf, true);
+        QCOMPARE(byName(listed, "Tree_Leaves").leafByRules, true);
+        QCOMPARE(byName(listed, "Tree_Leaves").leaf, false);
+        QVERIFY_THROWS_EXCEPTION(Error, listMaterials((dir + "/missing.obj").toStdString(), {}));
     }
 };
 

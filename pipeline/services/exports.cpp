@@ -1,0 +1,77 @@
+// Render and grid exports (exports.h).
+#include "pipeline/services/exports.h"
+
+#include <filesystem>
+
+#include "core/backend/backend.h"
+#include "core/base/error.h"
+#include "core/render/render_cpu.h"
+#include "pipeline/io/npy.h"
+#include "pipeline/render/render_job.h"
+
+namespace sylva {
+
+std::vector<std::string> speciesLogLines(const std::string& species, const JobLog& log)
+{
+    std::vector<std::string> out;
+    for (const std::string& stage : log.stages)
+        out.push_back(stage.rfind(species + ":", 0) == 0 ? stage : species + ": " + stage);
+    for (const std::string& w : log.warnings) out.push_back("warning: " + w);
+    return out;
+}
+
+void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, const std::string& path, Backend* backend,
+                  Progress* progress)
+{
+    if (progress) progress->report(0.0, "building");
+    const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
+    if (progress && progress->isCancelled()) throw Cancelled();
+    SubProgress tracePart(progress, 0.1, 0.96);
+    Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
+    if (progress && progress->isCancelled()) traceProgress.cancel();
+    const Film film = backend ? backend->render(rs, &traceProgress) : renderFilm(rs.view(), &traceProgress);
+    if (progress) progress->report(0.96, "writing");
+    const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, scene.sky);
+    writeRender(path, linear, film.width, film.height, scene.render.exposureKey);
+    if (progress) progress->report(1.0, "written");
+}
+
+std::string gridFileBase(const std::string& speciesName)
+{
+    std::string out;
+    for (unsigned char c : speciesName) {
+        const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '.' ||
+                          c == '-' || c == '_';
+        // A UTF-8 sequence is one character: one '_' for its lead byte, none for its continuation bytes.
+        if (keep) out += char(c);
+        else if ((c & 0xC0) != 0x80) out += '_';
+    }
+    return out.empty() ? std::string("species") : out;
+}
+
+GridExportFiles gridExportFiles(const std::string& folder, const std::string& speciesName)
+{
+    const std::filesystem::path base = std::filesystem::path(folder) / gridFileBase(speciesName);
+    return {base.string() + ".density.npy", base.string() + ".lighting.npy"};
+}
+
+GridExportFiles exportSpeciesGrids(const Scene& scene, size_t species, const std::string& folder, GridCache* cache,
+                                   Backend* backend, Progress* progress, JobLog* log, const TriangleMesh* mesh)
+{
+    if (species >= scene.species.size())
+        throw Error("grid export: no species " + std::to_string(species) + " in a scene of " +
+                    std::to_string(scene.species.size()));
+    const SpeciesDesc& sp = scene.species[species];
+    const GridExportFiles files = gridExportFiles(folder, sp.name);
+    SubProgress loadPart(progress, 0.0, 0.9);
+    Progress loadProgress([&](double f, const std::string& m) { loadPart.report(f, m); });
+    if (progress && progress->isCancelled()) loadProgress.cancel();
+    const SpeciesGrids g = loadSpeciesGrids(scene, species, cache, &loadProgress, log, mesh, backend);
+    if (progress) progress->report(0.9, "writing");
+    writeDensityGrid(files.density, g.density);
+    writeLightingGrid(files.lighting, g.lighting, lightingParamsJson(g.params, sp.preset, g.lighting.geometry.dims));
+    if (progress) progress->report(1.0, "written");
+    return files;
+}
+
+} // namespace sylva

@@ -1,0 +1,49 @@
+// The export jobs of the front ends as library calls: a scene's picture into an image file, a
+// species' density and lighting grids into .npy files with their sidecars. Each takes the backend
+// that solves and traces (null = the CPU) and a progress.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/base/progress.h"
+#include "core/render/render_scene.h"
+#include "core/scene/scene.h"
+#include "pipeline/lighting_job.h"
+
+namespace sylva {
+
+class Backend;
+class GridCache;
+
+// The lighting job's stages as log lines naming the species: "NAME: STAGE" (a stage that already
+// starts with "NAME:" as it is), then "warning: ..." for each warning.
+std::vector<std::string> speciesLogLines(const std::string& species, const JobLog& log);
+
+// The picture of `scene` with the species' assets (in species order; with lighting grids when the
+// mode needs them) into `path`: buildRenderScene, the film on `backend`, composeMode, writeRender
+// (.png/.tif/.tiff tone-mapped 8-bit, .exr linear). Throws Error (bad extension, unwritable file)
+// or Cancelled.
+void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, const std::string& path,
+                  Backend* backend = nullptr, Progress* progress = nullptr);
+
+// A file name base for a species' grids: ASCII letters, digits, '.', '-' and '_' kept, any other
+// character '_' ("Tree 1 (2)/x" -> "Tree_1__2__x"); "species" for an empty name.
+std::string gridFileBase(const std::string& speciesName);
+
+// The two files a grid export writes into `folder` for a species: FOLDER/BASE.density.npy (with
+// BASE.density.wood.npy) and FOLDER/BASE.lighting.npy, each with its .json sidecar.
+struct GridExportFiles {
+    std::string density, lighting;
+};
+GridExportFiles gridExportFiles(const std::string& folder, const std::string& speciesName);
+
+// Species `species` of `scene` through loadSpeciesGrids (the grid cache: a lit species is a cache
+// hit; mesh: the species' mesh when it is in memory) into gridExportFiles(folder, its name); the
+// lighting sidecar's parameters are lightingParamsJson's (as `sylva light` writes them). Stages go to
+// log. Returns the files written. Throws Error or Cancelled.
+GridExportFiles exportSpeciesGrids(const Scene& scene, size_t species, const std::string& folder, GridCache* cache,
+                                   Backend* backend = nullptr, Progress* progress = nullptr, JobLog* log = nullptr,
+                                   const TriangleMesh* mesh = nullptr);
+
+} // namespace sylva
