@@ -49,8 +49,12 @@ __device__ void blockSum(double v, double* out)
     }
 }
 
-// The sums the tone mapper needs: acc[1] = sum lum(indirect), acc[2] = sum lum(albedo) (the ambient
-// constant of the ambient mode); acc[0] and acc[3] = sum log(1e-4 + L) of the left and right modes.
+// The sums the tone mapper needs, with the host's per-pixel rules (core/render/tonemap.h): acc[1] = sum
+// lum(indirect), acc[2] = sum lum(albedo) (the ambient constant of the ambient mode); acc[0] and acc[3] the
+// log-luminance terms of the left and right modes, acc[4] and acc[5] the pixels they counted (non-finite
+// ones are left out, as on the host).
+constexpr int kToneSums = 6;
+
 __global__ void ambientSums(const SampleParts* film, size_t n, double* acc)
 {
     const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
@@ -59,14 +63,15 @@ __global__ void ambientSums(const SampleParts* film, size_t n, double* acc)
     blockSum(in ? double(luminance(film[i].albedo)) : 0.0, &acc[2]);
 }
 
-__device__ float ambientOf(const double* acc) { return acc[2] > 0.0 ? float(acc[1] / acc[2]) : 0.0f; }
+__device__ float ambientOf(const double* acc) { return ambientConstant(acc[1], acc[2]); }
 
-__global__ void logSum(const SampleParts* film, size_t n, RenderMode mode, glm::vec3 sky, double* acc, double* out)
+__global__ void logSum(const SampleParts* film, size_t n, RenderMode mode, glm::vec3 sky, double* acc, double* sum, double* count)
 {
     const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    double v = 0.0;
-    if (i < n) v = double(logf(1e-4f + fmaxf(luminance(composeSample(film[i], mode, sky, ambientOf(acc))), 0.0f)));
-    blockSum(v, out);
+    double term = 0.0;
+    const bool counted = i < n && logLuminanceTerm(composeSample(film[i], mode, sky, ambientOf(acc)), term);
+    blockSum(counted ? term : 0.0, sum);
+    blockSum(counted ? 1.0 : 0.0, count);
 }
 
 __global__ void toneMapKernel(const SampleParts* film, int width, size_t n, RenderMode left, RenderMode right, glm::vec3 sky,
@@ -75,8 +80,8 @@ __global__ void toneMapKernel(const SampleParts* film, int width, size_t n, Rend
     const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
     if (i >= n) return;
     const bool isRight = int(i % size_t(width)) >= width / 2 && right != left;
-    const float logAvg = expf(float(acc[isRight ? 3 : 0] / double(n)));
-    const glm::vec3 c = reinhard(composeSample(film[i], isRight ? right : left, sky, ambientOf(acc)), key / logAvg);
+    const float scale = exposureScale(key, logAverageOf(acc[isRight ? 3 : 0], acc[isRight ? 5 : 4]));
+    const glm::vec3 c = reinhard(composeSample(film[i], isRight ? right : left, sky, ambientOf(acc)), scale);
     const uint32_t r = uint32_t(srgbEncode(c.x) * 255.0f + 0.5f), g = uint32_t(srgbEncode(c.y) * 255.0f + 0.5f),
                    b = uint32_t(srgbEncode(c.z) * 255.0f + 0.5f);
     out[i] = r | (g << 8) | (b << 16) | (255u << 24);
@@ -117,7 +122,7 @@ struct Reusable {
 
 struct DeviceScene::Scratch {
     DeviceBuffer<SampleParts> film;
-    DeviceBuffer<double> acc{4, "tone map sums"};
+    DeviceBuffer<double> acc{kToneSums, "tone map sums"};
     SampleParts* filmFor(size_t n)
     {
         if (film.size() < n) film.allocate(n, "film");
@@ -234,12 +239,12 @@ void renderToRgba8(const DeviceScene& scene, RenderMode mode, float key, uint32_
     SampleParts* film = s.filmFor(n);
     traceOnDevice(v, film);
     double* acc = s.acc.get();
-    check(cudaMemset(acc, 0, 4 * sizeof(double)), "tone map sums");
+    check(cudaMemset(acc, 0, kToneSums * sizeof(double)), "tone map sums");
     const unsigned blocks = unsigned((n + 255) / 256);
     const RenderMode r = right.value_or(mode);
     if (mode == RenderMode::Ambient || r == RenderMode::Ambient) ambientSums<<<blocks, 256>>>(film, n, acc);
-    logSum<<<blocks, 256>>>(film, n, mode, v.sky, acc, &acc[0]);
-    if (r != mode) logSum<<<blocks, 256>>>(film, n, r, v.sky, acc, &acc[3]);
+    logSum<<<blocks, 256>>>(film, n, mode, v.sky, acc, &acc[0], &acc[4]);
+    if (r != mode) logSum<<<blocks, 256>>>(film, n, r, v.sky, acc, &acc[3], &acc[5]);
     toneMapKernel<<<blocks, 256>>>(film, v.width, n, mode, r, v.sky, key, acc, deviceRgba8);
     check(cudaGetLastError(), "tone map kernels");
     check(cudaDeviceSynchronize(), "tone map");

@@ -108,6 +108,30 @@ SYLVA_INLINE V maxVec(V a, V b)
     return a > b ? a : b;
 }
 SYLVA_INLINE Float4 load4(const float* p) { return loadVec<Float4>(p); }
+
+// One axis of the slab test for nodeEntry's rare path (a zero direction component on some axis): on a
+// zero axis the slab is all of t when the origin lies in [lo, hi] (a ray in a box face enters it), else
+// empty; unused (inverted) children are never entered. A function, not a lambda, so that it is always
+// inlined: as a lambda GCC began calling it out of line once the traversal grew its levels.
+template <class V>
+SYLVA_INLINE void slabAxis(const float* l, const float* h, const V& o, const V& i, bool zeroAxis, V& t0, V& t1)
+{
+    const V zero = {};
+    const V big = zero + 1e30f;
+    const V L = loadVec<V>(l), H = loadVec<V>(h);
+    if (zeroAxis) {
+        const auto inside = (L <= o) & (o <= H);
+        t0 = inside ? -big : big;
+        t1 = inside ? big : -big;
+    } else {
+        const V a = (L - o) * i, b = (H - o) * i;
+        t0 = minVec(a, b);
+        t1 = maxVec(a, b);
+        const auto inverted = L > H;   // unused child
+        t0 = inverted ? big : t0;
+        t1 = inverted ? -big : t1;
+    }
+}
 } // namespace detail
 #endif
 
@@ -135,28 +159,11 @@ SYLVA_HD SYLVA_INLINE unsigned nodeEntry(const BvhNodeW<W>& n, const glm::vec3& 
         tnear = maxVec(maxVec(nx, ny), maxVec(nz, lo));
         tfar = minVec(minVec(fx, fy), minVec(fz, hi));
     } else {
-        // A zero direction component (rare; the same branch for the whole traversal): on that axis
-        // the slab is all of t when the origin lies in [lo, hi] (a ray in a box face enters it), else empty.
-        const V big = zero + 1e30f;
-        auto axis = [&](const float* l, const float* h, const V& o, const V& i, bool zeroAxis, V& t0, V& t1) {
-            const V L = loadVec<V>(l), H = loadVec<V>(h);
-            if (zeroAxis) {
-                const auto inside = (L <= o) & (o <= H);
-                t0 = inside ? -big : big;
-                t1 = inside ? big : -big;
-            } else {
-                const V a = (L - o) * i, b = (H - o) * i;
-                t0 = minVec(a, b);
-                t1 = maxVec(a, b);
-                const auto inverted = L > H;   // unused child
-                t0 = inverted ? big : t0;
-                t1 = inverted ? -big : t1;
-            }
-        };
+        // A zero direction component (rare; the same branch for the whole traversal).
         V x0, x1, y0, y1, z0, z1;
-        axis(n.lox, n.hix, ox, ix, zeroAxes & 1u, x0, x1);
-        axis(n.loy, n.hiy, oy, iy, zeroAxes & 2u, y0, y1);
-        axis(n.loz, n.hiz, oz, iz, zeroAxes & 4u, z0, z1);
+        slabAxis(n.lox, n.hix, ox, ix, zeroAxes & 1u, x0, x1);
+        slabAxis(n.loy, n.hiy, oy, iy, zeroAxes & 2u, y0, y1);
+        slabAxis(n.loz, n.hiz, oz, iz, zeroAxes & 4u, z0, z1);
         tnear = maxVec(maxVec(x0, y0), maxVec(z0, lo));
         tfar = minVec(minVec(x1, y1), minVec(z1, hi));
     }

@@ -27,7 +27,7 @@ Film renderFilmRows(const RenderView& v, int y0, int y1, Progress* progress = nu
 // order), added to *indirect and *albedo so a frame in bands sums exactly as the whole film does.
 void addAmbientSums(const Film& film, double* indirect, double* albedo);
 // The ambient constant from those sums over the whole frame.
-inline float ambientConstant(double indirect, double albedo) { return albedo > 0.0 ? float(indirect / albedo) : 0.0f; }
+SYLVA_HD inline float ambientConstant(double indirect, double albedo) { return albedo > 0.0 ? float(indirect / albedo) : 0.0f; }
 
 // Linear RGB of a render mode: full = local + indirect, local = sun light only, ambient = local + a
 // constant ambient x albedo with the constant chosen so the mean luminance equals that of full,

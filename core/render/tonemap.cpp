@@ -15,7 +15,6 @@ namespace sylva {
 
 namespace {
 
-constexpr double kLogDelta = 1e-4;      // Reinhard's delta: keeps log() finite on black pixels
 constexpr size_t kGrain = 16384;        // pixels per task; fixed so the reduction order is too
 
 struct LogSum {
@@ -42,9 +41,9 @@ void LogAverageAccumulator::add(const float* rgb, size_t pixelCount, size_t stri
     auto sumOf = [&](size_t begin, size_t end, LogSum acc) {
         for (size_t i = begin; i != end; ++i) {
             const float* p = rgb + i * strideFloats;
-            const float l = luminance(glm::vec3(p[0], p[1], p[2]));
-            if (!std::isfinite(l)) continue;
-            acc.sum += std::log(kLogDelta + double(l > 0.0f ? l : 0.0f));
+            double term;
+            if (!logLuminanceTerm(glm::vec3(p[0], p[1], p[2]), term)) continue;
+            acc.sum += term;
             ++acc.count;
         }
         return acc;
@@ -87,9 +86,7 @@ void LogAverageAccumulator::add(const float* rgb, size_t pixelCount, size_t stri
 
 float LogAverageAccumulator::value() const
 {
-    const size_t count = m_count + m_partialCount;
-    if (count == 0) return 0.0f;
-    return float(std::exp((m_total + m_partial) / double(count)));
+    return logAverageOf(m_total + m_partial, double(m_count + m_partialCount));
 }
 
 void toneMapToSrgb(const float* linearRgb, size_t pixels, float* outRgb01, ToneMapParams params)
@@ -105,7 +102,7 @@ float toneMapScale(float logAverage, ToneMapParams params)
 {
     if (!std::isfinite(params.key) || !(params.key > 0.0f))
         throw Error("tone map key " + std::to_string(params.key) + " must be finite and > 0");
-    return logAverage > 0.0f ? params.key / logAverage : 0.0f;
+    return exposureScale(params.key, logAverage);
 }
 
 void toneMapScaled(const float* linearRgb, size_t pixels, float* outRgb01, float scale)

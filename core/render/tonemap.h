@@ -45,6 +45,26 @@ SYLVA_HD inline glm::vec3 reinhard(glm::vec3 rgb, float scale)
     return rgb * (ld / lin);
 }
 
+// The per-pixel rules of the tone-map reductions, shared by the host passes and the GPU kernels
+// (cuda/render_cuda.cu) so both average the same terms over the same pixels.
+inline constexpr double kLogDelta = 1e-4;   // Reinhard's delta: keeps log() finite on black pixels
+
+// One pixel's term of the log-average luminance, log(delta + max(L, 0)) in double; false (the pixel is
+// left out of the average) when its luminance is not finite.
+SYLVA_HD inline bool logLuminanceTerm(const glm::vec3& linearRgb, double& term)
+{
+    const float l = luminance(linearRgb);
+    if (!(fabsf(l) <= 3.402823466e38f)) return false;   // NaN or infinite
+    term = log(kLogDelta + double(l > 0.0f ? l : 0.0f));
+    return true;
+}
+
+// exp(mean term) over `count` pixels that counted; 0 when none did.
+SYLVA_HD inline float logAverageOf(double termSum, double count) { return count > 0.0 ? float(exp(termSum / count)) : 0.0f; }
+
+// The exposure scale for a key (finite, > 0) and a log-average: key / average, 0 for a black image.
+SYLVA_HD inline float exposureScale(float key, float logAverage) { return logAverage > 0.0f ? key / logAverage : 0.0f; }
+
 // Exposure setting of toneMapToSrgb: the key is the grey the log-average luminance is mapped to
 // before the Reinhard curve (0.18 = "middle grey", Reinhard et al. 2002). 4 bytes.
 struct ToneMapParams {

@@ -176,42 +176,46 @@ struct Query {
     uint32_t path[kMaxLevels];   // path[0]: top-level instance; path[k]: groupInstances index at depth k
 };
 
-// Records a closer hit of triangle `tri` found `depth` levels below the top.
-SYLVA_HD SYLVA_INLINE void recordHit(Query& q, int depth, float t, float u, float w, uint32_t tri)
+// Records a closer hit of triangle `tri` found Depth levels below the top.
+template <int Depth>
+SYLVA_HD SYLVA_INLINE void recordHit(Query& q, float t, float u, float w, uint32_t tri)
 {
-    q.hit.t = t;
-    q.hit.u = u;
-    q.hit.v = w;
-    q.hit.prim = tri;
-    q.hit.inst = q.path[0];
-    q.hit.depth = uint32_t(depth);
-    for (int k = 1; k <= depth; ++k) q.hit.nested[k - 1] = q.path[k];
+    Hit& h = q.hit;
+    h.t = t;
+    h.u = u;
+    h.v = w;
+    h.prim = tri;
+    h.inst = q.path[0];
+    h.depth = uint32_t(Depth);
+    for (int k = 1; k <= Depth; ++k) h.nested[k - 1] = q.path[k];
 }
 
-// A mesh in its own frame: its BVH over triangle blocks (Kd = false; the host walks the 8-wide copy when
-// the view has it) or its kd-tree (Kd = true). Returns true when an any-hit query found a hit.
-template <bool AnyHit, bool Kd>
-SYLVA_HD inline bool traceMesh(Query& q, const GeometryRecord& geo, int depth, const glm::vec3& o, const glm::vec3& d,
-                               float& tmax)
+// A mesh in its own frame, Depth levels below the top: its BVH over triangle blocks (Kd = false; the host
+// walks the 8-wide copy when the view has it) or its kd-tree (Kd = true). Returns true when an any-hit
+// query found a hit. The query's limits are copied to locals so that hit writes cannot make the
+// compiler reload them for every leaf.
+template <bool AnyHit, bool Kd, int Depth>
+SYLVA_HD inline bool traceMesh(Query& q, const GeometryRecord& geo, const glm::vec3& o, const glm::vec3& d, float& tmax)
 {
     const RenderView& v = q.v;
+    const float tmin = q.tmin, tAlpha = q.tAlpha;
     if constexpr (Kd) {
         const TriAccel* tris = v.tris + geo.triOffset;
         auto triFn = [&](uint32_t s, float& t) {
             float u, w;
-            if (!hitTriangle(v, tris[s], o, d, q.tmin, t, u, w, q.tAlpha)) return false;
-            if (!AnyHit) recordHit(q, depth, t, u, w, tris[s].tri);
+            if (!hitTriangle(v, tris[s], o, d, tmin, t, u, w, tAlpha)) return false;
+            if (!AnyHit) recordHit<Depth>(q, t, u, w, tris[s].tri);
             return AnyHit;
         };
         const KdView view{v.kdNodes + geo.kdNodeOffset, v.kdRefs + geo.kdRefOffset, geo.lo, geo.hi};
-        return traverseKd(view, o, d, q.tmin, tmax, triFn);
+        return traverseKd(view, o, d, tmin, tmax, triFn);
     } else {
         const TriBlock* blocks = v.blocks + geo.primOffset;
         auto blockFn = [&](uint32_t block, uint32_t count, float& t) {
             float u, w;
             uint32_t tri;
-            if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, q.tmin, t, u, w, tri, q.tAlpha)) return false;
-            if (!AnyHit) recordHit(q, depth, t, u, w, tri);
+            if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, tmin, t, u, w, tri, tAlpha)) return false;
+            if (!AnyHit) recordHit<Depth>(q, t, u, w, tri);
             return AnyHit;
         };
         const char* leafData = reinterpret_cast<const char*>(blocks);
@@ -219,10 +223,10 @@ SYLVA_HD inline bool traceMesh(Query& q, const GeometryRecord& geo, int depth, c
         // The host's 8-wide flattening of the same tree when the scene has it (same leaves; the same
         // closest hit up to which of two triangles at exactly the same t wins).
         if (v.blasWideNodes)
-            return traverseBvh(BvhView8{v.blasWideNodes + geo.wideNodeOffset, leafData, sizeof(TriBlock)}, o, d, q.tmin, tmax,
+            return traverseBvh(BvhView8{v.blasWideNodes + geo.wideNodeOffset, leafData, sizeof(TriBlock)}, o, d, tmin, tmax,
                                blockFn);
 #endif
-        return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset, leafData, sizeof(TriBlock)}, o, d, q.tmin, tmax, blockFn);
+        return traverseBvh(BvhView{v.blasNodes + geo.nodeOffset, leafData, sizeof(TriBlock)}, o, d, tmin, tmax, blockFn);
     }
 }
 
@@ -241,7 +245,7 @@ SYLVA_HD inline bool traceLevel(Query& q, const BvhNode* nodes, const BvhNode8* 
         q.path[Depth] = index;
         const glm::vec3 lo = toLocalPoint(in, o), ld = toLocalDir(in, d);
         const GeometryRecord& geo = v.geometries[in.geometry];
-        if (geo.kind == GeometryKind::Mesh) return traceMesh<AnyHit, Kd>(q, geo, Depth, lo, ld, t);
+        if (geo.kind == GeometryKind::Mesh) return traceMesh<AnyHit, Kd, Depth>(q, geo, lo, ld, t);
         if constexpr (Depth + 1 < kMaxLevels) {
             if (geo.kind == GeometryKind::Group)
                 return traceLevel<AnyHit, Kd, Depth + 1>(q, v.groupNodes + geo.nodeOffset,

@@ -236,6 +236,74 @@ private Q_SLOTS:
     }
 
     // The GPU film composes and tone-maps to the CPU picture in every mode.
+    void nestedRaysMatchCpu_data()
+    {
+        QTest::addColumn<int>("accel");
+        QTest::newRow("bvh") << int(AccelKind::Bvh);
+        QTest::newRow("kdtree") << int(AccelKind::KdTree);
+    }
+
+    // Four levels (the top, three nested groups) on the device: the same hits, instance paths and t as
+    // the CPU's traversal, closest and any hit, BVH and kd-tree meshes.
+    void nestedRaysMatchCpu()
+    {
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
+        QFETCH(int, accel);
+        Scene s = test::twoShrubs();
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, nullptr, false);
+        s.groups.resize(3);
+        for (uint32_t g = 0; g < 3; ++g) {
+            s.groups[g].name = "g" + std::to_string(g);
+            for (int i = 0; i < 3; ++i) {
+                InstanceDesc d;
+                d.position = {1.7 * double(i) * double(g + 1), 0.0, 0.9 * double(i % 2) * double(g + 1)};
+                d.rotationDeg = {0.0f, 50.0f * float(i + g), 3.0f * float(i)};
+                d.scale = 0.8f + 0.1f * float(i);
+                if (g > 0) d.group = g - 1;
+                s.groups[g].instances.push_back(d);
+            }
+        }
+        for (InstanceDesc& d : s.instances) d.group = 2;
+        s.ground.enabled = false;
+        s.render.accel = AccelKind(accel);
+        const RenderScene rs = buildRenderScene(s, assets, glm::vec3(1.0f));
+        const RenderView v = rs.view();
+        std::mt19937 rng(19);
+        std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+        std::vector<Ray> rays(100000);
+        for (Ray& r : rays) {
+            r.org = glm::vec3(4.0f + u(rng) * 3.0f, 1.0f + u(rng), -3.0f + u(rng) * 2.0f);
+            r.dir = glm::normalize(glm::vec3(u(rng) * 0.6f, u(rng) * 0.3f, 1.0f));
+            r.tmin = 0.0f;
+            r.tmax = 1e30f;
+        }
+        const cuda::DeviceScene ds(rs);
+        for (bool any : {false, true}) {
+            const std::vector<Hit> gpu = cuda::traceRaysCuda(ds, rays, any);
+            int differ = 0, hits = 0, deep = 0;
+            for (size_t i = 0; i < rays.size(); ++i) {
+                Hit h{};
+                const bool got = any ? traceScene<true>(v, rays[i], h) : traceScene<false>(v, rays[i], h);
+                const Hit& g = gpu[i];
+                hits += got;
+                bool same = got == (g.prim != kNoHit);
+                if (same && got && !any) {
+                    deep += h.depth == 3u;
+                    same = h.prim == g.prim && h.inst == g.inst && h.depth == g.depth && std::fabs(h.t - g.t) <= 1e-4f * h.t;
+                    for (uint32_t k = 0; same && k < h.depth; ++k) same = h.nested[k] == g.nested[k];
+                }
+                differ += same ? 0 : 1;
+            }
+            qInfo("%s: %d of %zu rays differ (%d hits, %d through all four levels)", any ? "any-hit" : "closest", differ,
+                  rays.size(), hits, deep);
+            QVERIFY(hits > 1000);
+            if (!any) QVERIFY(deep > hits / 2);
+            QVERIFY2(differ <= int(rays.size()) / 10000, qPrintable(QString("%1 rays differ").arg(differ)));
+        }
+#endif
+    }
+
     void imagesMatchCpu()
     {
         if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));

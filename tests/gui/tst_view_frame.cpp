@@ -5,10 +5,12 @@
 #include <QTest>
 
 #include <cmath>
+#include <cstring>
 
 #include "core/lb/lb_params.h"
 #include "core/render/render_cpu.h"
 #include "pipeline/cache/grid_cache.h"
+#include "pipeline/grow/tree_grower.h"
 #include "pipeline/render/render_job.h"
 #include "studio/asset_store.h"
 #include "studio/render_worker.h"
@@ -94,6 +96,66 @@ private Q_SLOTS:
         for (const SampleParts& p : want.pixels) hits += p.skyCover < 0.5f ? 1 : 0;
         QVERIFY2(hits > 500, "the trees and ground should fill part of the frame");
         QCOMPARE(differingPixels(got, want), 0);
+    }
+
+    void viewportFrameEqualsRenderFrame_data()
+    {
+        QTest::addColumn<float>("prune");
+        QTest::newRow("pruning off") << 0.0f;
+        QTest::newRow("pruning on") << 12.0f;
+    }
+
+    // The studio's frame (built once with every level of detail, re-placed at a new camera) traces exactly
+    // the frame sylva render builds for that camera: the same levels of detail, the same top level, the
+    // same pixels bit for bit.
+    void viewportFrameEqualsRenderFrame()
+    {
+        QFETCH(float, prune);
+        GrowOptions g;
+        g.species = TreeSpecies::Broadleaf;
+        g.targetTriangles = 8000;
+        std::vector<SpeciesAssets> assets(1);
+        assets[0].mesh = growTree(g).mesh;
+        Scene a;
+        a.species.resize(1);
+        a.species[0].name = "grown";
+        for (int i = 0; i < 12; ++i) {
+            InstanceDesc in;
+            in.position = {double(i % 3) * 9.0 - 9.0, 0.0, 8.0 + 14.0 * i};
+            in.rotationDeg = {0.0f, 33.0f * float(i), 0.0f};
+            a.instances.push_back(in);
+        }
+        a.camera.position = {0.0, 4.0, -6.0};
+        a.camera.target = {0.0, 3.0, 40.0};
+        a.render.pruneDistance = prune;
+        a.render.width = 96;
+        a.render.height = 64;
+        ViewFrame frame = buildViewFrame(a, assets, sunRadiance(a.sun));
+        QVERIFY(viewFrameFits(frame, a));
+        Scene b = a;   // the camera walks into the stand: instances change level
+        b.camera.position = {2.0, 5.0, 60.0};
+        b.camera.target = {-1.0, 3.0, 120.0};
+        placeViewFrame(frame, b, sunRadiance(b.sun), b.render.width, b.render.height, 1);
+        const RenderScene fresh = buildRenderScene(b, assets, sunRadiance(b.sun));
+        int levelsUsed = 0;
+        for (size_t n : fresh.stats().instancesPerLevel) levelsUsed += n > 0 ? 1 : 0;
+        QCOMPARE(levelsUsed > 2, prune > 0.0f);
+        for (int l = 0; l < kMaxPruneLevels; ++l) QCOMPARE(frame.rs.stats().instancesPerLevel[l], fresh.stats().instancesPerLevel[l]);
+        QCOMPARE(frame.rs.stats().instancedTriangles, fresh.stats().instancedTriangles);
+        const Film got = renderFilm(frame.rs.view()), want = renderFilm(fresh.view());
+        QCOMPARE(got.pixels.size(), want.pixels.size());
+        int hits = 0;
+        for (const SampleParts& p : want.pixels) hits += p.skyCover < 0.5f ? 1 : 0;
+        QVERIFY(hits > 1000);
+        QVERIFY(std::memcmp(got.pixels.data(), want.pixels.data(), got.pixels.size() * sizeof(SampleParts)) == 0);
+        // A frame built without pruning does not fit a scene that prunes (the studio builds it again).
+        Scene off = a;
+        off.render.pruneDistance = 0.0f;
+        const ViewFrame unpruned = buildViewFrame(off, assets, sunRadiance(off.sun));
+        Scene on = a;
+        on.render.pruneDistance = 12.0f;
+        QVERIFY(!viewFrameFits(unpruned, on));
+        QVERIFY(viewFrameFits(unpruned, off));
     }
 
     void workerRunsPassesAndRecomposes()
