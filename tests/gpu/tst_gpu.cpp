@@ -254,8 +254,8 @@ private Q_SLOTS:
         const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, nullptr, false);
         s.groups.resize(3);
         for (uint32_t g = 0; g < 3; ++g) {
-            s.groups[g].name = "g";
-            s.groups[g].name += std::to_string(g);   // not "g" + ...: GCC 12 warns falsely (-Wrestrict)
+            static const char* const kNames[] = {"g0", "g1", "g2"};   // (GCC 12 warns falsely on "g" + to_string)
+            s.groups[g].name = kNames[g];
             for (int i = 0; i < 3; ++i) {
                 InstanceDesc d;
                 d.position = {1.7 * double(i) * double(g + 1), 0.0, 0.9 * double(i % 2) * double(g + 1)};
