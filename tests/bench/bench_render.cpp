@@ -257,6 +257,23 @@ struct EmbreePeer {
     }
 };
 
+// One ray in Embree's layout (every mode fills its rays through this).
+SYLVA_INLINE void embreeRayFrom(RTCRay& r, const Ray& ray, float tfar, unsigned id)
+{
+    r.org_x = ray.org.x;
+    r.org_y = ray.org.y;
+    r.org_z = ray.org.z;
+    r.tnear = ray.tmin;
+    r.dir_x = ray.dir.x;
+    r.dir_y = ray.dir.y;
+    r.dir_z = ray.dir.z;
+    r.time = 0.0f;
+    r.tfar = tfar;
+    r.mask = 0xffffffffu;
+    r.id = id;
+    r.flags = 0;
+}
+
 // Closest hit of one ray, the ground tested analytically outside Embree exactly as traceBvh does.
 SYLVA_INLINE PrimaryResult embreePrimary1(RTCScene scene, const RenderView& v, const Ray& ray)
 {
@@ -272,18 +289,7 @@ SYLVA_INLINE PrimaryResult embreePrimary1(RTCScene scene, const RenderView& v, c
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
-    rh.ray.org_x = ray.org.x;
-    rh.ray.org_y = ray.org.y;
-    rh.ray.org_z = ray.org.z;
-    rh.ray.tnear = ray.tmin;
-    rh.ray.dir_x = ray.dir.x;
-    rh.ray.dir_y = ray.dir.y;
-    rh.ray.dir_z = ray.dir.z;
-    rh.ray.time = 0.0f;
-    rh.ray.tfar = tmax;
-    rh.ray.mask = 0xffffffffu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
+    embreeRayFrom(rh.ray, ray, tmax, 0);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     rtcIntersect1(scene, &ctx, &rh);
@@ -300,18 +306,7 @@ SYLVA_INLINE bool embreeOccluded1(RTCScene scene, const RenderView& v, const Ray
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;
-    r.org_x = ray.org.x;
-    r.org_y = ray.org.y;
-    r.org_z = ray.org.z;
-    r.tnear = ray.tmin;
-    r.dir_x = ray.dir.x;
-    r.dir_y = ray.dir.y;
-    r.dir_z = ray.dir.z;
-    r.time = 0.0f;
-    r.tfar = ray.tmax;
-    r.mask = 0xffffffffu;
-    r.id = 0;
-    r.flags = 0;
+    embreeRayFrom(r, ray, ray.tmax, 0);
     rtcOccluded1(scene, &ctx, &r);
     return r.tfar < 0.0f;
 }
@@ -400,22 +395,6 @@ void embreeOccluded8(RTCScene scene, const RenderView& v, const Ray* rays, const
 // Embree's stream mode: the rays of one 8x8 tile as one rtcIntersect1M / rtcOccluded1M call with the coherent flag
 // (Embree regroups a stream into packets itself). Ground plane outside Embree as in the other modes.
 constexpr int kStreamMax = kTile * kTile;
-
-void embreeRayFrom(RTCRay& r, const Ray& ray, float tfar, unsigned id)
-{
-    r.org_x = ray.org.x;
-    r.org_y = ray.org.y;
-    r.org_z = ray.org.z;
-    r.tnear = ray.tmin;
-    r.dir_x = ray.dir.x;
-    r.dir_y = ray.dir.y;
-    r.dir_z = ray.dir.z;
-    r.time = 0.0f;
-    r.tfar = tfar;
-    r.mask = 0xffffffffu;
-    r.id = id;
-    r.flags = 0;
-}
 
 // Camera rays of the tile [x0, x1) x [y0, y1) (at most kStreamMax pixels) into `image` (row length W).
 void embreePrimaryStream(RTCScene scene, const RenderView& v, int W, int x0, int y0, int x1, int y1, PrimaryResult* image)
