@@ -14,6 +14,8 @@ PACKAGES=(cmake ninja-build ccache g++ pkg-config
   qt6-base-dev qt6-base-dev-tools libqt6opengl6-dev
   libassimp-dev libopenmesh-dev libopenimageio-dev openimageio-tools libopencv-core-dev
   libglm-dev libtbb-dev libembree-dev
+  # OpenVDB grids in and out; xxHash keys of the grid cache
+  libopenvdb-dev libboost-iostreams-dev libxxhash-dev
   # sylva-studio's GL tests run under Xvfb with Mesa's software OpenGL
   qt6-qpa-plugins xvfb xauth libgl1-mesa-dri
   # sylva study draws the plots of docs/ACCURACY.md
