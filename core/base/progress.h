@@ -31,7 +31,13 @@ public:
     }
 
     void cancel() { m_cancelled.store(true, std::memory_order_relaxed); }
-    bool isCancelled() const { return m_cancelled.load(std::memory_order_relaxed); }
+    bool isCancelled() const { return m_cancelled.load(std::memory_order_relaxed) || cancelAllRequested(); }
+
+    // A process-wide cancel: every Progress reports cancelled from then on, the sub-progress objects
+    // of a job included. The CLI's SIGINT/SIGTERM handler calls it (a lock-free atomic store, so it is
+    // async-signal-safe); nothing resets it.
+    static void requestCancelAll() noexcept { s_cancelAll.store(true, std::memory_order_relaxed); }
+    static bool cancelAllRequested() noexcept { return s_cancelAll.load(std::memory_order_relaxed); }
     void throwIfCancelled() const
     {
         if (isCancelled()) throw Cancelled();
@@ -41,6 +47,8 @@ private:
     Callback m_callback;
     std::mutex m_mutex;
     std::atomic<bool> m_cancelled{false};
+    inline static std::atomic<bool> s_cancelAll{false};
+    static_assert(std::atomic<bool>::is_always_lock_free, "requestCancelAll must be async-signal-safe");
 };
 
 // Maps [0,1] of a sub-job onto [begin,end] of a parent's progress.

@@ -10,10 +10,22 @@
 #include <sstream>
 #include <vector>
 
-#include <QCryptographicHash>
+#include <cctype>
+#include <cerrno>
+#include <csignal>
+#include <cstdio>
+#include <ctime>
+#include <map>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <xxhash.h>
+
 #include <QDir>
 #include <QFile>
-#include <QFileInfo>
+#include <QSettings>
 
 #include "core/base/error.h"
 #include "pipeline/io/atomic_file.h"
@@ -22,121 +34,41 @@ namespace sylva {
 
 namespace fs = std::filesystem;
 
-// ---- XXH64 (public algorithm by Yann Collet; this implementation is ours) ----
-
 namespace {
 
-constexpr uint64_t kPrime1 = 0x9E3779B185EBCA87ull;
-constexpr uint64_t kPrime2 = 0xC2B2AE3D27D4EB4Full;
-constexpr uint64_t kPrime3 = 0x165667B19E3779F9ull;
-constexpr uint64_t kPrime4 = 0x85EBCA77C2B2AE63ull;
-constexpr uint64_t kPrime5 = 0x27D4EB2F165667C5ull;
-
-uint64_t load64(const unsigned char* p)
-{
-    uint64_t v;
-    std::memcpy(&v, p, 8);
-    if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap64(v);
-    return v;
-}
-
-uint32_t load32(const unsigned char* p)
-{
-    uint32_t v;
-    std::memcpy(&v, p, 4);
-    if constexpr (std::endian::native == std::endian::big) v = __builtin_bswap32(v);
-    return v;
-}
-
-uint64_t xxRound(uint64_t acc, uint64_t input)
-{
-    acc += input * kPrime2;
-    acc = std::rotl(acc, 31);
-    return acc * kPrime1;
-}
-
-uint64_t xxMerge(uint64_t acc, uint64_t value)
-{
-    acc ^= xxRound(0, value);
-    return acc * kPrime1 + kPrime4;
-}
-
-// Streaming XXH64: feed bytes in any pieces, the digest equals xxh64() of their concatenation.
-class Xxh64 {
+// Streaming XXH3-64 (libxxhash): the digest equals xxh3() of the concatenated pieces.
+class Xxh3Stream {
 public:
-    explicit Xxh64(uint64_t seed = 0)
-        : m_seed(seed), m_acc{seed + kPrime1 + kPrime2, seed + kPrime2, seed, seed - kPrime1}
+    Xxh3Stream() : m_state(XXH3_createState())
     {
+        if (!m_state || XXH3_64bits_reset(m_state) == XXH_ERROR) throw std::bad_alloc();
     }
-
-    void update(const void* data, size_t size)
-    {
-        const unsigned char* p = static_cast<const unsigned char*>(data);
-        m_total += size;
-        if (m_buffered > 0) {
-            const size_t take = std::min(size, size_t(32) - m_buffered);
-            std::memcpy(m_buffer + m_buffered, p, take);
-            m_buffered += take;
-            p += take;
-            size -= take;
-            if (m_buffered < 32) return;
-            stripe(m_buffer);
-            m_buffered = 0;
-        }
-        while (size >= 32) {
-            stripe(p);
-            p += 32;
-            size -= 32;
-        }
-        std::memcpy(m_buffer, p, size);
-        m_buffered = size;
-    }
-
-    uint64_t digest() const
-    {
-        uint64_t h;
-        if (m_total >= 32) {
-            h = std::rotl(m_acc[0], 1) + std::rotl(m_acc[1], 7) + std::rotl(m_acc[2], 12) + std::rotl(m_acc[3], 18);
-            for (uint64_t a : m_acc) h = xxMerge(h, a);
-        } else {
-            h = m_seed + kPrime5;
-        }
-        h += m_total;
-        const unsigned char* p = m_buffer;
-        size_t left = m_buffered;
-        for (; left >= 8; p += 8, left -= 8) h = std::rotl(h ^ xxRound(0, load64(p)), 27) * kPrime1 + kPrime4;
-        if (left >= 4) {
-            h = std::rotl(h ^ (uint64_t(load32(p)) * kPrime1), 23) * kPrime2 + kPrime3;
-            p += 4;
-            left -= 4;
-        }
-        for (; left > 0; ++p, --left) h = std::rotl(h ^ (uint64_t(*p) * kPrime5), 11) * kPrime1;
-        h ^= h >> 33;
-        h *= kPrime2;
-        h ^= h >> 29;
-        h *= kPrime3;
-        h ^= h >> 32;
-        return h;
-    }
+    ~Xxh3Stream() { XXH3_freeState(m_state); }
+    Xxh3Stream(const Xxh3Stream&) = delete;
+    Xxh3Stream& operator=(const Xxh3Stream&) = delete;
+    void update(const void* data, size_t size) { XXH3_64bits_update(m_state, data, size); }
+    uint64_t digest() const { return XXH3_64bits_digest(m_state); }
 
 private:
-    void stripe(const unsigned char* p)
-    {
-        for (int lane = 0; lane < 4; ++lane) m_acc[lane] = xxRound(m_acc[lane], load64(p + 8 * lane));
-    }
-
-    uint64_t m_seed;
-    uint64_t m_acc[4];
-    unsigned char m_buffer[32] = {};
-    size_t m_buffered = 0;
-    uint64_t m_total = 0;
+    XXH3_state_t* m_state;
 };
+
+CacheKey::Digest canonical(XXH128_hash_t h)
+{
+    XXH128_canonical_t c;
+    XXH128_canonicalFromHash(&c, h);
+    CacheKey::Digest out;
+    std::memcpy(out.data(), c.digest, out.size());
+    return out;
+}
 
 // ---- entry header ----
 
 constexpr char kEntryMagic[8] = {'S', 'Y', 'L', 'V', 'A', 'G', 'R', 'D'};
-constexpr size_t kHeaderSize = 136;
-constexpr size_t kChecksumOffset = 104;   // the checksum covers header bytes [0, 104) and the payload
+constexpr size_t kHeaderSize = 128;
+constexpr size_t kKeyOffset = 64;
+constexpr size_t kPayloadSizeOffset = 80;
+constexpr size_t kChecksumOffset = 88;   // the checksum covers header bytes [0, 88) and the payload
 constexpr uint32_t kKindDensity = 1;
 constexpr uint32_t kKindLighting = 2;
 
@@ -147,7 +79,7 @@ struct EntryHeader {
     uint32_t channels = 0;
     double origin[3] = {0.0, 0.0, 0.0};
     double spacing = 1.0;
-    std::array<std::byte, 32> key{};
+    CacheKey::Digest key{};
     uint64_t payloadBytes = 0;
     uint64_t checksum = 0;
 };
@@ -174,8 +106,8 @@ void encodeHeader(const EntryHeader& h, unsigned char* out)
     put(out + 28, h.channels, 4);
     for (int a = 0; a < 3; ++a) put(out + 32 + 8 * a, std::bit_cast<uint64_t>(h.origin[a]), 8);
     put(out + 56, std::bit_cast<uint64_t>(h.spacing), 8);
-    std::memcpy(out + 64, h.key.data(), 32);
-    put(out + 96, h.payloadBytes, 8);
+    std::memcpy(out + kKeyOffset, h.key.data(), h.key.size());
+    put(out + kPayloadSizeOffset, h.payloadBytes, 8);
     put(out + kChecksumOffset, h.checksum, 8);
 }
 
@@ -188,8 +120,8 @@ EntryHeader decodeHeader(const unsigned char* in)
     h.channels = uint32_t(get(in + 28, 4));
     for (int a = 0; a < 3; ++a) h.origin[a] = std::bit_cast<double>(get(in + 32 + 8 * a, 8));
     h.spacing = std::bit_cast<double>(get(in + 56, 8));
-    std::memcpy(h.key.data(), in + 64, 32);
-    h.payloadBytes = get(in + 96, 8);
+    std::memcpy(h.key.data(), in + kKeyOffset, h.key.size());
+    h.payloadBytes = get(in + kPayloadSizeOffset, 8);
     h.checksum = get(in + kChecksumOffset, 8);
     return h;
 }
@@ -239,7 +171,7 @@ std::string hex64(uint64_t v)
 }
 
 // Reads exactly `size` bytes, feeding them to `hash` when given; returns the count actually read.
-size_t readFully(QFile& file, void* data, size_t size, Xxh64* hash)
+size_t readFully(QFile& file, void* data, size_t size, Xxh3Stream* hash)
 {
     char* p = static_cast<char*>(data);
     size_t done = 0;
@@ -259,7 +191,10 @@ struct LoadedEntry {
 };
 
 // Loads and verifies one entry. Every defect deletes the file and explains itself through whyMissed.
-std::optional<LoadedEntry> loadEntry(const std::string& path, uint32_t kind, const std::array<std::byte, 32>& key, std::string* whyMissed)
+// The entry is read under a shared flock, which eviction respects; a hit sets its modification time
+// (its last use, for the least-recently-used eviction).
+std::optional<LoadedEntry> loadEntry(const std::string& path, uint32_t kind, const CacheKey::Digest& key, std::string* whyMissed,
+                                     const std::function<void(const std::string&)>& lockedHook)
 {
     auto miss = [&](const std::string& why) -> std::optional<LoadedEntry> {
         if (whyMissed) *whyMissed = why;
@@ -269,6 +204,12 @@ std::optional<LoadedEntry> loadEntry(const std::string& path, uint32_t kind, con
     if (!fs::exists(path, ec)) return miss("no cache entry " + path);
     QFile file(QString::fromStdString(path));
     if (!file.open(QIODevice::ReadOnly)) return miss("cannot read cache entry " + path + " (" + file.errorString().toStdString() + "); recomputing");
+    // Shared lock for the read; eviction takes the exclusive one, unlinks, then lets go: an entry
+    // unlinked while this waited is a miss.
+    while (::flock(file.handle(), LOCK_SH) != 0 && errno == EINTR) {}
+    struct stat st {};
+    if (::fstat(file.handle(), &st) != 0 || st.st_nlink == 0) return miss("no cache entry " + path + " (evicted)");
+    if (lockedHook) lockedHook(path);
 
     auto reject = [&](const std::string& problem) -> std::optional<LoadedEntry> {
         file.close();
@@ -277,7 +218,7 @@ std::optional<LoadedEntry> loadEntry(const std::string& path, uint32_t kind, con
         return miss("cache entry " + path + " is " + problem + "; recomputing");
     };
 
-    const uint64_t fileSize = uint64_t(file.size());
+    const uint64_t fileSize = uint64_t(st.st_size);
     unsigned char raw[kHeaderSize];
     if (readFully(file, raw, kHeaderSize, nullptr) != kHeaderSize)
         return reject("truncated (" + std::to_string(fileSize) + " bytes, the header alone needs " + std::to_string(kHeaderSize) + ")");
@@ -297,7 +238,7 @@ std::optional<LoadedEntry> loadEntry(const std::string& path, uint32_t kind, con
 
     LoadedEntry entry;
     entry.header = h;
-    Xxh64 hash;
+    Xxh3Stream hash;
     hash.update(raw, kChecksumOffset);
     entry.payload.resize(size_t(h.payloadBytes / sizeof(float)));
     if (readFully(file, entry.payload.data(), size_t(h.payloadBytes), &hash) != h.payloadBytes)
@@ -305,6 +246,7 @@ std::optional<LoadedEntry> loadEntry(const std::string& path, uint32_t kind, con
     if (hash.digest() != h.checksum) return reject("corrupt (checksum mismatch)");
     if constexpr (std::endian::native == std::endian::big)
         for (float& f : entry.payload) f = std::bit_cast<float>(__builtin_bswap32(std::bit_cast<uint32_t>(f)));
+    (void)::futimens(file.handle(), nullptr);   // used now (best effort: a read-only cache still reads)
     return entry;
 }
 
@@ -326,7 +268,7 @@ void storeEntry(const std::string& path, EntryHeader header, const std::vector<c
 
     unsigned char raw[kHeaderSize];
     encodeHeader(header, raw);
-    Xxh64 hash;
+    Xxh3Stream hash;
     hash.update(raw, kChecksumOffset);
     for (const auto* a : le) hash.update(a->data(), a->size() * sizeof(float));
     header.checksum = hash.digest();
@@ -371,11 +313,9 @@ void checkGeometry(const std::string& path, const GridGeometry& g)
 
 } // namespace
 
-uint64_t xxh64(const void* data, size_t size, uint64_t seed)
+uint64_t xxh3(const void* data, size_t size)
 {
-    Xxh64 h(seed);
-    h.update(data, size);
-    return h.digest();
+    return XXH3_64bits(data, size);
 }
 
 // ---- CacheKey ----
@@ -394,12 +334,11 @@ void CacheKey::field(char type, std::string_view label, const void* value, size_
 
 CacheKey& CacheKey::add(std::string_view label, std::span<const std::byte> bytes)
 {
-    // 32-byte SHA-256 of the bytes, then their length: the key keeps 40 bytes, not the data.
-    unsigned char inner[40];
-    const QByteArray digest = QCryptographicHash::hash(
-        QByteArrayView(reinterpret_cast<const char*>(bytes.data()), qsizetype(bytes.size())), QCryptographicHash::Sha256);
-    std::memcpy(inner, digest.constData(), 32);
-    put(inner + 32, bytes.size(), 8);
+    // 16-byte XXH3-128 of the bytes, then their length: the key keeps 24 bytes, not the data.
+    unsigned char inner[kDigestBytes + 8];
+    const Digest digest = canonical(XXH3_128bits(bytes.data(), bytes.size()));
+    std::memcpy(inner, digest.data(), kDigestBytes);
+    put(inner + kDigestBytes, bytes.size(), 8);
     field('B', label, inner, sizeof(inner));
     return *this;
 }
@@ -426,12 +365,9 @@ CacheKey& CacheKey::add(std::string_view label, int64_t value)
     return *this;
 }
 
-std::array<std::byte, 32> CacheKey::digest() const
+CacheKey::Digest CacheKey::digest() const
 {
-    const QByteArray d = QCryptographicHash::hash(QByteArrayView(m_fields.data(), qsizetype(m_fields.size())), QCryptographicHash::Sha256);
-    std::array<std::byte, 32> out;
-    std::memcpy(out.data(), d.constData(), 32);
-    return out;
+    return canonical(XXH3_128bits(m_fields.data(), m_fields.size()));
 }
 
 std::string CacheKey::hex() const
@@ -442,7 +378,8 @@ std::string CacheKey::hex() const
 
 // ---- GridCache ----
 
-GridCache::GridCache(std::string dir) : m_dir(std::move(dir))
+GridCache::GridCache(std::string dir, std::optional<uint64_t> maxBytes)
+    : m_dir(std::move(dir)), m_maxBytes(maxBytes ? *maxBytes : cacheSizeLimitSetting())
 {
     if (m_dir.empty()) {
         const QString xdg = qEnvironmentVariable("XDG_CACHE_HOME");
@@ -460,7 +397,7 @@ std::string GridCache::entryPath(const CacheKey& key, char kind) const
 
 std::optional<DensityGrid> GridCache::loadDensity(const CacheKey& key, std::string* whyMissed)
 {
-    auto entry = loadEntry(entryPath(key, 'd'), kKindDensity, key.digest(), whyMissed);
+    auto entry = loadEntry(entryPath(key, 'd'), kKindDensity, key.digest(), whyMissed, m_readHook);
     if (!entry) return std::nullopt;
     DensityGrid grid;
     grid.geometry = geometryOf(entry->header);
@@ -479,12 +416,14 @@ void GridCache::storeDensity(const CacheKey& key, const DensityGrid& grid)
     if (grid.density.size() != n || (!grid.woodFraction.empty() && grid.woodFraction.size() != n))
         throw Error(path + ": the density grid's arrays do not match its dims");
     const std::vector<float> zeros = grid.woodFraction.empty() ? std::vector<float>(n, 0.0f) : std::vector<float>();
+    beforeStore(path, uint64_t(n) * 2 * sizeof(float));
     storeEntry(path, headerFor(grid.geometry, kKindDensity, key), {&grid.density, grid.woodFraction.empty() ? &zeros : &grid.woodFraction});
+    afterStore(path);
 }
 
 std::optional<LightingGrid> GridCache::loadLighting(const CacheKey& key, std::string* whyMissed)
 {
-    auto entry = loadEntry(entryPath(key, 'l'), kKindLighting, key.digest(), whyMissed);
+    auto entry = loadEntry(entryPath(key, 'l'), kKindLighting, key.digest(), whyMissed, m_readHook);
     if (!entry) return std::nullopt;
     LightingGrid grid;
     grid.geometry = geometryOf(entry->header);
@@ -497,7 +436,325 @@ void GridCache::storeLighting(const CacheKey& key, const LightingGrid& grid)
     const std::string path = entryPath(key, 'l');
     checkGeometry(path, grid.geometry);
     if (grid.rgb.size() != grid.geometry.nodeCount() * 3) throw Error(path + ": the lighting grid's array does not match its dims");
+    beforeStore(path, uint64_t(grid.rgb.size()) * sizeof(float));
     storeEntry(path, headerFor(grid.geometry, kKindLighting, key), {&grid.rgb});
+    afterStore(path);
+}
+
+// ---- the folder: CACHEDIR.TAG, size limit, eviction, info and clean ----
+
+namespace {
+
+constexpr char kTagSignature[] = "Signature: 8a477f597d28d172789f06886806bc55";
+constexpr int64_t kStaleTempSeconds = 24 * 3600;
+
+int64_t mtimeNs(const struct stat& st)
+{
+    return int64_t(st.st_mtim.tv_sec) * 1000000000 + int64_t(st.st_mtim.tv_nsec);
+}
+
+bool isTempName(const std::string& name)
+{
+    return name.rfind(".tmp.", 0) == 0;
+}
+
+// A temporary file ".tmp.PID.N.NAME" whose writer is gone (no such process) or that is older than a day.
+bool staleTemp(const std::string& name, int64_t ageSeconds)
+{
+    if (ageSeconds > kStaleTempSeconds) return true;
+    const size_t end = name.find('.', 5);
+    if (end == std::string::npos) return true;
+    long pid = 0;
+    try {
+        pid = std::stol(name.substr(5, end - 5));
+    } catch (...) {
+        return true;
+    }
+    if (pid <= 0) return true;
+    if (pid == long(::getpid())) return false;
+    return ::kill(pid_t(pid), 0) != 0 && errno == ESRCH;
+}
+
+uint32_t versionOf(const std::string& path)
+{
+    unsigned char raw[12];
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return 0;
+    const ssize_t got = ::read(fd, raw, sizeof raw);
+    ::close(fd);
+    if (got != ssize_t(sizeof raw) || std::memcmp(raw, kEntryMagic, 8) != 0) return 0;
+    return uint32_t(get(raw + 8, 4));
+}
+
+// Removes an entry and its sidecars unless a reader holds it (then false, nothing removed). The
+// exclusive lock is held across the unlink, so a reader waiting for its shared lock sees an unlinked
+// file and misses.
+bool tryRemoveEntry(const GridCache::Entry& e)
+{
+    const int fd = ::open(e.path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return errno == ENOENT;   // gone already
+    if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        ::close(fd);
+        return false;
+    }
+    std::error_code ec;
+    fs::remove(e.path, ec);
+    ::close(fd);
+    const fs::path p(e.path);
+    const std::string prefix = p.filename().string() + ".";
+    for (const auto& side : fs::directory_iterator(p.parent_path(), ec)) {
+        const std::string name = side.path().filename().string();
+        if (name.rfind(prefix, 0) == 0) fs::remove(side.path(), ec);
+    }
+    return true;
+}
+
+} // namespace
+
+void GridCache::beforeStore(const std::string& path, uint64_t payloadBytes) const
+{
+    const uint64_t bytes = kHeaderSize + payloadBytes;
+    if (m_maxBytes > 0 && bytes > m_maxBytes)
+        throw Error(path + ": not cached: the entry (" + formatBytes(bytes) + ") is larger than the cache size limit (" +
+                    formatBytes(m_maxBytes) + "; `sylva cache limit` or cache/maxSize in " + cacheSettingsPath() + ")");
+    // CACHEDIR.TAG, so backup and sync tools skip the folder (https://bford.info/cachedir/).
+    const std::string tag = (fs::path(m_dir) / "CACHEDIR.TAG").string();
+    std::error_code ec;
+    if (!fs::exists(tag, ec)) {
+        AtomicFile file(tag, AtomicFile::Sync::No, "cache folder tag");
+        file.write(std::string(kTagSignature) + "\n# This file is a cache directory tag created by Sylva (sylva, sylva-studio).\n"
+                   "# For information about cache directory tags, see https://bford.info/cachedir/\n");
+        file.commit();
+    }
+}
+
+void GridCache::afterStore(const std::string&)
+{
+    if (m_maxBytes > 0) evictTo(m_maxBytes);
+}
+
+GridCache::Summary GridCache::summary(bool readVersions) const
+{
+    Summary sum;
+    const fs::path grids = fs::path(m_dir) / "grids";
+    std::error_code ec;
+    std::map<std::string, size_t> byName;   // entry file name -> index
+    std::vector<std::pair<std::string, uint64_t>> sidecars;
+    for (const auto& item : fs::directory_iterator(grids, ec)) {
+        struct stat st {};
+        const std::string path = item.path().string();
+        if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
+        const std::string name = item.path().filename().string();
+        if (isTempName(name)) {
+            ++sum.tempFiles;
+            sum.tempBytes += uint64_t(st.st_size);
+            sum.bytes += uint64_t(st.st_size);
+            continue;
+        }
+        const size_t dot = name.find(".sgrid");
+        if (dot == std::string::npos) continue;
+        if (dot + 6 == name.size()) {
+            Entry e;
+            e.path = path;
+            e.bytes = uint64_t(st.st_size);
+            e.lastUsedNs = mtimeNs(st);
+            e.kind = name.size() > 8 && name[name.size() - 8] == '.' ? name[name.size() - 7] : '?';
+            e.version = readVersions ? versionOf(path) : kCacheFormatVersion;
+            byName[name] = sum.entries.size();
+            sum.entries.push_back(e);
+        } else if (name[dot + 6] == '.') {
+            sidecars.emplace_back(name.substr(0, dot + 6), uint64_t(st.st_size));
+        }
+    }
+    for (const auto& [owner, bytes] : sidecars) {
+        auto it = byName.find(owner);
+        if (it != byName.end()) sum.entries[it->second].bytes += bytes;
+        else sum.bytes += bytes;   // an orphaned sidecar still takes space
+    }
+    std::sort(sum.entries.begin(), sum.entries.end(),
+              [](const Entry& a, const Entry& b) { return a.lastUsedNs != b.lastUsedNs ? a.lastUsedNs < b.lastUsedNs : a.path < b.path; });
+    for (const Entry& e : sum.entries) {
+        sum.bytes += e.bytes;
+        if (e.version != kCacheFormatVersion) ++sum.otherVersion;
+        else if (e.kind == 'd') ++sum.density;
+        else if (e.kind == 'l') ++sum.lighting;
+    }
+    return sum;
+}
+
+namespace {
+
+uint64_t entryBytes(const std::vector<GridCache::Entry>& entries)
+{
+    uint64_t total = 0;
+    for (const auto& e : entries) total += e.bytes;
+    return total;
+}
+
+// Evicts the oldest used of `entries` (sorted oldest first) until they fit `limit`; counts into r.
+void evictOldest(std::vector<GridCache::Entry>& entries, uint64_t limit, GridCache::CleanResult& r)
+{
+    uint64_t total = entryBytes(entries);
+    std::vector<GridCache::Entry> kept;
+    for (auto& e : entries) {
+        if (total > limit) {
+            if (tryRemoveEntry(e)) {
+                ++r.removed;
+                r.removedBytes += e.bytes;
+                total -= e.bytes;
+                continue;
+            }
+            ++r.busy;
+        }
+        kept.push_back(e);
+    }
+    entries = std::move(kept);
+}
+
+} // namespace
+
+GridCache::CleanResult GridCache::evictTo(uint64_t limit)
+{
+    CleanResult r;
+    std::vector<Entry> entries = summary(false).entries;
+    evictOldest(entries, limit, r);
+    r.kept = entries.size();
+    r.keptBytes = entryBytes(entries);
+    return r;
+}
+
+GridCache::CleanResult GridCache::clean(const CleanOptions& options)
+{
+    CleanResult r;
+    const Summary sum = summary(true);
+    const fs::path grids = fs::path(m_dir) / "grids";
+    std::error_code ec;
+    const int64_t now = int64_t(std::time(nullptr));
+    for (const auto& item : fs::directory_iterator(grids, ec)) {
+        const std::string name = item.path().filename().string();
+        struct stat st {};
+        if (!isTempName(name) || ::lstat(item.path().c_str(), &st) != 0 || !S_ISREG(st.st_mode)) continue;
+        if (staleTemp(name, now - int64_t(st.st_mtim.tv_sec))) {
+            std::error_code removeError;
+            if (fs::remove(item.path(), removeError)) {
+                ++r.removed;
+                r.removedBytes += uint64_t(st.st_size);
+            }
+        }
+    }
+    const bool all = !options.olderThanSeconds && !options.maxBytes;
+    std::vector<Entry> rest;
+    for (const Entry& e : sum.entries) {
+        const bool old = options.olderThanSeconds && (now - e.lastUsedNs / 1000000000) > *options.olderThanSeconds;
+        if (all || old || e.version != kCacheFormatVersion) {
+            if (tryRemoveEntry(e)) {
+                ++r.removed;
+                r.removedBytes += e.bytes;
+                continue;
+            }
+            ++r.busy;
+        }
+        rest.push_back(e);
+    }
+    if (options.maxBytes) evictOldest(rest, *options.maxBytes, r);
+    r.kept = rest.size();
+    r.keptBytes = entryBytes(rest);
+    return r;
+}
+
+// ---- settings and sizes ----
+
+uint64_t cacheSizeLimitSetting()
+{
+    const QSettings settings(QSettings::NativeFormat, QSettings::UserScope, QStringLiteral("Sylva"), QStringLiteral("sylva"));
+    const QVariant value = settings.value(QStringLiteral("cache/maxSize"));
+    if (!value.isValid()) return kDefaultCacheLimit;
+    const std::string text = value.toString().trimmed().toLower().toStdString();
+    if (text == "none" || text == "off" || text == "unlimited") return 0;
+    const auto bytes = parseByteSize(text);
+    return bytes ? *bytes : kDefaultCacheLimit;
+}
+
+void setCacheSizeLimitSetting(uint64_t bytes)
+{
+    QSettings settings(QSettings::NativeFormat, QSettings::UserScope, QStringLiteral("Sylva"), QStringLiteral("sylva"));
+    settings.setValue(QStringLiteral("cache/maxSize"), bytes == 0 ? QStringLiteral("none") : QString::number(qulonglong(bytes)));
+    settings.sync();
+    if (settings.status() != QSettings::NoError) throw Error(settings.fileName().toStdString() + ": cannot write the settings");
+}
+
+std::string cacheSettingsPath()
+{
+    const QSettings settings(QSettings::NativeFormat, QSettings::UserScope, QStringLiteral("Sylva"), QStringLiteral("sylva"));
+    return settings.fileName().toStdString();
+}
+
+std::optional<uint64_t> parseByteSize(std::string_view text)
+{
+    std::string t(text);
+    while (!t.empty() && std::isspace((unsigned char)t.back())) t.pop_back();
+    size_t used = 0;
+    double value = 0.0;
+    try {
+        value = std::stod(t, &used);
+    } catch (...) {
+        return std::nullopt;
+    }
+    if (used == 0 || !std::isfinite(value) || value < 0.0 || t[0] == '-' || t[0] == '+') return std::nullopt;
+    std::string unit = t.substr(used);
+    while (!unit.empty() && unit.front() == ' ') unit.erase(unit.begin());
+    for (char& c : unit) c = char(std::tolower((unsigned char)c));
+    if (unit.size() >= 2 && unit.substr(unit.size() - 2) == "ib") unit.resize(unit.size() - 2);
+    else if (unit.size() >= 2 && unit.back() == 'b') unit.pop_back();
+    else if (unit == "b" || unit == "bytes") unit.clear();
+    int shift = 0;
+    if (unit.empty()) shift = 0;
+    else if (unit == "k") shift = 10;
+    else if (unit == "m") shift = 20;
+    else if (unit == "g") shift = 30;
+    else if (unit == "t") shift = 40;
+    else return std::nullopt;
+    const double bytes = std::ldexp(value, shift);
+    if (bytes >= 18446744073709551616.0) return std::nullopt;
+    return uint64_t(std::llround(bytes));
+}
+
+std::optional<int64_t> parseDuration(std::string_view text)
+{
+    const std::string t(text);
+    size_t used = 0;
+    double value = 0.0;
+    try {
+        value = std::stod(t, &used);
+    } catch (...) {
+        return std::nullopt;
+    }
+    if (used == 0 || !std::isfinite(value) || value < 0.0 || t[0] == '-' || t[0] == '+') return std::nullopt;
+    const std::string unit = t.substr(used);
+    double scale = 0.0;
+    if (unit.empty() || unit == "d") scale = 86400.0;
+    else if (unit == "s") scale = 1.0;
+    else if (unit == "m" || unit == "min") scale = 60.0;
+    else if (unit == "h") scale = 3600.0;
+    else if (unit == "w") scale = 7 * 86400.0;
+    else return std::nullopt;
+    if (value * scale > 1e15) return std::nullopt;
+    return int64_t(std::llround(value * scale));
+}
+
+std::string formatBytes(uint64_t bytes)
+{
+    if (bytes < 1024) return std::to_string(bytes) + (bytes == 1 ? " byte" : " bytes");
+    static const char* units[] = {"KiB", "MiB", "GiB", "TiB", "PiB"};
+    double v = double(bytes) / 1024.0;
+    int u = 0;
+    while (v >= 1024.0 && u < 4) {
+        v /= 1024.0;
+        ++u;
+    }
+    char text[32];
+    std::snprintf(text, sizeof text, "%.2f %s", v, units[u]);
+    return text;
 }
 
 // ---- inspection ----
@@ -549,7 +806,7 @@ std::string describeCacheFile(const std::string& path)
             << " payload bytes in the file)\n";
         return out.str();
     }
-    Xxh64 hash;
+    Xxh3Stream hash;
     hash.update(raw, kChecksumOffset);
     std::vector<char> buffer(size_t(4) << 20);
     uint64_t left = h.payloadBytes;
@@ -562,7 +819,7 @@ std::string describeCacheFile(const std::string& path)
     if (left > 0)
         out << "  checksum:  not checked (read error)\n";
     else if (computed == h.checksum)
-        out << "  checksum:  ok (xxh64 " << hex64(h.checksum) << ")\n";
+        out << "  checksum:  ok (xxh3 " << hex64(h.checksum) << ")\n";
     else
         out << "  checksum:  MISMATCH (stored " << hex64(h.checksum) << ", computed " << hex64(computed) << "): the entry is corrupt\n";
     return out.str();

@@ -2,11 +2,48 @@
 #include "pipeline/cli/cli_util.h"
 
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <sstream>
 #include <unistd.h>
 
+#include "pipeline/io/atomic_file.h"
+
 namespace sylva::cli {
+
+namespace {
+
+volatile std::sig_atomic_t g_cancelSignal = 0;
+
+void onCancelSignal(int sig)
+{
+    if (g_cancelSignal != 0) {
+        // The second: no unwinding, only what is async-signal-safe.
+        removePendingAtomicFiles();
+        static const char message[] = "\nsylva: interrupted again: stopped at once\n";
+        (void)!::write(2, message, sizeof message - 1);
+        ::_exit(128 + sig);
+    }
+    g_cancelSignal = sig;
+    Progress::requestCancelAll();
+}
+
+} // namespace
+
+void cancelOnSignals()
+{
+    struct sigaction action {};
+    action.sa_handler = &onCancelSignal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESTART;   // reads and writes in progress go on; the job stops at its next check
+    ::sigaction(SIGINT, &action, nullptr);
+    ::sigaction(SIGTERM, &action, nullptr);
+}
+
+int cancelSignal()
+{
+    return int(g_cancelSignal);
+}
 
 double parseNumber(const std::string& option, const std::string& text)
 {

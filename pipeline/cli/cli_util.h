@@ -27,6 +27,14 @@ double parseNumber(const std::string& option, const std::string& text);
 long long parseInteger(const std::string& option, const std::string& text, long long lo, long long hi);
 std::vector<std::string> splitList(const std::string& text);
 
+// SIGINT (Ctrl-C) and SIGTERM cancel the running job: the first sets Progress::requestCancelAll(), so
+// the job throws Cancelled at its next progress check and unwinds (AtomicFile removes its temporary
+// files); main then exits with 128 + the signal (130 for SIGINT). A second signal removes the pending
+// temporary files (removePendingAtomicFiles) and exits at once with the same code.
+void cancelOnSignals();
+// The signal that asked to cancel (SIGINT, SIGTERM), 0 when none came.
+int cancelSignal();
+
 // Draws progress on stderr: a bar when stderr is a terminal, plain "NN% message" lines every 10%
 // otherwise. quiet: draw nothing.
 class ProgressPrinter {

@@ -1,6 +1,8 @@
 // sylva: the command line. This file holds the table of commands, `sylva --help` and `--version`, and
-// maps what a command throws to the exit code: 0 ok, 1 bad input or failure, 2 bad usage. Each command
-// is one file (cmd_NAME.cpp); what they compute lives in pipeline/services and the other pipeline folders.
+// maps what a command throws to the exit code: 0 ok, 1 bad input or failure, 2 bad usage, 128 + signal
+// when SIGINT (130) or SIGTERM (143) cancelled the job. Each command is one file (cmd_NAME.cpp); what
+// they compute lives in pipeline/services and the other pipeline folders.
+#include <csignal>
 #include <cstdio>
 #include <new>
 #include <string>
@@ -21,7 +23,7 @@ namespace {
 // The commands in the order `sylva --help` lists them.
 std::vector<Command> commands()
 {
-    return {growCommand(), voxelizeCommand(), lightCommand(), referenceCommand(), renderCommand(), studyCommand(), infoCommand()};
+    return {growCommand(), voxelizeCommand(), lightCommand(), referenceCommand(), renderCommand(), studyCommand(), infoCommand(), cacheCommand()};
 }
 
 void printMainHelp(const std::vector<Command>& cmds)
@@ -53,6 +55,7 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "sylva: unknown command '%s' (see sylva --help)\n", argsv[0].c_str());
         return kUsage;
     }
+    cancelOnSignals();
     try {
         const Args args(*cmd, std::vector<std::string>(argsv.begin() + 1, argsv.end()));
         if (args.help()) {
@@ -67,8 +70,14 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "sylva %s: error: out of memory (try a smaller --grid or --fp16)\n", cmd->name.c_str());
         return kFailure;
     } catch (const Cancelled&) {
-        std::fprintf(stderr, "sylva %s: cancelled\n", cmd->name.c_str());
-        return kFailure;
+        const int sig = cancelSignal();
+        if (sig == 0) {
+            std::fprintf(stderr, "sylva %s: cancelled\n", cmd->name.c_str());
+            return kFailure;
+        }
+        std::fprintf(stderr, "sylva %s: cancelled by %s; no partial output was left\n", cmd->name.c_str(),
+                     sig == SIGINT ? "SIGINT (Ctrl-C)" : "SIGTERM");
+        return 128 + sig;   // 130 for Ctrl-C, as shells report an interrupted program
     } catch (const std::exception& e) {
         std::fprintf(stderr, "sylva %s: error: %s\n", cmd->name.c_str(), e.what());
         return kFailure;

@@ -34,7 +34,42 @@ std::string resolveLinks(const std::string& path)
     return path;
 }
 
+// The temporary files a signal handler may have to remove: fixed slots, claimed with a compare and
+// swap, filled, then published (state 2); cleared before the path changes or the object goes.
+constexpr int kPendingSlots = 64;
+struct PendingSlot {
+    std::atomic<int> state{0};   // 0 free, 1 being filled, 2 published
+    char path[4096] = {};
+};
+PendingSlot g_pending[kPendingSlots];
+static_assert(std::atomic<int>::is_always_lock_free);
+
+int publishPending(const std::string& path)
+{
+    if (path.size() >= sizeof(PendingSlot::path)) return -1;
+    for (int i = 0; i < kPendingSlots; ++i) {
+        int expected = 0;
+        if (!g_pending[i].state.compare_exchange_strong(expected, 1, std::memory_order_acquire)) continue;
+        std::memcpy(g_pending[i].path, path.c_str(), path.size() + 1);
+        g_pending[i].state.store(2, std::memory_order_release);
+        return i;
+    }
+    return -1;
+}
+
+void retractPending(int& slot)
+{
+    if (slot >= 0) g_pending[slot].state.store(0, std::memory_order_release);
+    slot = -1;
+}
+
 } // namespace
+
+void removePendingAtomicFiles() noexcept
+{
+    for (PendingSlot& slot : g_pending)
+        if (slot.state.load(std::memory_order_acquire) == 2) ::unlink(slot.path);
+}
 
 AtomicFile::AtomicFile(std::string target, Sync sync, std::string what)
     : m_target(std::move(target)), m_what(std::move(what)), m_sync(sync)
@@ -68,6 +103,7 @@ AtomicFile::AtomicFile(std::string target, Sync sync, std::string what)
         m_temp.clear();
         throw Error(m_target + ": cannot create the " + m_what + " (" + std::strerror(err) + ")");
     }
+    m_slot = publishPending(m_temp);
     if (exists) (void)::fchmod(fd, existing.st_mode & 07777);
     m_file = ::fdopen(fd, "wb");
     if (!m_file) {
@@ -84,6 +120,7 @@ AtomicFile::~AtomicFile()
         std::error_code ec;
         fs::remove(m_temp, ec);
     }
+    retractPending(m_slot);   // after the removal: a signal between the two finds the file gone
 }
 
 void AtomicFile::fail(const std::string& doing, int err)
@@ -92,6 +129,7 @@ void AtomicFile::fail(const std::string& doing, int err)
     m_file = nullptr;
     std::error_code ec;
     if (!m_temp.empty()) fs::remove(m_temp, ec);
+    retractPending(m_slot);
     m_temp.clear();
     const std::string what = doing == "move" ? "move the written " + m_what + " into place" : doing + " the " + m_what;
     throw Error(m_target + ": cannot " + what + " (" + std::strerror(err) + ")");
@@ -135,6 +173,7 @@ void AtomicFile::commit()
     }
     if (::rename(m_temp.c_str(), m_final.c_str()) != 0) fail("move", errno);
     m_committed = true;
+    retractPending(m_slot);
 }
 
 } // namespace sylva

@@ -51,6 +51,13 @@ private:
     Sync m_sync;
     std::FILE* m_file = nullptr;
     bool m_committed = false;
+    int m_slot = -1;   // in the table removePendingAtomicFiles() reads
 };
+
+// Removes the temporary file of every AtomicFile neither committed nor destroyed, without locks or
+// allocation: async-signal-safe, for a handler that ends the process at once (the CLI's second Ctrl-C;
+// the first cancels the job, and unwinding removes the files). Files past the table's 64 slots are
+// left (a crash leaves them too; `sylva cache clean` removes those of the cache).
+void removePendingAtomicFiles() noexcept;
 
 } // namespace sylva

@@ -138,7 +138,7 @@ private Q_SLOTS:
         QVERIFY(abc1 != abc2);
         QVERIFY(hexOf([](CacheKey& k) { k.add("x", "ab").add("y", "c"); }) != hexOf([](CacheKey& k) { k.add("x", "a").add("y", "bc"); }));
         QCOMPARE(abc1, hexOf([](CacheKey& k) { k.add("ab", "c"); }));
-        QCOMPARE(abc1.size(), size_t(64));
+        QCOMPARE(abc1.size(), size_t(32));
         QVERIFY(abc1.find_first_not_of("0123456789abcdef") == std::string::npos);
         QVERIFY(hexOf([](CacheKey& k) { k.add("n", 1.0); }) != hexOf([](CacheKey& k) { k.add("n", int64_t(1)); }));
         QCOMPARE(hexOf([](CacheKey& k) { k.add("n", -0.0); }), hexOf([](CacheKey& k) { k.add("n", 0.0); }));
@@ -149,19 +149,44 @@ private Q_SLOTS:
         QVERIFY(spanKey != hexOf([](CacheKey& k) { k.add("mesh", "abc"); }));
         QCOMPARE(spanKey, hexOf([&](CacheKey& k) { k.add("mesh", std::span<const std::byte>(raw, 3)); }));
         QVERIFY(spanKey != hexOf([&](CacheKey& k) { k.add("mesh", std::span<const std::byte>(raw, 2)); }));
-        QCOMPARE(CacheKey().hex(), std::string("e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"));   // SHA-256("")
+        // No fields: the XXH3-128 of no bytes, xxHash's published value (`xxhsum -H2 /dev/null`).
+        QCOMPARE(CacheKey().hex(), std::string("99aa06d3014798d86001c324468d497f"));
+        // Content keys: equal bytes give equal keys, one changed float anywhere gives another key.
+        std::vector<float> grid(1 << 16);
+        for (size_t i = 0; i < grid.size(); ++i) grid[i] = float(i % 251) * 0.25f;
+        auto gridKey = [](const std::vector<float>& g) {
+            CacheKey k;
+            k.add("density", std::as_bytes(std::span<const float>(g)));
+            return k.hex();
+        };
+        const std::string gridHex = gridKey(grid);
+        QCOMPARE(gridKey(std::vector<float>(grid)), gridHex);
+        for (size_t at : {size_t(0), grid.size() / 2, grid.size() - 1}) {
+            std::vector<float> changed = grid;
+            changed[at] = std::nextafter(changed[at], 1e9f);
+            QVERIFY(gridKey(changed) != gridHex);
+        }
+        std::vector<float> shorter(grid.begin(), grid.end() - 1);
+        QVERIFY(gridKey(shorter) != gridHex);
     }
 
-    // XXH64 against the reference implementation's values.
+    // XXH3-64 against xxHash's published value, and the checksum in an entry against XXH3-64 of the
+    // file's header bytes [0, 88) and payload computed here from the bytes on disk.
     void checksumVectors()
     {
-        QCOMPARE(xxh64("", 0), 0xef46db3751d8e999ull);
-        QCOMPARE(xxh64("abc", 3), 0x44bc2cf5ad770999ull);
-        QByteArray pattern;
-        for (int r = 0; r < 4; ++r)
-            for (int i = 0; i < 256; ++i) pattern += char(i);
-        pattern += "xyz";
-        QCOMPARE(xxh64(pattern.constData(), size_t(pattern.size())), 0xe146cb31b65bc21aull);
+        QCOMPARE(xxh3("", 0), 0x2d06800538d394c2ull);
+        GridCache cache(freshDir("checksum"), 0);
+        const CacheKey key = keyFor("tree.obj", 0.5);
+        cache.storeLighting(key, makeLighting({4, 5, 6}, 0.25f));
+        const QByteArray bytes = readAll(cache.entryPath(key, 'l'));
+        QCOMPARE(bytes.size(), qsizetype(128 + 4 * 5 * 6 * 3 * 4));
+        QByteArray covered = bytes.left(88) + bytes.mid(128);
+        uint64_t stored = 0;
+        for (int b = 7; b >= 0; --b) stored = (stored << 8) | uint8_t(bytes[88 + b]);
+        QCOMPARE(stored, xxh3(covered.constData(), size_t(covered.size())));
+        // The key digest sits at 64..80, as CacheKey::digest() gives it.
+        const auto digest = key.digest();
+        QCOMPARE(bytes.mid(64, 16), QByteArray(reinterpret_cast<const char*>(digest.data()), 16));
     }
 
     void defaultDir()
@@ -210,7 +235,7 @@ private Q_SLOTS:
         QVERIFY(cache.loadDensity(key)->woodFraction == std::vector<float>(d.density.size(), 0.0f));
 
         // Entries are exactly header + payload, and no temporary files remain.
-        QCOMPARE(QFileInfo(QString::fromStdString(cache.entryPath(key, 'l'))).size(), qint64(136 + 4 * 5 * 6 * 3 * 4));
+        QCOMPARE(QFileInfo(QString::fromStdString(cache.entryPath(key, 'l'))).size(), qint64(128 + 4 * 5 * 6 * 3 * 4));
         const QStringList files = QFileInfo(QString::fromStdString(cache.entryPath(key, 'd'))).dir().entryList(QDir::Files | QDir::Hidden);
         QCOMPARE(files.size(), 2);
 
@@ -245,7 +270,7 @@ private Q_SLOTS:
         expectRejected("flip-payload", [](QByteArray& b) { b[b.size() - 1000] = char(b[b.size() - 1000] ^ 0x10); },
                        QStringLiteral("is corrupt (checksum mismatch)"));
         expectRejected("flip-origin", [](QByteArray& b) { b[40] = char(b[40] ^ 0x01); }, QStringLiteral("is corrupt (checksum mismatch)"));
-        expectRejected("flip-checksum", [](QByteArray& b) { b[104] = char(b[104] ^ 0x80); }, QStringLiteral("is corrupt (checksum mismatch)"));
+        expectRejected("flip-checksum", [](QByteArray& b) { b[88] = char(b[88] ^ 0x80); }, QStringLiteral("is corrupt (checksum mismatch)"));
         expectRejected("flip-dims", [](QByteArray& b) { b[16] = char(b[16] + 1); }, QStringLiteral("is corrupt"));
         expectRejected("bad magic", [](QByteArray& b) { b[0] = 'X'; }, QStringLiteral("not a Sylva grid cache file"));
     }
