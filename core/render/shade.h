@@ -8,13 +8,22 @@ namespace sylva {
 
 // The three parts a render mode combines (linear RGB): local = sun light only, indirect = LB
 // indirect light (ground: sky light), albedo = the surface colour the indirect light multiplies
-// (for the constant-ambient comparison), skyCover = share of samples that saw the sky. 40 bytes.
+// (for the constant-ambient comparison), skyCover = share of samples that saw the sky. Beside them,
+// for the render passes only (no mode reads them): normal = the unit surface normal facing the
+// viewer (world orientation; 0 for the sky), averaged over a pixel's samples like the parts, and
+// depth = the distance along the camera's forward axis to the surface, the nearest over the samples
+// (kSkyDepth for the sky). 56 bytes.
 struct SampleParts {
     glm::vec3 local;
     glm::vec3 indirect;
     glm::vec3 albedo;
     float skyCover;
+    glm::vec3 normal;
+    float depth;
 };
+
+// The depth of a sample that saw the sky (Cycles' value for the background of its Z pass).
+inline constexpr float kSkyDepth = 1e10f;
 
 // Linear RGB of a render mode from a pixel's parts: full = local + indirect, local = sun light only,
 // ambient = local + a constant ambient x albedo, lb = indirect only; plus the sky where samples saw it.
@@ -157,12 +166,12 @@ SYLVA_HD SYLVA_INLINE void volumeStage(const RenderView& v, const Ray& ray, floa
 SYLVA_HD SYLVA_INLINE SampleParts backgroundStage(const RenderView& v, const Ray& ray)
 {
     (void)v, (void)ray;
-    return SampleParts{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 1.0f};
+    return SampleParts{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 1.0f, glm::vec3(0.0f), kSkyDepth};
 }
 
 SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& s)
 {
-    SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f};
+    SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward)};
     const float nl = glm::dot(s.ng, v.sunDir);
     if (s.ground) {
         if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng))) out.local = v.groundColor * v.sunRadiance * nl;
@@ -235,7 +244,7 @@ SYLVA_HD SYLVA_INLINE glm::vec2 samplePosition(int px, int py, int s, int spp)
 // All samples of one pixel, box-filtered.
 SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
 {
-    SampleParts sum{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f};
+    SampleParts sum{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, glm::vec3(0.0f), kSkyDepth};
     for (int s = 0; s < v.spp; ++s) {
         const glm::vec2 pos = samplePosition(px, py, s, v.spp);
         const SampleParts p = shadeRay(v, cameraRay(v, pos.x, pos.y));
@@ -243,12 +252,15 @@ SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
         sum.indirect += p.indirect;
         sum.albedo += p.albedo;
         sum.skyCover += p.skyCover;
+        sum.normal += p.normal;
+        sum.depth = fminf(sum.depth, p.depth);
     }
     const float inv = 1.0f / float(v.spp);
     sum.local *= inv;
     sum.indirect *= inv;
     sum.albedo *= inv;
     sum.skyCover *= inv;
+    sum.normal *= inv;
     return sum;
 }
 

@@ -9,6 +9,7 @@
 #include "pipeline/io/output_path.h"
 #include "pipeline/lighting_job.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/render/render_passes.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/render_stats.h"
 
@@ -80,15 +81,23 @@ int runRender(const Args& args)
     std::string stem;
     const Scene scene = sceneForArgs(args, &stem);
     const RenderSettings& r = scene.render;
-    const std::string out = args.get("--output", stem + ".png");
+    const bool passes = args.has("--passes");
+    const std::string out = args.get("--output", stem + (passes ? ".exr" : ".png"));
     const std::string ext = lowerExtension(out);
     if (ext != ".png" && ext != ".exr" && ext != ".tif" && ext != ".tiff")
         throw UsageError("output " + out + ": unknown image extension (use .png, .exr, .tif or .tiff)");
+    if (passes && ext != ".exr")
+        throw UsageError("option --passes: the passes are layers of one multi-layer EXR; use -o NAME.exr, not " + out);
+    if (passes && args.has("--band-rows")) throw UsageError("option --passes: a frame in bands cannot be written with passes; drop --band-rows");
     requireReplaceableFile(out);
     int bandRows = 0;   // 0: the whole frame at once
     if (args.has("--band-rows")) bandRows = int(parseInteger("--band-rows", args.get("--band-rows"), 1, 32768));
     else if (!frameFitsMemory(r)) bandRows = bandRowsFor(r);
     if (bandRows >= r.height) bandRows = 0;
+    if (passes && bandRows > 0)
+        throw Error("--passes: the " + std::to_string(r.width) + "x" + std::to_string(r.height) +
+                    " frame does not fit in the available memory and would be traced in bands, which writes no passes; "
+                    "render a smaller frame or without --passes");
     auto compute = openBackend(backend);
     auto cache = openCache(args);
     JobLog log;
@@ -112,8 +121,14 @@ int runRender(const Args& args)
         ProgressPrinter bar("render", args.has("--quiet"));
         const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get());
         bar.finish();
-        const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, scene.sky, &ambient);
-        writeRender(out, linear, r.width, r.height, r.exposureKey);
+        if (passes) {
+            const RenderPasses layers = renderPasses(result.film, r.mode, scene.sky);
+            writeRenderPasses(out, layers);
+            ambient = layers.ambient;
+        } else {
+            const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, scene.sky, &ambient);
+            writeRender(out, linear, r.width, r.height, r.exposureKey);
+        }
         st = result.stats;
         timings = result.timings;
     }
@@ -129,7 +144,7 @@ int runRender(const Args& args)
 
 Command renderCommand()
 {
-    return {"render", "[SCENE.sylva.json] [-o OUT.png|.exr|.tif]",
+    return {"render", "[SCENE.sylva.json] [-o OUT.png|.exr|.tif] [--passes -o OUT.exr]",
             "render a scene (the bundled default forest when none is given)",
             {{"--quality", "preview|final|reference", "quality preset: LB grid, steps and storage of every species, samples and distance knobs (docs/ACCURACY.md); the options below override it"},
              {"--width", "W", "image width in pixels (default: the scene's)"},
@@ -142,6 +157,7 @@ Command renderCommand()
              {"--prune-distance", "M", "prune leaves of plants beyond M metres, area-preserving (0: off, default)"},
              kBackend,
              {"--band-rows", "N", "trace and write the frame in bands of N rows (default: only when the whole frame does not fit in memory)"},
+             {"--passes", "", "write one multi-layer EXR (32-bit float) of the render passes: Combined, DiffDir, DiffInd, DiffCol, Env, Normal, Depth, Alpha (docs/RENDERING.md); default output NAME.exr"},
              {"--stats", "", "print timings and acceleration structure sizes"},
              kOutput, kCache, kNoCache, kThreads, kQuiet},
             0, 1, &runRender};

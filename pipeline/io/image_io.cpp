@@ -71,17 +71,29 @@ bool imageHasAlpha(const std::string& path)
     return spec.alpha_channel >= 0 || spec.nchannels == 2 || spec.nchannels >= 4;
 }
 
+namespace {
+
+// The one whole-image writer: `spec`'s pixels from float `data`, through a temporary file beside the
+// target (keeping the extension, so OIIO picks the same format), renamed at the end.
+void writePixels(const std::string& path, const OIIO::ImageSpec& spec, const float* data)
+{
+    AtomicFile file(path, AtomicFile::Sync::No, "image");
+    const std::string& temp = file.pathForWriter();
+    auto out = OIIO::ImageOutput::create(temp);
+    if (!out) throw Error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
+    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data) || !out->close())
+        throw Error(path + ": cannot write image (" + out->geterror() + ")");
+    file.commit();
+}
+
+} // namespace
+
 void writeImage(const std::string& path, const ImageRgba& image, int channels)
 {
     if (image.empty()) throw Error(path + ": refusing to write an empty image");
     if (channels != 3 && channels != 4) throw Error(path + ": images are written with 3 or 4 channels");
     const std::string ext = lowerExtension(path);
     const bool isFloat = ext == ".exr" || ext == ".hdr";
-    // The temporary name keeps the extension, so OIIO picks the same format.
-    AtomicFile file(path, AtomicFile::Sync::No, "image");
-    const std::string& temp = file.pathForWriter();
-    auto out = OIIO::ImageOutput::create(temp);
-    if (!out) throw Error(path + ": no image writer for this extension (" + OIIO::geterror() + ")");
     OIIO::ImageSpec spec(image.width, image.height, channels, isFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
     if (channels == 4) {
         spec.alpha_channel = 3;
@@ -93,9 +105,22 @@ void writeImage(const std::string& path, const ImageRgba& image, int channels)
             float v = image.pixels[p * 4 + size_t(c)];
             data[p * size_t(channels) + size_t(c)] = isFloat ? v : std::clamp(v, 0.0f, 1.0f);
         }
-    if (!out->open(temp, spec) || !out->write_image(OIIO::TypeDesc::FLOAT, data.data()) || !out->close())
-        throw Error(path + ": cannot write image (" + out->geterror() + ")");
-    file.commit();
+    writePixels(path, spec, data.data());
+}
+
+void writeImageChannels(const std::string& path, int width, int height, const std::vector<std::string>& channels,
+                        const std::vector<float>& interleaved)
+{
+    if (width < 1 || height < 1 || channels.empty()) throw Error(path + ": refusing to write an empty image");
+    if (lowerExtension(path) != ".exr") throw Error(path + ": named channels are written to OpenEXR files only (use .exr)");
+    if (interleaved.size() != size_t(width) * size_t(height) * channels.size())
+        throw Error(path + ": " + std::to_string(interleaved.size()) + " values for " + std::to_string(channels.size()) +
+                    " channels of " + std::to_string(width) + "x" + std::to_string(height) + " pixels");
+    OIIO::ImageSpec spec(width, height, int(channels.size()), OIIO::TypeDesc::FLOAT);
+    spec.channelnames = channels;
+    spec.alpha_channel = -1;
+    spec.z_channel = -1;
+    writePixels(path, spec, interleaved.data());
 }
 
 struct RowImageWriter::Impl {

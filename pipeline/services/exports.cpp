@@ -6,8 +6,10 @@
 #include "core/backend/backend.h"
 #include "core/base/error.h"
 #include "core/render/render_cpu.h"
+#include "pipeline/io/file_extension.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/render/render_passes.h"
 
 namespace sylva {
 
@@ -21,8 +23,10 @@ std::vector<std::string> speciesLogLines(const std::string& species, const JobLo
 }
 
 void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, const std::string& path, Backend* backend,
-                  Progress* progress)
+                  Progress* progress, bool passes)
 {
+    if (passes && lowerExtension(path) != ".exr")
+        throw Error(path + ": render passes are written as a multi-layer OpenEXR file (use .exr)");
     if (progress) progress->report(0.0, "building");
     const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
     if (progress && progress->isCancelled()) throw Cancelled();
@@ -31,8 +35,12 @@ void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, 
     if (progress && progress->isCancelled()) traceProgress.cancel();
     const Film film = backend ? backend->render(rs, &traceProgress) : renderFilm(rs.view(), &traceProgress);
     if (progress) progress->report(0.96, "writing");
-    const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, scene.sky);
-    writeRender(path, linear, film.width, film.height, scene.render.exposureKey);
+    if (passes) {
+        writeRenderPasses(path, renderPasses(film, scene.render.mode, scene.sky));
+    } else {
+        const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, scene.sky);
+        writeRender(path, linear, film.width, film.height, scene.render.exposureKey);
+    }
     if (progress) progress->report(1.0, "written");
 }
 

@@ -22,10 +22,10 @@ std::vector<std::string> speciesLogLines(const std::string& species, const JobLo
 
 // The picture of `scene` with the species' assets (in species order; with lighting grids when the
 // mode needs them) into `path`: buildRenderScene, the film on `backend`, composeMode, writeRender
-// (.png/.tif/.tiff tone-mapped 8-bit, .exr linear). Throws Error (bad extension, unwritable file)
-// or Cancelled.
+// (.png/.tif/.tiff tone-mapped 8-bit, .exr linear); with `passes`, renderPasses and writeRenderPasses
+// instead (one multi-layer EXR: .exr only). Throws Error (bad extension, unwritable file) or Cancelled.
 void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, const std::string& path,
-                  Backend* backend = nullptr, Progress* progress = nullptr);
+                  Backend* backend = nullptr, Progress* progress = nullptr, bool passes = false);
 
 // A file name base for a species' grids: ASCII letters, digits, '.', '-' and '_' kept, any other
 // character '_' ("Tree 1 (2)/x" -> "Tree_1__2__x"); "species" for an empty name.
