@@ -1,7 +1,17 @@
 // Tests of the grid cache: keys, round trips, detection of damaged or stale entries, concurrent writers.
 #include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
 #include <cstring>
+#include <ctime>
 #include <functional>
+#include <mutex>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <QCoreApplication>
 #include <QDir>
@@ -121,6 +131,8 @@ private:
 private Q_SLOTS:
     void initTestCase()
     {
+        // The size limit setting of this test, not the user's (QSettings reads XDG_CONFIG_HOME).
+        qputenv("XDG_CONFIG_HOME", QFile::encodeName(outDir() + QStringLiteral("/config")));
         if (isChild()) return;
         QDir(outDir()).removeRecursively();
         QVERIFY(QDir().mkpath(outDir()));
@@ -328,6 +340,210 @@ private Q_SLOTS:
         QVERIFY(!isCacheFile(outDir().toStdString() + "/missing"));
         QVERIFY_THROWS_EXCEPTION(Error, describeCacheFile(npy));
         QVERIFY_THROWS_EXCEPTION(Error, describeCacheFile(outDir().toStdString() + "/missing"));
+    }
+
+    // A random sequence of stores and loads against a model of least-recently-used eviction kept
+    // here: after every operation the entries on disk are exactly the model's and fit the limit.
+    void evictionLeastRecentlyUsed()
+    {
+        const glm::ivec3 dims(6, 7, 8);
+        const uint64_t entryBytes = 128 + uint64_t(6 * 7 * 8) * 3 * 4;
+        const uint64_t limit = 4 * entryBytes + entryBytes / 2;   // room for four entries
+        const std::string dir = freshDir("lru");
+        GridCache cache(dir, limit);
+        QCOMPARE(cache.maxBytes(), limit);
+        std::vector<int> model;   // key numbers, least recently used first
+        auto use = [&](int k) {
+            model.erase(std::remove(model.begin(), model.end(), k), model.end());
+            model.push_back(k);
+        };
+        uint32_t rng = 12345;
+        auto next = [&](uint32_t n) {
+            rng = rng * 1664525u + 1013904223u;
+            return (rng >> 8) % n;
+        };
+        for (int op = 0; op < 40; ++op) {
+            QTest::qWait(12);   // file times tick in jiffies: keep the uses apart
+            const int k = int(next(8));
+            const CacheKey key = keyFor("lru.obj", double(k));
+            const bool present = std::find(model.begin(), model.end(), k) != model.end();
+            if (next(2) == 0) {
+                cache.storeLighting(key, makeLighting(dims, float(k)));
+                use(k);
+                while (model.size() > 4) model.erase(model.begin());
+            } else {
+                const auto hit = cache.loadLighting(key);
+                QCOMPARE(bool(hit), present);
+                if (hit) {
+                    QCOMPARE(hit->rgb.front(), float(k));
+                    use(k);
+                }
+            }
+            const GridCache::Summary sum = cache.summary();
+            QVERIFY2(sum.bytes <= limit, qPrintable(QString::number(sum.bytes)));
+            std::vector<int> onDisk;
+            for (int j = 0; j < 8; ++j)
+                if (exists(cache.entryPath(keyFor("lru.obj", double(j)), 'l'))) onDisk.push_back(j);
+            std::vector<int> expected = model;
+            std::sort(expected.begin(), expected.end());
+            QVERIFY2(onDisk == expected, qPrintable(QStringLiteral("op %1").arg(op)));
+            // summary() lists them oldest use first, as the model does.
+            QCOMPARE(sum.entries.size(), model.size());
+            for (size_t i = 0; i < model.size(); ++i)
+                QCOMPARE(QString::fromStdString(sum.entries[i].path), QString::fromStdString(cache.entryPath(keyFor("lru.obj", double(model[i])), 'l')));
+        }
+        // An entry larger than the limit is refused and nothing is written.
+        const CacheKey big = keyFor("big.obj", 1.0);
+        QVERIFY_THROWS_EXCEPTION(Error, cache.storeLighting(big, makeLighting({20, 20, 20}, 1.0f)));
+        QVERIFY(!exists(cache.entryPath(big, 'l')));
+    }
+
+    // While one load holds the oldest entry (stopped inside the read), stores past the limit evict
+    // the others, never that one; the load then returns the whole grid and marks it used.
+    void evictionSparesEntryBeingRead()
+    {
+        const glm::ivec3 dims(6, 7, 8);
+        const uint64_t entryBytes = 128 + uint64_t(6 * 7 * 8) * 3 * 4;
+        const std::string dir = freshDir("busy");
+        GridCache writer(dir, 2 * entryBytes + entryBytes / 2);
+        GridCache reader(dir, 0);
+        const CacheKey a = keyFor("a.obj", 1.0), b = keyFor("b.obj", 1.0), c = keyFor("c.obj", 1.0), d = keyFor("d.obj", 1.0),
+                       e = keyFor("e.obj", 1.0);
+        writer.storeLighting(a, makeLighting(dims, 1.0f));
+        QTest::qWait(12);
+        writer.storeLighting(b, makeLighting(dims, 2.0f));
+        QTest::qWait(12);
+
+        std::mutex m;
+        std::condition_variable cv;
+        bool locked = false, release = false;
+        reader.setReadHookForTests([&](const std::string&) {
+            std::unique_lock lock(m);
+            locked = true;
+            cv.notify_all();
+            cv.wait(lock, [&] { return release; });
+        });
+        std::optional<LightingGrid> got;
+        std::thread thread([&] { got = reader.loadLighting(a); });
+        {
+            std::unique_lock lock(m);
+            QVERIFY(cv.wait_for(lock, std::chrono::seconds(10), [&] { return locked; }));
+        }
+        writer.storeLighting(c, makeLighting(dims, 3.0f));   // a (oldest) is busy: b goes
+        QTest::qWait(12);
+        writer.storeLighting(d, makeLighting(dims, 4.0f));   // a still busy: c goes
+        QVERIFY(exists(writer.entryPath(a, 'l')));
+        QVERIFY(!exists(writer.entryPath(b, 'l')));
+        QVERIFY(!exists(writer.entryPath(c, 'l')));
+        QVERIFY(exists(writer.entryPath(d, 'l')));
+        GridCache::CleanOptions all;
+        const GridCache::CleanResult r = GridCache(dir, 0).clean(all);   // clean skips it too
+        QCOMPARE(r.busy, size_t(1));
+        QVERIFY(exists(writer.entryPath(a, 'l')));
+        QVERIFY(!exists(writer.entryPath(d, 'l')));
+        {
+            std::lock_guard lock(m);
+            release = true;
+        }
+        cv.notify_all();
+        thread.join();
+        QVERIFY(got);
+        QCOMPARE(got->rgb, makeLighting(dims, 1.0f).rgb);
+        QVERIFY(exists(writer.entryPath(a, 'l')));
+    }
+
+    void folderTagAndClean()
+    {
+        const std::string dir = freshDir("clean");
+        GridCache cache(dir, 0);
+        const glm::ivec3 dims(4, 4, 4);
+        const CacheKey fresh = keyFor("fresh.obj", 1.0), old = keyFor("old.obj", 1.0), older = keyFor("older.obj", 1.0);
+        cache.storeLighting(fresh, makeLighting(dims, 1.0f));
+        cache.storeLighting(old, makeLighting(dims, 2.0f));
+        cache.storeDensity(older, makeDensity(dims, 3.0f));
+        // CACHEDIR.TAG: the signature line the specification fixes, first.
+        const QByteArray tag = readAll(dir + "/CACHEDIR.TAG");
+        QVERIFY(tag.startsWith("Signature: 8a477f597d28d172789f06886806bc55"));
+        // Last uses 3 and 10 days ago.
+        const auto age = [](const std::string& path, int days) {
+            const std::time_t t = std::time(nullptr) - std::time_t(days) * 86400;
+            struct timespec times[2] = {{t, 0}, {t, 0}};
+            return ::utimensat(AT_FDCWD, path.c_str(), times, 0) == 0;
+        };
+        QVERIFY(age(cache.entryPath(old, 'l'), 3));
+        QVERIFY(age(cache.entryPath(older, 'd'), 10));
+        // A version 1 entry (SHA-256 name), a sidecar, a dead writer's temporary file and a live one.
+        const std::string grids = dir + "/grids/";
+        QByteArray v1 = readAll(cache.entryPath(fresh, 'l'));
+        v1[8] = 1;
+        writeAll(grids + std::string(64, 'a') + ".l.sgrid", v1);
+        writeAll(cache.entryPath(older, 'd') + ".seconds", "12.5\n");
+        writeAll(grids + ".tmp.999999999.0.x.l.sgrid", QByteArray(100, 'x'));
+        const std::string live = grids + ".tmp." + std::to_string(::getpid()) + ".7.y.l.sgrid";
+        writeAll(live, QByteArray(50, 'y'));
+
+        GridCache::Summary sum = cache.summary();
+        QCOMPARE(sum.lighting, size_t(2));
+        QCOMPARE(sum.density, size_t(1));
+        QCOMPARE(sum.otherVersion, size_t(1));
+        QCOMPARE(sum.tempFiles, size_t(2));
+        uint64_t onDisk = 0;
+        for (const QFileInfo& f : QDir(QString::fromStdString(grids)).entryInfoList(QDir::Files | QDir::Hidden)) onDisk += uint64_t(f.size());
+        QCOMPARE(sum.bytes, onDisk);
+        QCOMPARE(QString::fromStdString(sum.entries.front().path), QString::fromStdString(cache.entryPath(older, 'd')));
+
+        // Older than 5 days: the 10-day entry with its sidecar, the old version, the dead writer's file.
+        GridCache::CleanOptions byAge;
+        byAge.olderThanSeconds = 5 * 86400;
+        GridCache::CleanResult r = cache.clean(byAge);
+        QCOMPARE(r.removed, size_t(3));
+        QVERIFY(!exists(cache.entryPath(older, 'd')) && !exists(cache.entryPath(older, 'd') + ".seconds"));
+        QVERIFY(!exists(grids + ".tmp.999999999.0.x.l.sgrid"));
+        QVERIFY(exists(live));
+        QVERIFY(exists(cache.entryPath(old, 'l')) && exists(cache.entryPath(fresh, 'l')));
+        QCOMPARE(r.kept, size_t(2));
+        // Down to one entry's size: the least recently used (3 days) goes.
+        GridCache::CleanOptions bySize;
+        bySize.maxBytes = uint64_t(QFileInfo(QString::fromStdString(cache.entryPath(fresh, 'l'))).size());
+        r = cache.clean(bySize);
+        QCOMPARE(r.removed, size_t(1));
+        QVERIFY(!exists(cache.entryPath(old, 'l')) && exists(cache.entryPath(fresh, 'l')));
+        // No option: every entry.
+        r = cache.clean({});
+        QCOMPARE(r.removed, size_t(1));
+        QCOMPARE(r.kept, size_t(0));
+        QVERIFY(!exists(cache.entryPath(fresh, 'l')));
+        QVERIFY(exists(live));   // a writer that still runs keeps its file
+    }
+
+    void sizesAndDurations()
+    {
+        QCOMPARE(parseByteSize("4096"), std::optional<uint64_t>(4096));
+        QCOMPARE(parseByteSize("20G"), std::optional<uint64_t>(uint64_t(20) << 30));
+        QCOMPARE(parseByteSize("512M"), std::optional<uint64_t>(uint64_t(512) << 20));
+        QCOMPARE(parseByteSize("1.5GiB"), std::optional<uint64_t>(uint64_t(3) << 29));
+        QCOMPARE(parseByteSize("2 kb"), std::optional<uint64_t>(2048));
+        QCOMPARE(parseByteSize("1T"), std::optional<uint64_t>(uint64_t(1) << 40));
+        for (const char* bad : {"", "G", "-1G", "12X", "1e30T", "nan"}) QVERIFY2(!parseByteSize(bad), bad);
+        QCOMPARE(parseDuration("30d"), std::optional<int64_t>(30 * 86400));
+        QCOMPARE(parseDuration("7"), std::optional<int64_t>(7 * 86400));
+        QCOMPARE(parseDuration("12h"), std::optional<int64_t>(12 * 3600));
+        QCOMPARE(parseDuration("90m"), std::optional<int64_t>(90 * 60));
+        QCOMPARE(parseDuration("45s"), std::optional<int64_t>(45));
+        QCOMPARE(parseDuration("2w"), std::optional<int64_t>(14 * 86400));
+        for (const char* bad : {"", "d", "-3d", "3y", "1e20"}) QVERIFY2(!parseDuration(bad), bad);
+        QCOMPARE(formatBytes(1000), std::string("1000 bytes"));
+        QCOMPARE(formatBytes(1536), std::string("1.50 KiB"));
+        QCOMPARE(formatBytes(uint64_t(20) << 30), std::string("20.00 GiB"));
+        // The setting: unset gives the default, a size or "none" as written.
+        QCOMPARE(cacheSizeLimitSetting(), kDefaultCacheLimit);
+        setCacheSizeLimitSetting(uint64_t(3) << 20);
+        QCOMPARE(cacheSizeLimitSetting(), uint64_t(3) << 20);
+        QCOMPARE(GridCache(freshDir("setting")).maxBytes(), uint64_t(3) << 20);
+        setCacheSizeLimitSetting(0);
+        QCOMPARE(cacheSizeLimitSetting(), uint64_t(0));
+        QVERIFY(QString::fromStdString(cacheSettingsPath()).startsWith(outDir() + QStringLiteral("/config/")));
+        QFile::remove(QString::fromStdString(cacheSettingsPath()));
     }
 
     // Child processes store the same key many times while this process keeps loading it: every
