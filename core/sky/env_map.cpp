@@ -14,6 +14,8 @@ namespace {
 float lum(glm::vec3 c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 double lumD(glm::dvec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
+constexpr float kChromaSpikeRatio = 32.0f, kChromaSpikeFloor = 1.0f;
+
 size_t pixelCount(const EnvMap& m) { return size_t(m.width) * size_t(m.height); }
 
 void checkStorage(const EnvMap& m)
@@ -86,6 +88,21 @@ EnvMapCleanReport cleanEnvMap(EnvMap& map, float spikeRatio)
                 if (spike[c]) d[c] = nmax[c];
             r.spikes += 1;
             r.spikeEnergy += double(lum(before) - lum(glm::vec3(d[0], d[1], d[2]))) * envMapPixelSolidAngle(w, h, y);
+        }
+    // Single-channel extremes (a block of lossy compression gone wrong, e.g. around a clipped sun: blue in
+    // the thousands, red and green 0): grey of the same luminance.
+    for (int y = 0; y < map.height; ++y)
+        for (int x = 0; x < map.width; ++x) {
+            float* d = map.ptr(x, y);
+            for (int c = 0; c < 3; ++c) {
+                const float o1 = d[(c + 1) % 3], o2 = d[(c + 2) % 3];
+                if (d[c] > kChromaSpikeFloor && d[c] > kChromaSpikeRatio * std::max(o1, o2)) {
+                    const float l = lum(glm::vec3(d[0], d[1], d[2]));
+                    d[0] = d[1] = d[2] = l;
+                    r.spikes += 1;
+                    break;
+                }
+            }
         }
     return r;
 }

@@ -32,15 +32,18 @@ void checkEnvMapShape(int width, int height, const std::string& what);
 struct EnvMapCleanReport {
     size_t negative = 0;     // some channel < 0: those channels set to 0
     size_t nonFinite = 0;    // some channel NaN or +-Inf: those channels set to 0
-    size_t spikes = 0;       // isolated extreme channels replaced by their neighbours' maximum
-    double spikeEnergy = 0;  // luminance x sr removed by the spike filter (compare with the map's integral)
+    size_t spikes = 0;       // single-channel extremes made grey + isolated extreme channels replaced
+    double spikeEnergy = 0;  // luminance x sr removed by the isolated-spike filter (compare with the integral)
 };
 
 // Cleans a map read from a file so no negative, NaN or infinite radiance reaches the renderer: negative
-// and non-finite channels -> 0; then a spike filter for lossy-compression outliers: a channel more than
-// spikeRatio x the largest of the same channel in its 8 neighbours (and above 1e-6) while the pixel's other
-// channels are not (below spikeRatio x their own neighbourhood maximum) is set to that maximum. A real sun
-// is bright in all three channels and is kept. spikeRatio <= 0: no spike filter.
+// and non-finite channels -> 0. Then, unless spikeRatio <= 0, two filters for lossy-compression outliers
+// (counted in `spikes`): first a channel more than spikeRatio x the largest of the same channel in its 8
+// neighbours (and above 1e-6) while the pixel's other channels are not is set to that maximum (a real sun
+// is bright in all three channels and is kept); then a pixel with one channel above 1 and above 32 x both
+// others (no sky or sun has such a colour; DWA-compressed suns do: park.exr's is blue 11800 with red and
+// green 0, in a 2 x 2 cluster the first filter cannot see) becomes grey of the same luminance, so its
+// luminance power is kept but not its false colour.
 EnvMapCleanReport cleanEnvMap(EnvMap& map, float spikeRatio = 16.0f);
 
 // Solid angle of a pixel of row y: (2 pi / width) (cos theta_top - cos theta_bottom), sr. The rows sum to 4 pi.
@@ -59,7 +62,7 @@ struct SunFindSettings {
     float regionFraction = 0.02f;   // the region: pixels 8-connected to the peak above this x peak luminance
                                     // (and above minContrast x median)
     double maxSolidAngle = 0.01;    // sr: a larger region is not a compact sun (0.01 sr: a 3.2 degree radius)
-    double minPowerFraction = 0.02; // the region's power (above the fill) over the map's: smaller is no sun
+    double minPowerFraction = 0.005; // the region's power (above the fill) over the map's: smaller is no sun
 };
 
 // The map's sun: the brightest compact region, as a directional sun. Its pixels are set to the mean of the

@@ -13,6 +13,7 @@ Command referenceCommand();   // cmd_reference.cpp
 Command renderCommand();      // cmd_render.cpp
 Command studyCommand();       // cmd_study.cpp
 Command infoCommand();        // cmd_info.cpp
+Command skyCommand();         // cmd_sky.cpp
 Command cacheCommand();       // cmd_cache.cpp
 
 } // namespace sylva::cli

@@ -347,11 +347,25 @@ private Q_SLOTS:
         const EnvMapCleanReport r = cleanEnvMap(m);
         QCOMPARE(r.negative, size_t(2));
         QCOMPARE(r.nonFinite, size_t(3));
-        QCOMPARE(r.spikes, size_t(1));
+        // Two extremes: the blue spike, and (4, 3), red only once its negative green and blue are cleared
+        // (made grey at its luminance).
+        QCOMPARE(r.spikes, size_t(2));
+        QCOMPARE(m.at(4, 3).x, m.at(4, 3).z);
         for (float v : m.rgb) QVERIFY(std::isfinite(v) && v >= 0.0f);
         QVERIFY(m.ptr(20, 8)[2] < 10.0f);
         QCOMPARE(m.ptr(40, 10)[0], 3000.0f);
         QVERIFY(r.spikeEnergy > 0.0);
+        // A 2 x 2 block of blue-only extremes (what DWA compression made of park.exr's sun) turns grey at
+        // the same luminance; an ordinary saturated sky pixel is kept.
+        EnvMap block = testMap(64);
+        for (int y = 10; y < 12; ++y)
+            for (int x = 30; x < 32; ++x) block.ptr(x, y)[0] = block.ptr(x, y)[1] = 0.0f, block.ptr(x, y)[2] = 8000.0f;
+        block.ptr(5, 5)[0] = 0.1f, block.ptr(5, 5)[1] = 0.3f, block.ptr(5, 5)[2] = 2.5f;
+        const glm::vec3 keep = block.at(5, 5);
+        const EnvMapCleanReport rb = cleanEnvMap(block);
+        QCOMPARE(rb.spikes, size_t(4));
+        QVERIFY(glm::length(block.at(30, 10) - glm::vec3(0.0722f * 8000.0f)) < 1e-2f);
+        QCOMPARE(block.at(5, 5), keep);
     }
 
     void sunExtraction()

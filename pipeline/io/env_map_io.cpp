@@ -1,0 +1,53 @@
+// Environment maps through OpenImageIO.
+#include "pipeline/io/env_map_io.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+
+#include "core/base/error.h"
+
+namespace sylva {
+
+namespace fs = std::filesystem;
+
+EnvMapFile readEnvMap(const std::string& path, float spikeRatio)
+{
+    if (!fs::exists(path)) throw Error(path + ": no such environment map");
+    if (fs::is_directory(path)) throw Error(path + ": is a folder, not an environment map");
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) throw Error(path + ": not an image OpenImageIO can read (" + OIIO::geterror() + ")");
+    const OIIO::ImageSpec& spec = in->spec();
+    const int w = spec.width, h = spec.height, nc = spec.nchannels;
+    sky::checkEnvMapShape(w, h, path);
+    if (nc <= 0) throw Error(path + ": the image has no channels");
+    std::vector<float> data(size_t(w) * size_t(h) * size_t(nc));
+    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data()))
+        throw Error(path + ": cannot decode the image (" + in->geterror() + ")");
+    in->close();
+    EnvMapFile f;
+    f.map.width = w;
+    f.map.height = h;
+    f.map.rgb.resize(size_t(w) * size_t(h) * 3);
+    for (size_t p = 0; p < size_t(w) * size_t(h); ++p)
+        for (int c = 0; c < 3; ++c) f.map.rgb[p * 3 + size_t(c)] = data[p * size_t(nc) + size_t(nc >= 3 ? c : 0)];
+    f.cleaned = sky::cleanEnvMap(f.map, spikeRatio);
+    return f;
+}
+
+std::string envMapCleanSummary(const std::string& path, const EnvMapFile& file)
+{
+    const sky::EnvMapCleanReport& r = file.cleaned;
+    char buf[512];
+    std::snprintf(buf, sizeof buf, "%s: %d x %d", path.c_str(), file.map.width, file.map.height);
+    std::string s = buf;
+    if (r.negative == 0 && r.nonFinite == 0 && r.spikes == 0) return s + ", no negative, non-finite or isolated extreme pixels";
+    std::snprintf(buf, sizeof buf, ", cleaned: %zu pixels with negative values -> 0, %zu with NaN/Inf -> 0, %zu extreme values from lossy "
+                  "compression (isolated: -> the neighbours' maximum, %.4g luminance x sr removed; single-channel: -> grey)",
+                  r.negative, r.nonFinite, r.spikes, r.spikeEnergy);
+    return s + buf;
+}
+
+} // namespace sylva

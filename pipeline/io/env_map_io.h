@@ -1,0 +1,24 @@
+// Equirectangular environment maps (.exr, .hdr, anything OpenImageIO reads as float) into sky::EnvMap,
+// checked and cleaned (core/sky/env_map.h).
+#pragma once
+
+#include <string>
+
+#include "core/sky/env_map.h"
+
+namespace sylva {
+
+struct EnvMapFile {
+    sky::EnvMap map;                  // cleaned: no negative, NaN or infinite values
+    sky::EnvMapCleanReport cleaned;   // what the cleaning changed
+};
+
+// Reads the first subimage's first three channels (a grey map: its one channel in all three) as linear
+// radiance and cleans it (cleanEnvMap with spikeRatio). Throws sylva::Error naming the file when it is
+// missing, not an image, empty, 1 x N or not 2:1, or cannot be decoded.
+EnvMapFile readEnvMap(const std::string& path, float spikeRatio = 16.0f);
+
+// One line for the log: "PATH: 512 x 256, cleaned: 1234 negative pixels -> 0, ..." (or "clean").
+std::string envMapCleanSummary(const std::string& path, const EnvMapFile& file);
+
+} // namespace sylva
