@@ -63,7 +63,7 @@ struct RenderOutput {
 };
 // backend: where the LB solves and the frame run (null = the CPU). The film holds every pixel until the
 // picture is composed, so a frame needs about kFrameBytesPerPixel bytes per pixel (film + composed
-// picture; 16384 x 8192 about 7 GB): one that does not fit in 80% of the available memory is refused
+// picture; 16384 x 8192 about 9 GB): one that does not fit in 80% of the available memory is refused
 // up front (Error naming the size and the memory), before any asset is loaded.
 inline constexpr size_t kFrameBytesPerPixel = sizeof(SampleParts) + sizeof(glm::vec3);
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr,
