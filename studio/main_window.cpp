@@ -19,6 +19,7 @@
 #include <QMenuBar>
 #include <QMimeData>
 #include <QPlainTextEdit>
+#include <QSettings>
 #include <QStatusBar>
 #include <QToolBar>
 #include <QTreeView>
@@ -238,6 +239,30 @@ void MainWindow::showEvent(QShowEvent* event)
     resizeDocks({dock("outlinerDock"), dock("propertiesDock")}, {2, 3}, Qt::Vertical);
     resizeDocks({dock("jobsDock"), dock("logDock")}, {1, 2}, Qt::Horizontal);
     resizeDocks({dock("jobsDock")}, {130}, Qt::Vertical);
+    restoreLayout();   // the last session's window and docks, over these defaults
+}
+
+// ---- window layout (QSettings window/geometry, window/state) ----
+
+namespace {
+constexpr int kLayoutVersion = 1;   // bump when the docks change, so an old layout is ignored
+}
+
+void MainWindow::saveLayout() const
+{
+    QSettings settings;
+    settings.setValue("window/geometry", saveGeometry());
+    settings.setValue("window/state", saveState(kLayoutVersion));
+}
+
+bool MainWindow::restoreLayout()
+{
+    const QSettings settings;
+    const QByteArray geometry = settings.value("window/geometry").toByteArray();
+    const QByteArray state = settings.value("window/state").toByteArray();
+    const bool placed = !geometry.isEmpty() && restoreGeometry(geometry);
+    const bool docked = !state.isEmpty() && restoreState(state, kLayoutVersion);
+    return placed && docked;
 }
 
 void MainWindow::buildActions()
@@ -495,6 +520,7 @@ void MainWindow::closeEvent(QCloseEvent* event)
     m_jobs->cancelAll();
     m_jobs->waitForAll();
     m_autosave->removeRecoveryFile();   // a clean close: nothing to recover
+    saveLayout();
     event->accept();
 }
 

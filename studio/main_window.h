@@ -101,6 +101,10 @@ public:
     void deleteSelection();
     // The species the outliner selection points at (a species row, or an instance's species); -1 if none.
     int selectedSpecies() const;
+    // The window's size, place and dock layout in QSettings (window/geometry, window/state): saved
+    // on close, restored when the window first shows. restoreLayout: false when nothing (valid) was saved.
+    void saveLayout() const;
+    bool restoreLayout();
 
 Q_SIGNALS:
     void errorReported(const QString& title, const QString& message);
