@@ -29,7 +29,7 @@ int runGrow(const Args& args)
         opt.height = float(parseNumber("--height", args.get("--height")));
         if (!(opt.height > 0.0f)) throw UsageError("option --height: must be > 0 metres");
     }
-    const std::string out = args.get("--output", speciesName(opt.species) + ".obj");
+    const std::string out = outputFile(args, {".obj"}, speciesName(opt.species) + ".obj");
     requireReplaceableFile(out);
     ProgressPrinter bar("grow", args.has("--quiet"));
     GrownTree tree = growTree(opt, &bar.progress());

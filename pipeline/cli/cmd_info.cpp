@@ -18,7 +18,7 @@ int runInfo(const Args& args)
 
 Command infoCommand()
 {
-    return {"info", "FILE", "print what a scene (.json), mesh, grid (.npy) or cache file holds", {}, 1, 1, &runInfo};
+    return {"info", "FILE", "print what a scene (.json), mesh, grid (.npy, .vdb) or cache file holds", {}, 1, 1, &runInfo};
 }
 
 } // namespace sylva::cli

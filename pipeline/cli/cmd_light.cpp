@@ -5,7 +5,7 @@
 #include "pipeline/cli/commands.h"
 #include "pipeline/cli/common_options.h"
 #include "pipeline/cli/grid_options.h"
-#include "pipeline/io/npy.h"
+#include "pipeline/io/grid_file.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/lighting_job.h"
 #include "pipeline/services/grid_stats.h"
@@ -17,7 +17,6 @@ int runLight(const Args& args)
 {
     auto threads = threadLimit(args);
     if (args.has("--density") == args.has("--mesh")) throw UsageError("'sylva light' needs exactly one of --density FILE or --mesh FILE");
-    const std::string out = args.require("--output");
     auto compute = openBackend(backendName(args));
     const lb::LbParams params = lightParams(args);
     auto cache = openCache(args);
@@ -25,6 +24,7 @@ int runLight(const Args& args)
     const VoxelizeSettings voxel = voxelSettings(args);
     rejectMeshOptionsWithDensity(args);
     const PictureOptions picture = pictureOptions(args);
+    const std::string out = outputFile(args, gridFileExtensions());
     requireReplaceableFile(out);
     const DensityGrid density = loadDensityInput(args, voxel, cache.get(), log);
     printDensitySummary(density);
@@ -33,7 +33,8 @@ int runLight(const Args& args)
     bar.finish(log.stages.back());
     for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     // The sidecar records what produced the grid: the optics actually used (after any overrides).
-    writeLightingGrid(out, light, lightingParamsJson(params, args.get("--preset", "leaf"), density.geometry.dims));
+    // A .vdb holds the density beside the lighting (one file for a renderer); .npy the lighting alone.
+    writeLightingFile(out, light, lightingParamsJson(params, args.get("--preset", "leaf"), density.geometry.dims), &density);
     const ChannelStats s = channelStats(light);
     std::printf("lighting grid %s: mean RGB (%.4f, %.4f, %.4f), max RGB (%.4f, %.4f, %.4f)\nwrote %s\n",
                 gridDimsText(light.geometry).c_str(), s.mean.x, s.mean.y, s.mean.z, s.max.x, s.max.y, s.max.z, out.c_str());
@@ -45,9 +46,9 @@ int runLight(const Args& args)
 
 Command lightCommand()
 {
-    return {"light", "(--density DENSITY.npy | --mesh MESH) --sun X,Y,Z -o LIGHT.npy",
+    return {"light", "(--density DENSITY.npy|.vdb | --mesh MESH) --sun X,Y,Z -o LIGHT.npy|.vdb",
             "solve the lattice-Boltzmann lighting of a density grid",
-            {{"--density", "FILE", "density grid (.npy from sylva voxelize)"},
+            {{"--density", "FILE", "density grid: .npy from sylva voxelize, or .vdb (the float grid 'density', else the first float grid)"},
              {"--mesh", "FILE", "mesh to voxelize first (with --grid)"},
              kGrid, kSubcells, kLeafMaterials,
              {"--preset", "NAME", "leaf (default), dogrose, cloud or pmma"},
@@ -64,7 +65,8 @@ Command lightCommand()
              {"--warm-start", "", "start from the unobstructed light field: same steady state, fewer steps"},
              {"--coarse-start", "", "with --tol: solve on half-resolution grids first and start from that (fastest to a given error)"},
              kBackend,
-             kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
+             {"--output", "FILE", "output file (also -o): .npy (+ sidecar), or .vdb (lighting, its channels, density and wood fraction)"},
+             kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
             0, 0, &runLight};
 }
 

@@ -9,6 +9,7 @@
 #include "pipeline/cli/commands.h"
 #include "pipeline/cli/common_options.h"
 #include "pipeline/cli/grid_options.h"
+#include "pipeline/io/grid_file.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/services/grid_stats.h"
@@ -23,7 +24,6 @@ int runReference(const Args& args)
     auto threads = threadLimit(args);
     if (args.has("--density") == args.has("--mesh"))
         throw UsageError("'sylva reference' needs exactly one of --density FILE or --mesh FILE");
-    const std::string out = args.require("--output");
     const lb::LbParams params = lightParams(args);
     ReferenceSettings settings;
     if (args.has("--paths"))
@@ -33,12 +33,13 @@ int runReference(const Args& args)
     if (args.has("--collimated")) settings.incidence = Incidence::Collimated;
     const VoxelizeSettings voxel = voxelSettings(args);
     rejectMeshOptionsWithDensity(args);
+    const std::string out = outputFile(args, {".npy"});   // with its standard error file: .npy only
     const std::string errPath = standardErrorPath(out);
     for (const std::string& target : {out, gridSidecarPath(out), errPath, gridSidecarPath(errPath)}) requireReplaceableFile(target);
     std::optional<LightingGrid> compare;
     if (args.has("--compare")) {
         requireReadable(args.get("--compare"), "lighting grid");
-        compare = readLightingGrid(args.get("--compare"));
+        compare = readLightingFile(args.get("--compare"));
     }
     auto cache = openCache(args);
     JobLog log;
@@ -79,7 +80,7 @@ Command referenceCommand()
 {
     return {"reference", "(--density DENSITY.npy | --mesh MESH) --sun X,Y,Z -o REF.npy",
             "Monte Carlo reference lighting (slow; measures the LB model): mean and standard error",
-            {{"--density", "FILE", "density grid (.npy from sylva voxelize)"},
+            {{"--density", "FILE", "density grid: .npy from sylva voxelize, or .vdb (the float grid 'density', else the first float grid)"},
              {"--mesh", "FILE", "mesh to voxelize first (with --grid)"},
              kGrid, kSubcells, kLeafMaterials,
              {"--preset", "NAME", "leaf (default), dogrose, cloud or pmma (the optics of sylva light)"},
@@ -94,7 +95,7 @@ Command referenceCommand()
              {"--seed", "S", "random seed (default 1); the same seed gives the same bits"},
              {"--max-bounces", "K", "scattering events per path (default unlimited; 0: direct light only)"},
              {"--collimated", "", "one beam along the sun instead of the LB's 18 lattice beams"},
-             {"--compare", "LIGHT.npy", "print the normalized error of this LB grid against the reference"},
+             {"--compare", "LIGHT.npy|.vdb", "print the normalized error of this LB grid against the reference"},
              kOutput, kCache, kNoCache, kThreads, kQuiet},
             0, 0, &runReference};
 }

@@ -5,7 +5,7 @@
 #include "pipeline/cli/commands.h"
 #include "pipeline/cli/common_options.h"
 #include "pipeline/cli/grid_options.h"
-#include "pipeline/io/npy.h"
+#include "pipeline/io/grid_file.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/lighting_job.h"
 
@@ -16,20 +16,27 @@ int runVoxelize(const Args& args)
 {
     auto threads = threadLimit(args);
     const std::string mesh = args.positional()[0];
-    const std::string out = args.require("--output");
     DensityJob job{mesh, importOptions(args), voxelSettings(args)};   // usage errors before file errors
     const PictureOptions picture = pictureOptions(args);
+    const std::string out = outputFile(args, gridFileExtensions());
     requireReadable(mesh, "mesh file");
     requireReplaceableFile(out);
     auto cache = openCache(args);
     ProgressPrinter bar("voxelize", args.has("--quiet"));
     JobLog log;
     const DensityGrid grid = densityForMesh(job, cache.get(), &bar.progress(), &log);
-    writeDensityGrid(out, grid);
+    writeDensityFile(out, grid);
     bar.finish(log.stages.empty() ? "" : log.stages.back());
     for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     printDensitySummary(grid);
-    std::printf("wrote %s (+ %s, %s)\n", out.c_str(), woodFractionPath(out).c_str(), gridSidecarPath(out).c_str());
+    const std::vector<std::string> files = densityFilesFor(out);
+    std::string also;   // "wrote d.npy (+ d.wood.npy, d.npy.json)", "wrote d.vdb"
+    for (size_t f = 1; f < files.size(); ++f) {
+        also += f == 1 ? " (+ " : ", ";
+        also += files[f];
+    }
+    if (files.size() > 1) also += ")";
+    std::printf("wrote %s%s\n", out.c_str(), also.c_str());
     writePicture(picture, &grid, nullptr);
     return kOk;
 }
@@ -38,7 +45,7 @@ int runVoxelize(const Args& args)
 
 Command voxelizeCommand()
 {
-    return {"voxelize", "MESH -o DENSITY.npy", "voxelize a mesh into a density grid (+ wood fraction)",
+    return {"voxelize", "MESH -o DENSITY.npy|.vdb", "voxelize a mesh into a density grid (+ wood fraction)",
             {kGrid, kSubcells, kLeafMaterials, kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
             1, 1, &runVoxelize};
 }

@@ -45,4 +45,12 @@ std::unique_ptr<Backend> openBackend(const std::string& name)
     return selectBackend(name, [](const std::string& note) { std::fprintf(stderr, "note: %s\n", note.c_str()); });
 }
 
+std::string outputFile(const Args& args, const std::vector<std::string>& extensions, const std::string& fallback)
+{
+    const std::string path = fallback.empty() ? args.require("--output") : args.get("--output", fallback);
+    const std::string problem = unwritableExtension(path, extensions);
+    if (!problem.empty()) throw UsageError("output " + path + ": " + problem);
+    return path;
+}
+
 } // namespace sylva::cli

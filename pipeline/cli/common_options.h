@@ -3,6 +3,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <tbb/global_control.h>
 
@@ -32,5 +33,11 @@ std::string backendName(const Args& args);
 std::unique_ptr<Backend> openBackend(const std::string& name);
 // lowerExtension(path): ".PNG" -> ".png" (the pipeline's one, here for the commands).
 using sylva::lowerExtension;
+// The file of --output (-o) of a command that writes the formats `extensions` (".npy", ...), checked
+// before any work: `fallback` without the option (an empty fallback: the option is required,
+// UsageError), UsageError "output PATH: cannot write .x files (use ...)" for another extension (today
+// `-o x.vdb` would otherwise get NumPy bytes). Every command with -o takes its output through this; the
+// command then checks the file itself (requireReplaceableFile) after its other usage checks.
+std::string outputFile(const Args& args, const std::vector<std::string>& extensions, const std::string& fallback = {});
 
 } // namespace sylva::cli

@@ -8,6 +8,7 @@
 #include "core/lb/lb_solver.h"
 #include "pipeline/cli/cli_util.h"
 #include "pipeline/cli/common_options.h"
+#include "pipeline/io/grid_file.h"
 #include "pipeline/io/grid_picture.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/io/output_path.h"
@@ -130,7 +131,7 @@ DensityGrid loadDensityInput(const Args& args, const VoxelizeSettings& voxel, Gr
     if (args.has("--density")) {
         const std::string path = args.get("--density");
         requireReadable(path, "density grid");
-        DensityGrid density = readDensityGrid(path);
+        DensityGrid density = readDensityFile(path);
         try {
             lb::validateDensity(density);
         } catch (const Error& e) {

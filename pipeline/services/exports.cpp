@@ -7,7 +7,7 @@
 #include "core/base/error.h"
 #include "core/render/render_cpu.h"
 #include "pipeline/io/file_extension.h"
-#include "pipeline/io/npy.h"
+#include "pipeline/io/grid_file.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/render_passes.h"
 
@@ -57,27 +57,34 @@ std::string gridFileBase(const std::string& speciesName)
     return out.empty() ? std::string("species") : out;
 }
 
-GridExportFiles gridExportFiles(const std::string& folder, const std::string& speciesName)
+GridExportFiles gridExportFiles(const std::string& folder, const std::string& speciesName, GridFileFormat format)
 {
     const std::filesystem::path base = std::filesystem::path(folder) / gridFileBase(speciesName);
+    if (format == GridFileFormat::Vdb) return {base.string() + ".vdb", base.string() + ".vdb"};
     return {base.string() + ".density.npy", base.string() + ".lighting.npy"};
 }
 
 GridExportFiles exportSpeciesGrids(const Scene& scene, size_t species, const std::string& folder, GridCache* cache,
-                                   Backend* backend, Progress* progress, JobLog* log, const TriangleMesh* mesh)
+                                   Backend* backend, Progress* progress, JobLog* log, const TriangleMesh* mesh,
+                                   GridFileFormat format)
 {
     if (species >= scene.species.size())
         throw Error("grid export: no species " + std::to_string(species) + " in a scene of " +
                     std::to_string(scene.species.size()));
     const SpeciesDesc& sp = scene.species[species];
-    const GridExportFiles files = gridExportFiles(folder, sp.name);
+    const GridExportFiles files = gridExportFiles(folder, sp.name, format);
     SubProgress loadPart(progress, 0.0, 0.9);
     Progress loadProgress([&](double f, const std::string& m) { loadPart.report(f, m); });
     if (progress && progress->isCancelled()) loadProgress.cancel();
     const SpeciesGrids g = loadSpeciesGrids(scene, species, cache, &loadProgress, log, mesh, backend);
     if (progress) progress->report(0.9, "writing");
-    writeDensityGrid(files.density, g.density);
-    writeLightingGrid(files.lighting, g.lighting, lightingParamsJson(g.params, sp.preset, g.lighting.geometry.dims));
+    const std::string params = lightingParamsJson(g.params, sp.preset, g.lighting.geometry.dims);
+    if (format == GridFileFormat::Vdb) {
+        writeLightingFile(files.lighting, g.lighting, params, &g.density);   // one file, every grid
+    } else {
+        writeDensityFile(files.density, g.density);
+        writeLightingFile(files.lighting, g.lighting, params);
+    }
     if (progress) progress->report(1.0, "written");
     return files;
 }

@@ -9,6 +9,7 @@
 #include "core/base/progress.h"
 #include "core/render/render_scene.h"
 #include "core/scene/scene.h"
+#include "pipeline/io/grid_file.h"
 #include "pipeline/lighting_job.h"
 
 namespace sylva {
@@ -31,19 +32,22 @@ void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, 
 // character '_' ("Tree 1 (2)/x" -> "Tree_1__2__x"); "species" for an empty name.
 std::string gridFileBase(const std::string& speciesName);
 
-// The two files a grid export writes into `folder` for a species: FOLDER/BASE.density.npy (with
-// BASE.density.wood.npy) and FOLDER/BASE.lighting.npy, each with its .json sidecar.
+// The files a grid export writes into `folder` for a species. Npy: FOLDER/BASE.density.npy (with
+// BASE.density.wood.npy) and FOLDER/BASE.lighting.npy, each with its .json sidecar. Vdb: one file
+// FOLDER/BASE.vdb with the density, wood fraction and lighting grids (density == lighting).
 struct GridExportFiles {
     std::string density, lighting;
 };
-GridExportFiles gridExportFiles(const std::string& folder, const std::string& speciesName);
+GridExportFiles gridExportFiles(const std::string& folder, const std::string& speciesName,
+                                GridFileFormat format = GridFileFormat::Npy);
 
 // Species `species` of `scene` through loadSpeciesGrids (the grid cache: a lit species is a cache
-// hit; mesh: the species' mesh when it is in memory) into gridExportFiles(folder, its name); the
-// lighting sidecar's parameters are lightingParamsJson's (as `sylva light` writes them). Stages go to
-// log. Returns the files written. Throws Error or Cancelled.
+// hit; mesh: the species' mesh when it is in memory) into gridExportFiles(folder, its name, format)
+// (pipeline/io/grid_file); the lighting's parameters (sidecar or .vdb metadata) are
+// lightingParamsJson's (as `sylva light` writes them). Stages go to log. Returns the files written.
+// Throws Error or Cancelled.
 GridExportFiles exportSpeciesGrids(const Scene& scene, size_t species, const std::string& folder, GridCache* cache,
                                    Backend* backend = nullptr, Progress* progress = nullptr, JobLog* log = nullptr,
-                                   const TriangleMesh* mesh = nullptr);
+                                   const TriangleMesh* mesh = nullptr, GridFileFormat format = GridFileFormat::Npy);
 
 } // namespace sylva

@@ -9,6 +9,7 @@
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/file_extension.h"
 #include "pipeline/io/npy.h"
+#include "pipeline/io/vdb_io.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/grid_stats.h"
 
@@ -48,7 +49,7 @@ std::string describeMeshFile(const std::string& path)
     try {
         mesh = importMesh(path, {}, &report);
     } catch (const Error& e) {
-        throw Error(std::string(e.what()) + " (sylva info reads meshes, .npy grids and cache entries)");
+        throw Error(std::string(e.what()) + " (sylva info reads meshes, .npy and .vdb grids and cache entries)");
     }
     std::string text = path + ": mesh\n" + describeMesh(mesh);
     for (const auto& w : report.warnings) text += "warning: " + w + "\n";
@@ -60,12 +61,13 @@ std::string describeKnownFile(const std::string& path)
     if (isCacheFile(path)) return describeCacheFile(path);
     const std::string ext = lowerExtension(path);
     if (ext == ".npy") return describeNpy(path);
+    if (ext == ".vdb") return describeVdbFile(path);
     if (ext == ".json" && path.size() > 11 && path.substr(path.size() - 11) != ".npy.json")
         return path + ": scene\n" + describeScene(readSceneFile(path));
     for (const char* notMesh : {".json", ".png", ".jpg", ".jpeg", ".tif", ".tiff", ".exr", ".txt", ".mtl"})
         if (ext == notMesh)
-            throw Error(path + ": not a scene, mesh, .npy grid or cache entry (sylva info reads those; a .npy.json sidecar is "
-                               "shown with its .npy)");
+            throw Error(path + ": not a scene, mesh, .npy or .vdb grid or cache entry (sylva info reads those; a .npy.json "
+                               "sidecar is shown with its .npy)");
     return describeMeshFile(path);
 }
 

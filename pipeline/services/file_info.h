@@ -1,5 +1,5 @@
 // The description of a file that `sylva info` prints: a scene (.json), a mesh, a grid (.npy, with its
-// sidecar) or a grid cache entry.
+// sidecar, or .vdb: describeVdbFile) or a grid cache entry.
 #pragma once
 
 #include <string>

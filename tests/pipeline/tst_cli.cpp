@@ -135,9 +135,12 @@ private Q_SLOTS:
         QCOMPARE(r.code, 1);
         QVERIFY2(r.err.contains(fifo) && r.err.contains("not a regular file"), qPrintable(r.err));
         QVERIFY(QFileInfo(fifo).exists() && !QFileInfo(fifo).isFile());
-        r = runSylva({"light", "--density", garbage, "--sun", "0,1,0", "-o", fifo});
+        const QString gridFifo = dir + "/fifo.npy";   // light writes .npy or .vdb (another extension is a usage error)
+        QFile::remove(gridFifo);
+        QCOMPARE(::mkfifo(gridFifo.toLocal8Bit().constData(), 0600), 0);
+        r = runSylva({"light", "--density", garbage, "--sun", "0,1,0", "-o", gridFifo});
         QCOMPARE(r.code, 1);
-        QVERIFY(!QFileInfo(fifo).isFile());
+        QVERIFY(!QFileInfo(gridFifo).isFile());
         // Out-of-range density values are reported with the file's name.
         NpyArray bad;
         bad.shape = {4, 4, 4};

@@ -303,7 +303,7 @@ private Q_SLOTS:
         QVERIFY(pf.open(QIODevice::WriteOnly));
         pf.close();
         const std::string m = messageOf(png);
-        QVERIFY2(m.rfind(png + ": not a scene, mesh, .npy grid or cache entry", 0) == 0, m.c_str());
+        QVERIFY2(m.rfind(png + ": not a scene, mesh, .npy or .vdb grid or cache entry", 0) == 0, m.c_str());
     }
 
     // One lowerExtension for the commands and the services.
