@@ -12,6 +12,7 @@
 #include "core/base/version.h"
 #include "pipeline/backend_info.h"
 #include "pipeline/cli/args.h"
+#include "pipeline/cli/cli_docs.h"
 #include "pipeline/cli/cli_util.h"
 #include "pipeline/cli/commands.h"
 
@@ -46,6 +47,11 @@ int main(int argc, char** argv)
     }
     if (argsv[0] == "--version") {
         std::printf("sylva %s\nbackends: %s\n", versionString(), backendSummary().c_str());
+        return kOk;
+    }
+    // Hidden: the man page and the bash completion from this table (the build installs their output).
+    if (argsv[0] == "--man" || argsv[0] == "--completion") {
+        std::fputs((argsv[0] == "--man" ? manPage(cmds) : bashCompletion(cmds)).c_str(), stdout);
         return kOk;
     }
     const Command* cmd = nullptr;

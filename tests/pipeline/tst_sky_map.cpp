@@ -7,6 +7,7 @@
 #include <QTest>
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <string>
 #include <vector>
@@ -217,6 +218,18 @@ private Q_SLOTS:
         const Run below = runSylva({"sky", "--sun", "1,-0.5,0", "-o", QString::fromStdString(out)});
         QCOMPARE(below.code, 1);
         QVERIFY(below.err.contains("below the horizon"));
+        // The sun by date and place: NREL SPA's example (Reda & Andreas 2004: elevation 90 - 50.11162,
+        // bearing 194.34024), parsed from the command line.
+        const Run at = runSylva({"sky", "--sun-at", "2003-10-17,12:30:30,-7,39.742476,-105.1786", "--width", "16", "-o", QString::fromStdString(out)});
+        QVERIFY2(at.code == 0, qPrintable(at.err));
+        double el = 0.0, az = 0.0, bearing = 0.0;
+        const int idx = at.out.indexOf("elevation ");
+        QVERIFY(idx >= 0);
+        QCOMPARE(std::sscanf(at.out.mid(idx).toUtf8().constData(), "elevation %lf deg, azimuth %lf deg (compass bearing %lf", &el, &az, &bearing), 3);
+        QVERIFY(std::abs(el - (90.0 - 50.11162)) < 0.02 && std::abs(bearing - 194.34024) < 0.02 && std::abs(az - (180.0 - 194.34024 + 360.0)) < 0.02);
+        for (const char* bad : {"2003-10-17,12:30,-7,39.7", "2003-13-17,12:30,-7,39.7,-105", "2003-10-17,12h30,-7,39.7,-105", "2003-10-17,12:30,-7,95,-105"})
+            QCOMPARE(runSylva({"sky", "--sun-at", bad, "-o", QString::fromStdString(out)}).code, 2);
+        QCOMPARE(runSylva({"sky", "--sun", "0,1,0", "--sun-at", "2003-10-17,12:30,-7,39.7,-105", "-o", QString::fromStdString(out)}).code, 2);
         // The sun from a scene file.
         const std::string scene = outPath("sun.sylva.json");
         {
