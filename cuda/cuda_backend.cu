@@ -1,8 +1,11 @@
 // The CUDA backend: device selection, the LB solve and the frame behind the Backend interface.
 #include "cuda/cuda_backend.h"
 
+#include <utility>
+
 #include "cuda/cuda_check.h"
 #include "cuda/device_query.h"
+#include "cuda/gl_interop.h"
 #include "cuda/lb_cuda.h"
 #include "cuda/render_cuda.h"
 
@@ -33,6 +36,37 @@ private:
     std::string m_name;
 };
 
+class CudaFrame final : public DeviceFrame {
+public:
+    explicit CudaFrame(const RenderScene& scene) : m_scene(scene) {}
+    void place(const RenderScene& scene) override { m_scene.place(scene); }
+    size_t deviceBytes() const override { return m_scene.deviceBytes(); }
+    const DeviceScene& scene() const { return m_scene; }
+
+private:
+    DeviceScene m_scene;
+};
+
+class CudaDisplay final : public DeviceDisplay {
+public:
+    explicit CudaDisplay(std::string name) : m_name(std::move(name)) {}
+    std::string deviceName() const override { return m_name; }
+    void setPixelBuffer(unsigned glBuffer, int width, int height) override { m_interop.setPixelBuffer(glBuffer, width, height); }
+    void releasePixelBuffer() override { m_interop.releasePixelBuffer(); }
+    void render(const DeviceFrame& frame, RenderMode mode, float key, std::optional<RenderMode> right, uint32_t* hostCopy) override
+    {
+        const auto* f = dynamic_cast<const CudaFrame*>(&frame);
+        if (!f) throw BackendError("CUDA display: the frame was not uploaded by the CUDA backend");
+        m_interop.render(f->scene(), mode, key, right, hostCopy);
+    }
+    bool available() const { return m_interop.available(); }
+    const std::string& whyUnavailable() const { return m_interop.whyUnavailable(); }
+
+private:
+    GlInterop m_interop;
+    std::string m_name;
+};
+
 } // namespace
 
 std::unique_ptr<Backend> makeCudaBackend(std::string* why)
@@ -43,6 +77,29 @@ std::unique_ptr<Backend> makeCudaBackend(std::string* why)
         return nullptr;
     }
     return std::make_unique<CudaBackend>(q.devices.front());
+}
+
+std::unique_ptr<DeviceDisplay> makeCudaDisplay(std::string* why)
+{
+    const DeviceQuery q = queryDevices();
+    if (q.devices.empty()) {
+        if (why) *why = q.message.empty() ? "no CUDA device" : q.message;
+        return nullptr;
+    }
+    auto display = std::make_unique<CudaDisplay>(q.devices.front().name);
+    if (!display->available()) {
+        if (why) *why = display->whyUnavailable();
+        return nullptr;
+    }
+    return display;
+}
+
+std::unique_ptr<DeviceFrame> uploadCudaFrame(const RenderScene& scene)
+{
+    const DeviceQuery q = queryDevices();
+    if (q.devices.empty()) throw BackendError(q.message.empty() ? "no CUDA device" : q.message);
+    check(cudaSetDevice(q.devices.front().index), "select device");
+    return std::make_unique<CudaFrame>(scene);
 }
 
 } // namespace sylva::cuda

@@ -3,10 +3,22 @@
 
 namespace sylva::cuda {
 
+namespace {
+const char* const kNoCuda = "this build has no CUDA backend (nvcc was not found at configure time)";
+}
+
 std::unique_ptr<Backend> makeCudaBackend(std::string* why)
 {
-    if (why) *why = "this build has no CUDA backend (nvcc was not found at configure time)";
+    if (why) *why = kNoCuda;
     return nullptr;
 }
+
+std::unique_ptr<DeviceDisplay> makeCudaDisplay(std::string* why)
+{
+    if (why) *why = kNoCuda;
+    return nullptr;
+}
+
+std::unique_ptr<DeviceFrame> uploadCudaFrame(const RenderScene&) { throw BackendError(kNoCuda); }
 
 } // namespace sylva::cuda

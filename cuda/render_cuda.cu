@@ -4,8 +4,9 @@
 #include <vector>
 
 #include "core/render/shade.h"
-#include "core/render/tonemap.h"
+#include "core/render/tonemap_film.h"
 #include "cuda/cuda_check.h"
+#include "cuda/device_exec.cuh"
 
 namespace sylva::cuda {
 namespace {
@@ -32,59 +33,6 @@ __global__ void __launch_bounds__(kTile * kTile, kMinBlocksPerSm) shadeKernel(Re
     const int x = int(blockIdx.x) * kTile + int(threadIdx.x), y = int(blockIdx.y) * kTile + int(threadIdx.y);
     if (x >= v.width || y >= v.height) return;
     film[size_t(y) * size_t(v.width) + size_t(x)] = shadePixel(v, x, y);
-}
-
-// Block-wide sum of one double per thread, added to *out by one atomic per block (blockDim.x == 256).
-__device__ void blockSum(double v, double* out)
-{
-    __shared__ double warpSums[8];
-    for (int o = 16; o > 0; o >>= 1) v += __shfl_down_sync(0xffffffffu, v, o);
-    const int lane = int(threadIdx.x) & 31, warp = int(threadIdx.x) >> 5;
-    if (lane == 0) warpSums[warp] = v;
-    __syncthreads();
-    if (warp == 0) {
-        v = lane < 8 ? warpSums[lane] : 0.0;
-        for (int o = 4; o > 0; o >>= 1) v += __shfl_down_sync(0xffffffffu, v, o);
-        if (lane == 0) atomicAdd(out, v);
-    }
-}
-
-// The sums the tone mapper needs, with the host's per-pixel rules (core/render/tonemap.h): acc[1] = sum
-// lum(indirect), acc[2] = sum lum(albedo) (the ambient constant of the ambient mode); acc[0] and acc[3] the
-// log-luminance terms of the left and right modes, acc[4] and acc[5] the pixels they counted (non-finite
-// ones are left out, as on the host).
-constexpr int kToneSums = 6;
-
-__global__ void ambientSums(const SampleParts* film, size_t n, double* acc)
-{
-    const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    const bool in = i < n;
-    blockSum(in ? double(luminance(film[i].indirect)) : 0.0, &acc[1]);
-    blockSum(in ? double(luminance(film[i].albedo)) : 0.0, &acc[2]);
-}
-
-__device__ float ambientOf(const double* acc) { return ambientConstant(acc[1], acc[2]); }
-
-__global__ void logSum(const SampleParts* film, size_t n, RenderMode mode, glm::vec3 sky, double* acc, double* sum, double* count)
-{
-    const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    double term = 0.0;
-    const bool counted = i < n && logLuminanceTerm(composeSample(film[i], mode, sky, ambientOf(acc)), term);
-    blockSum(counted ? term : 0.0, sum);
-    blockSum(counted ? 1.0 : 0.0, count);
-}
-
-__global__ void toneMapKernel(const SampleParts* film, int width, size_t n, RenderMode left, RenderMode right, glm::vec3 sky,
-                              float key, const double* acc, uint32_t* out)
-{
-    const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
-    if (i >= n) return;
-    const bool isRight = int(i % size_t(width)) >= width / 2 && right != left;
-    const float scale = exposureScale(key, logAverageOf(acc[isRight ? 3 : 0], acc[isRight ? 5 : 4]));
-    const glm::vec3 c = reinhard(composeSample(film[i], isRight ? right : left, sky, ambientOf(acc)), scale);
-    const uint32_t r = uint32_t(srgbEncode(c.x) * 255.0f + 0.5f), g = uint32_t(srgbEncode(c.y) * 255.0f + 0.5f),
-                   b = uint32_t(srgbEncode(c.z) * 255.0f + 0.5f);
-    out[i] = r | (g << 8) | (b << 16) | (255u << 24);
 }
 
 template <typename T>
@@ -238,15 +186,7 @@ void renderToRgba8(const DeviceScene& scene, RenderMode mode, float key, uint32_
     DeviceScene::Scratch& s = scene.scratch();
     SampleParts* film = s.filmFor(n);
     traceOnDevice(v, film);
-    double* acc = s.acc.get();
-    check(cudaMemset(acc, 0, kToneSums * sizeof(double)), "tone map sums");
-    const unsigned blocks = unsigned((n + 255) / 256);
-    const RenderMode r = right.value_or(mode);
-    if (mode == RenderMode::Ambient || r == RenderMode::Ambient) ambientSums<<<blocks, 256>>>(film, n, acc);
-    logSum<<<blocks, 256>>>(film, n, mode, v.sky, acc, &acc[0], &acc[4]);
-    if (r != mode) logSum<<<blocks, 256>>>(film, n, r, v.sky, acc, &acc[3], &acc[5]);
-    toneMapKernel<<<blocks, 256>>>(film, v.width, n, mode, r, v.sky, key, acc, deviceRgba8);
-    check(cudaGetLastError(), "tone map kernels");
+    toneMapFilm(CudaExec{}, film, v.width, v.height, mode, right.value_or(mode), v.sky, key, s.acc.get(), deviceRgba8);
     check(cudaDeviceSynchronize(), "tone map");
 }
 

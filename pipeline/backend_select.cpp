@@ -70,4 +70,8 @@ std::unique_ptr<Backend> selectBackend(const std::string& request, const std::fu
     return std::make_unique<FallbackBackend>(std::move(cuda), onNote);
 }
 
+std::unique_ptr<DeviceDisplay> makeDeviceDisplay(std::string* why) { return cuda::makeCudaDisplay(why); }
+
+std::unique_ptr<DeviceFrame> uploadDeviceFrame(const RenderScene& scene) { return cuda::uploadCudaFrame(scene); }
+
 } // namespace sylva

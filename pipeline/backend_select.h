@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/backend/backend.h"
+#include "core/backend/device_display.h"
 
 namespace sylva {
 
@@ -37,5 +38,14 @@ private:
 // there is no device). Notes (one line each, e.g. "CUDA requested but no CUDA device: ...; using the
 // CPU") go to onNote; the returned backend is never null. Throws Error on another request.
 std::unique_ptr<Backend> selectBackend(const std::string& request, const std::function<void(const std::string&)>& onNote);
+
+// The studio viewport's GPU display (CUDA-GL interop on the first usable device); null with *why set
+// (one line) when this build has no CUDA backend or the machine no device. The viewport then probes
+// whether its GL context can share buffers with the device (setPixelBuffer).
+std::unique_ptr<DeviceDisplay> makeDeviceDisplay(std::string* why);
+
+// Uploads a render scene for a DeviceDisplay, from any thread. Throws BackendError when there is no
+// device or its memory is short.
+std::unique_ptr<DeviceFrame> uploadDeviceFrame(const RenderScene& scene);
 
 } // namespace sylva

@@ -1,12 +1,16 @@
 // RenderWorker: progressive passes with restart, the species part of the frame kept across camera moves.
 #include "studio/render_worker.h"
 
-#include <cstring>
+#include <cmath>
+#include <string>
 
 #include <QMutexLocker>
 
 #include "core/backend/backend.h"
 #include "core/base/error.h"
+#include "core/base/parallel.h"
+#include "core/render/tonemap_film.h"
+#include "pipeline/backend_select.h"
 #include "pipeline/render/render_job.h"
 #include "studio/background_priority.h"
 #include "studio/scene_document.h"
@@ -15,29 +19,18 @@ namespace sylva {
 
 QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float exposureKey)
 {
-    if (film.width <= 0 || film.height <= 0) return {};
-    const std::vector<glm::vec3> linear = composeMode(film, mode, sky);
-    const ImageRgba img = toneMapped(linear, film.width, film.height, exposureKey);
-    QImage out(film.width, film.height, QImage::Format_RGBX8888);
-    for (int y = 0; y < film.height; ++y) {
-        uchar* line = out.scanLine(y);
-        for (int x = 0; x < film.width; ++x) {
-            const float* px = &img.pixels[(size_t(y) * size_t(film.width) + size_t(x)) * 4];
-            for (int c = 0; c < 3; ++c) line[x * 4 + c] = uchar(std::clamp(px[c], 0.0f, 1.0f) * 255.0f + 0.5f);
-            line[x * 4 + 3] = 255;
-        }
-    }
-    return out;
+    return compareImage(film, mode, mode, sky, exposureKey);
 }
 
 QImage compareImage(const Film& film, RenderMode left, RenderMode right, const glm::vec3& sky, float exposureKey)
 {
-    QImage out = filmImage(film, left, sky, exposureKey);
-    if (out.isNull() || right == left) return out;
-    const QImage r = filmImage(film, right, sky, exposureKey);
-    const int split = film.width / 2;
-    for (int y = 0; y < film.height; ++y)
-        std::memcpy(out.scanLine(y) + size_t(split) * 4, r.constScanLine(y) + size_t(split) * 4, size_t(film.width - split) * 4);
+    if (film.width <= 0 || film.height <= 0) return {};
+    if (!std::isfinite(exposureKey) || !(exposureKey > 0.0f))
+        throw Error("tone map key " + std::to_string(exposureKey) + " must be finite and > 0");
+    QImage out(film.width, film.height, QImage::Format_RGBX8888);   // bytes R, G, B, 255, rows packed
+    double acc[kToneSums];
+    toneMapFilm(HostExec{}, film.pixels.data(), film.width, film.height, left, right, sky, exposureKey, acc,
+                reinterpret_cast<uint32_t*>(out.bits()));
     return out;
 }
 
@@ -166,7 +159,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
             g->frame = buildViewFrame(scene, copies, sun);
             if (interrupted()) throw Cancelled();
             placeViewFrame(g->frame, scene, sun, w, h, 1);
-            g->device = std::make_unique<cuda::DeviceScene>(g->frame.rs);
+            g->device = uploadDeviceFrame(g->frame.rs);
             g->assets = req.assets;
             m_gpuAssets = req.assets;
             m_gpuPruned = scene.render.pruneDistance > 0.0f;

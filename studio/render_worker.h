@@ -16,9 +16,9 @@
 #include <QThread>
 #include <QWaitCondition>
 
+#include "core/backend/device_display.h"
 #include "core/render/render_cpu.h"
 #include "core/scene/scene.h"
-#include "cuda/render_cuda.h"
 #include "pipeline/render/view_frame.h"
 #include "studio/asset_store.h"
 
@@ -38,10 +38,10 @@ QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float 
 QImage compareImage(const Film& film, RenderMode left, RenderMode right, const glm::vec3& sky, float exposureKey);
 
 // The GPU viewport's frame: the species part built and uploaded on the worker thread, then handed to
-// the viewport, which re-places it for every camera move (placeViewFrame, DeviceScene::place).
+// the viewport, which re-places it for every camera move (placeViewFrame, DeviceFrame::place).
 struct GpuFrame {
     ViewFrame frame;
-    std::unique_ptr<cuda::DeviceScene> device;
+    std::unique_ptr<DeviceFrame> device;
     std::vector<AssetsPtr> assets;   // what it was built from
 };
 using GpuFramePtr = std::shared_ptr<GpuFrame>;

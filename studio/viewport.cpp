@@ -11,8 +11,7 @@
 #include <QWheelEvent>
 
 #include "core/backend/backend.h"
-#include "cuda/device_query.h"
-#include "cuda/gl_interop.h"
+#include "pipeline/backend_select.h"
 #include "pipeline/render/render_job.h"
 #include "studio/camera_nav.h"
 #include "studio/render_worker.h"
@@ -159,9 +158,10 @@ void Viewport::setupGpu()
         m_backendNote = tr("CPU viewport (SYLVA_VIEWPORT=cpu)");
         return;
     }
-    auto interop = std::make_unique<cuda::GlInterop>();
-    if (!interop->available()) {
-        m_backendNote = tr("CPU viewport: %1").arg(QString::fromStdString(interop->whyUnavailable()));
+    std::string why;
+    std::unique_ptr<DeviceDisplay> interop = makeDeviceDisplay(&why);
+    if (!interop) {
+        m_backendNote = tr("CPU viewport: %1").arg(QString::fromStdString(why));
         return;
     }
     // Interop needs this GL context to run on the CUDA device: registering a buffer tells.
@@ -182,8 +182,7 @@ void Viewport::setupGpu()
     m_interop = std::move(interop);
     m_pbo = probe;
     m_pboSize = QSize(1, 1);
-    const cuda::DeviceQuery q = cuda::queryDevices();
-    m_backendNote = tr("GPU viewport: CUDA-GL interop on %1").arg(QString::fromStdString(q.devices.empty() ? "?" : q.devices[0].name));
+    m_backendNote = tr("GPU viewport: CUDA-GL interop on %1").arg(QString::fromStdString(m_interop->deviceName()));
     m_worker->setGpuMode(true);
     requestRender();
 }

@@ -23,10 +23,6 @@ class QOpenGLTexture;
 
 namespace sylva {
 
-namespace cuda {
-class GlInterop;
-}
-
 class Viewport : public QOpenGLWidget, protected QOpenGLFunctions {
     Q_OBJECT
 
@@ -126,8 +122,8 @@ private:
     QOpenGLBuffer m_quad;
     void drawTexture();
 
-    // GPU path (null m_interop: CPU path)
-    std::unique_ptr<cuda::GlInterop> m_interop;
+    // GPU path: the device's display (null: CPU path)
+    std::unique_ptr<DeviceDisplay> m_interop;
     GpuFramePtr m_gpuFrame;
     GLuint m_pbo = 0;
     QSize m_pboSize;

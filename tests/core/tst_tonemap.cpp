@@ -8,7 +8,10 @@
 #include <vector>
 
 #include "core/base/error.h"
+#include "core/base/parallel.h"
+#include "core/render/render_cpu.h"
 #include "core/render/tonemap.h"
+#include "core/render/tonemap_film.h"
 
 using namespace sylva;
 
@@ -246,6 +249,88 @@ private Q_SLOTS:
         QVERIFY_THROWS_EXCEPTION(Error, toneMapToSrgb(img.data(), 10, out.data(), ToneMapParams{std::numeric_limits<float>::quiet_NaN()}));
         QVERIFY_THROWS_EXCEPTION(Error, toneMapToSrgb(nullptr, 10, out.data(), {}));
         toneMapToSrgb(nullptr, 0, nullptr, {});   // empty image: nothing to do
+    }
+    // The studio's picture of a film (toneMapFilm, written once for HostExec and the GPU's CudaExec) equals
+    // the whole-image path of `sylva render` on the same film: composeMode, then toneMapToSrgb, then 8-bit
+    // rounding; for each mode, with NaN and infinite pixels in the film, and the compare halves each equal
+    // to their own mode's picture.
+    void toneMapFilmEqualsWholeImagePath()
+    {
+        const int w = 301, h = 173;   // odd width: the compare split is not a multiple of anything
+        Film film;
+        film.width = w;
+        film.height = h;
+        film.pixels.resize(size_t(w) * h);
+        std::mt19937 rng(11);
+        std::uniform_real_distribution<float> u(0.0f, 2.0f);
+        for (SampleParts& p : film.pixels) {
+            p.local = glm::vec3(u(rng), u(rng), u(rng)) * u(rng);
+            p.indirect = glm::vec3(u(rng), u(rng), u(rng)) * 0.3f;
+            p.albedo = glm::vec3(u(rng), u(rng), u(rng)) * 0.4f;
+            p.skyCover = rng() % 5 == 0 ? u(rng) * 0.5f : 0.0f;
+        }
+        film.pixels[17].local.x = std::numeric_limits<float>::quiet_NaN();
+        film.pixels[4000].indirect.y = std::numeric_limits<float>::infinity();
+        const glm::vec3 sky(0.4f, 0.6f, 0.9f);
+        const float key = 0.22f;
+        auto reference = [&](RenderMode mode) {
+            const std::vector<glm::vec3> lin = composeMode(film, mode, sky);
+            std::vector<float> srgb(lin.size() * 3);
+            toneMapToSrgb(reinterpret_cast<const float*>(lin.data()), lin.size(), srgb.data(), ToneMapParams{key});
+            std::vector<uint32_t> px(lin.size());
+            for (size_t i = 0; i < lin.size(); ++i) {
+                uint32_t v = 255u << 24;
+                for (int c = 0; c < 3; ++c) v |= uint32_t(std::clamp(srgb[i * 3 + c], 0.0f, 1.0f) * 255.0f + 0.5f) << (8 * c);
+                px[i] = v;
+            }
+            return px;
+        };
+        const RenderMode modes[] = {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb};
+        for (RenderMode left : modes) {
+            const std::vector<uint32_t> want = reference(left);
+            std::vector<uint32_t> got(want.size());
+            double acc[kToneSums];
+            toneMapFilm(HostExec{}, film.pixels.data(), w, h, left, left, sky, key, acc, got.data());
+            QVERIFY2(got == want, qPrintable(QString("mode %1").arg(int(left))));
+            for (RenderMode right : modes) {
+                if (right == left) continue;
+                const std::vector<uint32_t> other = reference(right);
+                toneMapFilm(HostExec{}, film.pixels.data(), w, h, left, right, sky, key, acc, got.data());
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x) {
+                        const size_t i = size_t(y) * w + x;
+                        if (got[i] != (x < w / 2 ? want[i] : other[i]))
+                            QFAIL(qPrintable(QString("compare %1|%2 differs at %3,%4").arg(int(left)).arg(int(right)).arg(x).arg(y)));
+                    }
+            }
+        }
+    }
+
+    // HostExec::sum adds in a fixed chunk order: the same bits as a serial sum over the same chunks,
+    // whatever the thread count; n = 0 gives zeros.
+    void hostSumIsChunkOrdered()
+    {
+        const size_t n = 3 * HostExec::kChunk + 123;
+        std::vector<double> v(n);
+        std::mt19937 rng(3);
+        for (double& x : v) x = std::ldexp(double(rng()), -int(rng() % 40));
+        struct Body {
+            const double* v;
+            void operator()(size_t i, double* t) const { t[0] = v[i]; t[1] = 1.0; }
+        };
+        double got[2] = {-1.0, -1.0};
+        HostExec{}.sum<2>(n, Body{v.data()}, got);
+        double want = 0.0;
+        for (size_t c = 0; c * HostExec::kChunk < n; ++c) {
+            double part = 0.0;
+            for (size_t i = c * HostExec::kChunk; i < std::min(n, (c + 1) * HostExec::kChunk); ++i) part += v[i];
+            want += part;
+        }
+        QCOMPARE(got[0], want);
+        QCOMPARE(got[1], double(n));
+        HostExec{}.sum<2>(0, Body{v.data()}, got);
+        QCOMPARE(got[0], 0.0);
+        QCOMPARE(got[1], 0.0);
     }
 };
 
