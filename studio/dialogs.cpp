@@ -83,6 +83,16 @@ ExportDialog::ExportDialog(const ExportSettings& initial, QWidget* parent) : QDi
     form->addRow(tr("Width"), m_width);
     form->addRow(tr("Height"), m_height);
     form->addRow(tr("Samples per pixel"), m_spp);
+    m_passes = new QCheckBox(tr("Render passes (multi-layer EXR: Combined, DiffDir, DiffInd, DiffCol, Env, Normal, Depth, Alpha)"));
+    auto exrOnly = [this](const QString& path) {
+        const bool exr = path.endsWith(QLatin1String(".exr"), Qt::CaseInsensitive);
+        m_passes->setEnabled(exr);
+        if (!exr) m_passes->setChecked(false);
+    };
+    m_passes->setChecked(initial.passes);
+    exrOnly(initial.path);
+    connect(m_path, &QLineEdit::textChanged, this, exrOnly);
+    form->addRow(QString(), m_passes);
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
     connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
     connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
@@ -91,7 +101,7 @@ ExportDialog::ExportDialog(const ExportSettings& initial, QWidget* parent) : QDi
 
 ExportSettings ExportDialog::settings() const
 {
-    return {m_path->text(), m_width->value(), m_height->value(), m_spp->value()};
+    return {m_path->text(), m_width->value(), m_height->value(), m_spp->value(), m_passes->isChecked()};
 }
 
 ScatterDialog::ScatterDialog(const QStringList& speciesNames, const ScatterSpec& initial, QWidget* parent)

@@ -35,9 +35,10 @@ private:
 struct ExportSettings {
     QString path;
     int width = 896, height = 448, spp = 4;
+    bool passes = false;   // the render passes as one multi-layer EXR (pipeline/render/render_passes.h)
 };
 
-// Output file (PNG/EXR/TIFF), size and samples per pixel.
+// Output file (PNG/EXR/TIFF), size, samples per pixel, and for .exr whether to write the render passes.
 class ExportDialog : public QDialog {
     Q_OBJECT
 
@@ -50,6 +51,7 @@ private:
     QSpinBox* m_width;
     QSpinBox* m_height;
     QSpinBox* m_spp;
+    QCheckBox* m_passes;
 };
 
 // Scatter tool: species, count, rectangle (x and z ranges), random rotation about up, scale range, seed.

@@ -24,6 +24,7 @@
 #include "core/backend/backend.h"
 #include "cuda/device_query.h"
 #include "pipeline/cache/grid_cache.h"
+#include "pipeline/io/grid_file.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/job_panel.h"
@@ -287,6 +288,17 @@ private Q_SLOTS:
         QCOMPARE(p["preset"].toString(), QStringLiteral("leaf"));
         const glm::vec3 sun = s.sun.direction;
         for (int c = 0; c < 3; ++c) QCOMPARE(float(p["sun"].toArray()[c].toDouble()), sun[c]);
+        // As OpenVDB (File > Export Species Grids as OpenVDB): one Tree_1.vdb holding the same grids.
+        QVERIFY(m_win->findChild<QAction*>("actionExportGridsVdb"));
+        QVERIFY(waitForJob(m_win->exporter()->exportSpeciesGrids(0, folder, GridFileFormat::Vdb), 60000));
+        const std::string vdbPath = QDir(folder).filePath("Tree_1.vdb").toStdString();
+        const LightingGrid vdbLight = readLightingFile(vdbPath);
+        QCOMPARE(vdbLight.geometry, light.geometry);
+        QVERIFY(vdbLight.rgb == light.rgb);
+        const DensityGrid vdbDensity = readDensityFile(vdbPath);
+        QCOMPARE(vdbDensity.geometry, density.geometry);
+        QVERIFY(vdbDensity.density == density.density);
+        QVERIFY(vdbDensity.woodFraction == density.woodFraction);
         // No species: an error, no job.
         m_errors.clear();
         QVERIFY(!m_win->exporter()->exportSpeciesGrids(5, folder));
@@ -464,6 +476,7 @@ private Q_SLOTS:
         QTest::newRow("png") << "out/render.png";
         QTest::newRow("exr") << "out/render.exr";
         QTest::newRow("tiff") << "out/render.tif";
+        QTest::newRow("passes") << "out/render.passes.exr";
     }
 
     void exportPng()
@@ -472,8 +485,16 @@ private Q_SLOTS:
         m_errors.clear();
         if (!name.endsWith(".png")) {
             const QString path = m_dir.filePath(name);
-            QVERIFY(waitForJob(m_win->exporter()->exportRender({path, 32, 18, 1}), 60000));
+            const bool passes = name.contains("passes");
+            QVERIFY(waitForJob(m_win->exporter()->exportRender({path, 32, 18, 1, passes}), 60000));
             QVERIFY(QFileInfo(path).size() > 0);
+            if (passes) {   // the EXR header names every layer's channels (NUL-terminated)
+                QFile f(path);
+                QVERIFY(f.open(QIODevice::ReadOnly));
+                const QByteArray header = f.read(4096);
+                for (const char* ch : {"Combined.R", "DiffDir.G", "DiffInd.B", "DiffCol.R", "Env.G", "Normal.X", "Depth.Z", "Alpha.A"})
+                    QVERIFY2(header.contains(QByteArray(ch) + '\0'), ch);
+            }
             return;
         }
         const QString path = m_dir.filePath("out/render.png");
