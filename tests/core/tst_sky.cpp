@@ -11,6 +11,7 @@
 
 #include "core/base/error.h"
 #include "core/color/color.h"
+#include "core/lb/lattice.h"
 #include "core/render/tonemap.h"
 #include "core/scene/scene.h"
 #include "core/sky/env_map.h"
@@ -599,6 +600,18 @@ private Q_SLOTS:
         for (const glm::dvec3& s : rs) rsum += s;
         QVERIFY(glm::length(rsum - directIntegral(m, false)) < 1e-6 * glm::length(rsum));
         QVERIFY_THROWS_EXCEPTION(Error, skyDirectionShares(c, {glm::vec3(0.0f)}));
+        // The LB's D3Q19 moving directions: a constant sky gives the 6 axial directions equal shares and the
+        // 12 diagonal ones equal shares (the lattice's symmetry), summing to 4 pi L.
+        std::vector<glm::vec3> d3q19;
+        for (int q = 1; q < lb::kDirections; ++q) d3q19.emplace_back(float(lb::kC[q][0]), float(lb::kC[q][1]), float(lb::kC[q][2]));
+        const std::vector<glm::dvec3> lat = skyDirectionShares(constantSky(glm::vec3(1.0f), none), d3q19, 1024);
+        double total = 0.0;
+        for (int q = 1; q < lb::kDirections; ++q) {
+            const double ref = lb::isAxial(q) ? lat[0].x : lat[6].x;
+            QVERIFY2(std::abs(lat[size_t(q - 1)].x - ref) < 0.01 * ref, qPrintable(QString("direction %1: %2 vs %3").arg(q).arg(lat[size_t(q - 1)].x).arg(ref)));
+            total += lat[size_t(q - 1)].x;
+        }
+        QVERIFY(std::abs(total - 4.0 * kPI) < 1e-6);
     }
 };
 
