@@ -125,8 +125,7 @@ Command cacheCommand()
 {
     return {"cache",
             "info|clean|limit [SIZE|none] [--older-than D] [--max-size S] [--cache DIR]",
-            "the grid cache: info (size, entries, oldest), clean (every entry, or by age and size), limit (show or set the size\n"
-            "limit; least recently used entries are evicted past it)",
+            "the grid cache: info (size, entries, oldest use), clean (all, or by age and size), limit (the size limit)",
             {kOlderThan, kMaxSize, kCache},
             1,
             2,
