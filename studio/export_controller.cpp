@@ -74,7 +74,7 @@ QString ExportController::gridFileBase(const QString& speciesName)
     return QString::fromStdString(sylva::gridFileBase(speciesName.toStdString()));
 }
 
-Job* ExportController::exportSpeciesGrids(int species, const QString& folder)
+Job* ExportController::exportSpeciesGrids(int species, const QString& folder, GridFileFormat format)
 {
     const Scene scene = m_doc->scene();
     if (species < 0 || size_t(species) >= scene.species.size()) {
@@ -83,22 +83,24 @@ Job* ExportController::exportSpeciesGrids(int species, const QString& folder)
     }
     const SpeciesDesc& sp = scene.species[size_t(species)];
     const std::string dir = folder.toStdString();
-    const GridExportFiles files = gridExportFiles(dir, sp.name);
+    const GridExportFiles files = gridExportFiles(dir, sp.name, format);
     AssetsPtr held = m_assets->find(assetKey(sp, scene.sun, true));
     if (!held) held = m_assets->find(assetKey(sp, scene.sun, false));
     GridCache* cache = m_cache;
     Backend* backend = m_backend;
     log(tr("exporting the grids of %1 to %2").arg(QString::fromStdString(sp.name), QDir::toNativeSeparators(folder)));
     return m_jobs->start(tr("Export grids of %1").arg(QString::fromStdString(sp.name)),
-                         [scene, species, held, cache, backend, dir](Job& job, Progress& progress) {
+                         [scene, species, held, cache, backend, dir, format](Job& job, Progress& progress) {
                              JobLog log;
                              sylva::exportSpeciesGrids(scene, size_t(species), dir, cache, backend, &progress, &log,
-                                                held ? &held->mesh : nullptr);
+                                                held ? &held->mesh : nullptr, format);
                              for (const std::string& line : speciesLogLines(scene.species[size_t(species)].name, log))
                                  job.log(QString::fromStdString(line));
                          },
                          [this, files](Job* job) {
-                             if (job->state() == Job::State::Succeeded)
+                             if (job->state() == Job::State::Succeeded && files.density == files.lighting)
+                                 log(tr("exported %1").arg(QString::fromStdString(files.density)));
+                             else if (job->state() == Job::State::Succeeded)
                                  log(tr("exported %1 and %2").arg(QString::fromStdString(files.density),
                                                                   QString::fromStdString(files.lighting)));
                              else if (job->state() == Job::State::Failed) fail(tr("Export failed"), job->error());
@@ -121,7 +123,7 @@ void ExportController::exportDialog()
     if (d.exec() == QDialog::Accepted) exportRender(d.settings());
 }
 
-void ExportController::exportGridsDialog(int species)
+void ExportController::exportGridsDialog(int species, GridFileFormat format)
 {
     if (species < 0) {
         fail(tr("Export failed"), tr("Select a species (or one of its instances) to export its grids."));
@@ -130,7 +132,7 @@ void ExportController::exportGridsDialog(int species)
     const QString folder = QFileDialog::getExistingDirectory(
         m_window, tr("Export the grids of %1 to").arg(QString::fromStdString(m_doc->scene().species[size_t(species)].name)),
         m_doc->filePath().isEmpty() ? QString() : QFileInfo(m_doc->filePath()).absolutePath());
-    if (!folder.isEmpty()) exportSpeciesGrids(species, folder);
+    if (!folder.isEmpty()) exportSpeciesGrids(species, folder, format);
 }
 
 } // namespace sylva

@@ -1,10 +1,11 @@
 // Exports: File > Export Render (a picture of the scene, the pipeline's exportRender) and File > Export
-// Species Grids (a species' density and lighting grids as .npy with sidecars, exportSpeciesGrids),
-// each a background job on the studio's backend, with their dialogs.
+// Species Grids (a species' density and lighting grids as .npy with sidecars, or as one OpenVDB file:
+// exportSpeciesGrids), each a background job on the studio's backend, with their dialogs.
 #pragma once
 
 #include <QString>
 
+#include "pipeline/io/grid_file.h"
 #include "studio/dialogs.h"
 #include "studio/studio_controller.h"
 
@@ -31,9 +32,10 @@ public:
     // EXR linear). Null (and an error) for an empty scene.
     Job* exportRender(const ExportSettings& settings);
     // Writes a species' grids (loadSpeciesGrids) into folder as NAME.density.npy (+ NAME.density.wood.npy)
-    // and NAME.lighting.npy, each with its JSON sidecar (CONTRACTS.md); NAME is gridFileBase of the
-    // species name. Null (and an error) for a bad species index.
-    Job* exportSpeciesGrids(int species, const QString& folder);
+    // and NAME.lighting.npy, each with its JSON sidecar (CONTRACTS.md), or with GridFileFormat::Vdb as
+    // one NAME.vdb (density, wood fraction and lighting grids, docs/FILES.md); NAME is gridFileBase of
+    // the species name. Null (and an error) for a bad species index.
+    Job* exportSpeciesGrids(int species, const QString& folder, GridFileFormat format = GridFileFormat::Npy);
     // The species name with characters other than letters, digits, '.', '-', '_' replaced by '_'
     // (the pipeline's gridFileBase).
     static QString gridFileBase(const QString& speciesName);
@@ -41,7 +43,7 @@ public:
     // The Export Render dialog (starting from the last export's settings), then exportRender.
     void exportDialog();
     // A folder dialog for the species' grids (an error without a species), then exportSpeciesGrids.
-    void exportGridsDialog(int species);
+    void exportGridsDialog(int species, GridFileFormat format = GridFileFormat::Npy);
 
 private:
     SceneDocument* m_doc;

@@ -288,6 +288,8 @@ void MainWindow::buildActions()
     add(file, tr("&Grow Species..."), "actionGrow", QKeySequence(Qt::CTRL | Qt::Key_G), [this] { m_importer->growDialog(); });
     add(file, tr("&Export Render..."), "actionExport", QKeySequence(Qt::CTRL | Qt::Key_E), [this] { m_export->exportDialog(); });
     add(file, tr("Export Species &Grids..."), "actionExportGrids", QKeySequence(), [this] { m_export->exportGridsDialog(selectedSpecies()); });
+    add(file, tr("Export Species Grids as &OpenVDB..."), "actionExportGridsVdb", QKeySequence(),
+        [this] { m_export->exportGridsDialog(selectedSpecies(), GridFileFormat::Vdb); });
     file->addSeparator();
     add(file, tr("&Quit"), "actionQuit", QKeySequence::Quit, [this] { close(); });
 

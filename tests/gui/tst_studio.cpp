@@ -24,6 +24,7 @@
 #include "core/backend/backend.h"
 #include "cuda/device_query.h"
 #include "pipeline/cache/grid_cache.h"
+#include "pipeline/io/grid_file.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/job_panel.h"
@@ -287,6 +288,17 @@ private Q_SLOTS:
         QCOMPARE(p["preset"].toString(), QStringLiteral("leaf"));
         const glm::vec3 sun = s.sun.direction;
         for (int c = 0; c < 3; ++c) QCOMPARE(float(p["sun"].toArray()[c].toDouble()), sun[c]);
+        // As OpenVDB (File > Export Species Grids as OpenVDB): one Tree_1.vdb holding the same grids.
+        QVERIFY(m_win->findChild<QAction*>("actionExportGridsVdb"));
+        QVERIFY(waitForJob(m_win->exporter()->exportSpeciesGrids(0, folder, GridFileFormat::Vdb), 60000));
+        const std::string vdbPath = QDir(folder).filePath("Tree_1.vdb").toStdString();
+        const LightingGrid vdbLight = readLightingFile(vdbPath);
+        QCOMPARE(vdbLight.geometry, light.geometry);
+        QVERIFY(vdbLight.rgb == light.rgb);
+        const DensityGrid vdbDensity = readDensityFile(vdbPath);
+        QCOMPARE(vdbDensity.geometry, density.geometry);
+        QVERIFY(vdbDensity.density == density.density);
+        QVERIFY(vdbDensity.woodFraction == density.woodFraction);
         // No species: an error, no job.
         m_errors.clear();
         QVERIFY(!m_win->exporter()->exportSpeciesGrids(5, folder));
