@@ -105,11 +105,12 @@ std::string manPage(const std::vector<Command>& commands)
         put(m, {".TP\n.B ", roff("-h, --help"), "\nthis command's options\n"});
     }
     m += ".SH EXIT STATUS\n.TP\n.B 0\nsuccess\n.TP\n.B 1\nbad input or failure (the message names the file and the problem)\n"
-         ".TP\n.B 2\nbad usage\n";
+         ".TP\n.B 2\nbad usage\n.TP\n.B 130\ncancelled by Ctrl\\-C (SIGINT)\n.TP\n.B 143\ncancelled by SIGTERM\n";
     m += ".SH ENVIRONMENT\n.TP\n.B XDG_CACHE_HOME\nthe grid cache is \\fI$XDG_CACHE_HOME/sylva\\fR (default "
          "\\fI~/.cache/sylva\\fR) unless \\fB\\-\\-cache\\fR names another folder\n"
          ".TP\n.B SYLVA_MEMORY_LIMIT_MB\ncaps the memory a render assumes it may use (frames larger than it are traced in bands)\n";
-    m += ".SH SEE ALSO\n.BR sylva\\-studio (1)\n";
+    m += ".SH FILES\n.TP\n.I share/sylva/default_forest.sylva.json\nthe bundled default forest (under the install prefix), "
+         "a start for a scene file; the programs carry their own copy\n";
     return m;
 }
 
