@@ -9,8 +9,11 @@
 #include <QTest>
 
 #include <csignal>
+#include <memory>
+#include <string_view>
 
 #include "pipeline/cache/grid_cache.h"
+#include "pipeline/io/atomic_file.h"
 #include "pipeline/io/npy.h"
 
 using namespace sylva;
@@ -150,6 +153,29 @@ private Q_SLOTS:
         QCOMPARE(lines[0], QStringLiteral("sylva " SYLVA_VERSION));
         QVERIFY2(lines.value(1).startsWith(QLatin1String("backends: cpu")), qPrintable(r.out));
         QVERIFY2(runSylva({"--help"}).out.contains(QRegularExpression("\\n  cache +the grid cache")), "sylva --help lists cache");
+    }
+
+    // What a second signal runs before it exits: the temporary files of the writers still open go, a
+    // committed file and files of writers that finished stay.
+    void pendingTemporaryFilesRemoved()
+    {
+        const std::string dir = (outDir() + "/pending").toStdString();
+        QDir(QString::fromStdString(dir)).removeRecursively();
+        AtomicFile done(dir + "/done.npy");
+        done.write(std::string_view("done"));
+        done.commit();
+        std::vector<std::unique_ptr<AtomicFile>> open;
+        for (int i = 0; i < 3; ++i) {
+            open.push_back(std::make_unique<AtomicFile>(dir + "/open" + std::to_string(i) + ".npy"));
+            open.back()->write(std::string_view("partial"));
+        }
+        open.erase(open.begin());   // abandoned normally: its own destructor removed it
+        QCOMPARE(tempFiles(QString::fromStdString(dir)).size(), 2);
+        removePendingAtomicFiles();
+        QCOMPARE(tempFiles(QString::fromStdString(dir)), QStringList());
+        QVERIFY(QFileInfo::exists(QString::fromStdString(dir + "/done.npy")));
+        open.clear();   // their destructors find nothing left to remove
+        QCOMPARE(QDir(QString::fromStdString(dir)).entryList(QDir::Files | QDir::Hidden), QStringList{"done.npy"});
     }
 
     void sigintCancelsLight() { cancelLight(SIGINT, "sigint"); }
