@@ -6,6 +6,7 @@
 #include <QProcess>
 #include <QTest>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -177,6 +178,16 @@ private Q_SLOTS:
         // And nothing downstream turns into NaN.
         const sky::Sky s = sky::mapSky(f.map, 10.0f, 1.0f);
         for (const sky::VirtualLight& l : sky::skyLights(s, 16)) QVERIFY(std::isfinite(l.power.x + l.power.y + l.power.z) && glm::all(glm::greaterThanEqual(l.power, glm::vec3(0.0f))));
+        // Radiance .hdr (RGBE: 8-bit mantissas) reads back within its precision.
+        std::vector<float> ramp(size_t(w) * size_t(h) * 3);
+        for (size_t i = 0; i < ramp.size(); ++i) ramp[i] = 0.01f * float(i % 97) + float(i % 3) * 100.0f;
+        writeFloatExr(outPath("ramp.hdr"), w, h, ramp);
+        const EnvMapFile hdr = readEnvMap(outPath("ramp.hdr"));
+        QCOMPARE(hdr.map.width, w);
+        for (size_t p = 0; p < size_t(w) * size_t(h); ++p) {
+            const float big = std::max({ramp[p * 3], ramp[p * 3 + 1], ramp[p * 3 + 2]});
+            for (int c = 0; c < 3; ++c) QVERIFY(std::abs(hdr.map.rgb[p * 3 + size_t(c)] - ramp[p * 3 + size_t(c)]) <= big / 128.0f + 1e-6f);
+        }
         // A grey (one-channel) map is read into all three.
         writeFloatExr(outPath("grey.exr"), 8, 4, std::vector<float>(32, 2.0f), 1);
         const EnvMapFile g = readEnvMap(outPath("grey.exr"));
