@@ -15,5 +15,6 @@ Command studyCommand();       // cmd_study.cpp
 Command infoCommand();        // cmd_info.cpp
 Command skyCommand();         // cmd_sky.cpp
 Command cacheCommand();       // cmd_cache.cpp
+Command exportCommand();      // cmd_export.cpp
 
 } // namespace sylva::cli

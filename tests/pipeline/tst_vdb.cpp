@@ -26,6 +26,7 @@
 #include "pipeline/io/vdb_io.h"
 #include "pipeline/lighting_job.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/scene/scene_file.h"
 #include "pipeline/services/exports.h"
 
 using namespace sylva;
@@ -455,6 +456,54 @@ private Q_SLOTS:
         QVERIFY(sameBits(ed.density, solved.density.density));
         QVERIFY(sameBits(ed.woodFraction, solved.density.woodFraction));
         QVERIFY(sameBits(el.rgb, solved.lighting.rgb));
+    }
+
+    // sylva export SCENE: one NAME.vdb per species (or the .npy files with --format npy) holding the
+    // grids the library's loadSpeciesGrids gives for the scene read back; unknown species exit 1, a bad
+    // format 2.
+    void exportCommand()
+    {
+        Scene s;
+        s.species.resize(2);
+        s.species[0].name = "Shrub A";
+        s.species[1].name = "other";
+        for (SpeciesDesc& sp : s.species) {
+            sp.meshPath = out("shrub.obj");   // written by commandsWriteAndReadVdb
+            sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+            sp.lighting.steps = 8;
+            sp.grid = 10;
+        }
+        s.species[1].grid = 9;
+        InstanceDesc a;
+        s.instances = {a};
+        const QString scenePath = m_dir + "/export.sylva.json";
+        writeSceneFile(s, scenePath.toStdString());
+        const QString folder = m_dir + "/exported";
+        Run r = runSylva({"export", scenePath, "--species", "Shrub A", "--out", folder, "--no-cache", "--backend", "cpu", "--quiet"});
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QVERIFY2(r.out == "wrote " + folder + "/Shrub_A.vdb\n", qPrintable(r.out));
+        QVERIFY(!QFile::exists(folder + "/other.vdb"));
+        const Scene read = readSceneFile(scenePath.toStdString());
+        const SpeciesGrids want = loadSpeciesGrids(read, 0, nullptr);
+        const std::string vdb = (folder + "/Shrub_A.vdb").toStdString();
+        const DensityGrid d = readDensityFile(vdb);
+        const LightingGrid l = readLightingFile(vdb);
+        QVERIFY(d.geometry == want.density.geometry && l.geometry == want.lighting.geometry);
+        QVERIFY(sameBits(d.density, want.density.density) && sameBits(d.woodFraction, want.density.woodFraction));
+        QVERIFY(sameBits(l.rgb, want.lighting.rgb));
+
+        r = runSylva({"export", scenePath, "--format", "npy", "--out", folder, "--no-cache", "--backend", "cpu", "--quiet"});
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        for (const char* f : {"Shrub_A.density.npy", "Shrub_A.density.wood.npy", "Shrub_A.lighting.npy", "other.density.npy", "other.lighting.npy.json"})
+            QVERIFY2(r.out.contains(folder + "/" + f) && QFile::exists(folder + "/" + f), f);
+        QCOMPARE(readDensityFile((folder + "/other.density.npy").toStdString()).geometry.longestEdge(), 9);
+        QVERIFY(sameBits(readLightingFile((folder + "/Shrub_A.lighting.npy").toStdString()).rgb, l.rgb));
+
+        r = runSylva({"export", scenePath, "--species", "palm", "--out", folder});
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains("no species 'palm'") && r.err.contains("'Shrub A', 'other'"), qPrintable(r.err));
+        r = runSylva({"export", scenePath, "--format", "exr"});
+        QCOMPARE(r.code, 2);
     }
 
     // Every command with -o refuses a name whose extension it cannot write (exit 2), before any work
