@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iterator>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -473,6 +475,9 @@ std::string describeVdbFile(const std::string& path)
     VdbReader vdb(path);
     std::string text = path + ": OpenVDB file (format " + vdb.file().version() + "), " + std::to_string(vdb.grids().size()) +
                        (vdb.grids().size() == 1 ? " grid\n" : " grids\n");
+    // Each grid's sylva_* metadata as text, then what every grid has alike (printed once).
+    std::vector<std::map<std::string, std::string>> metadata;
+    std::vector<std::string> lines;
     for (const openvdb::GridBase::Ptr& meta : vdb.grids()) {
         const std::string name = meta->getName();
         openvdb::GridBase::Ptr grid;
@@ -484,18 +489,34 @@ std::string describeVdbFile(const std::string& path)
         const CoordBBox box = grid->evalActiveVoxelBoundingBox();
         const openvdb::Vec3d voxel = grid->voxelSize();
         const openvdb::Vec3d origin = grid->constTransform().indexToWorld(openvdb::Vec3d(0.0));
-        text += "grid " + quoted(name) + ": " + grid->valueType() + ", class " + openvdb::GridBase::gridClassToString(grid->getGridClass()) +
+        std::string line = "grid " + quoted(name) + ": " + grid->valueType() + ", class " + openvdb::GridBase::gridClassToString(grid->getGridClass()) +
                 ", " + std::to_string(grid->activeVoxelCount()) + " active voxels";
         if (!box.empty())
-            text += ", index box " + triple(box.min().x(), box.min().y(), box.min().z()) + " .. " +
+            line += ", index box " + triple(box.min().x(), box.min().y(), box.min().z()) + " .. " +
                     triple(box.max().x(), box.max().y(), box.max().z());
-        text += ", voxel size " + triple(voxel.x(), voxel.y(), voxel.z()) + ", voxel (0,0,0) at " + triple(origin.x(), origin.y(), origin.z());
-        if (const auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) text += ", " + valueRangeText(*f);
-        else if (const auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid)) text += ", " + valueRangeText(*v);
-        text += "\n";
+        line += ", voxel size " + triple(voxel.x(), voxel.y(), voxel.z()) + ", voxel (0,0,0) at " + triple(origin.x(), origin.y(), origin.z());
+        if (const auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(grid)) line += ", " + valueRangeText(*f);
+        else if (const auto v = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid)) line += ", " + valueRangeText(*v);
+        lines.push_back(line + "\n");
+        std::map<std::string, std::string>& m = metadata.emplace_back();
         for (auto it = grid->beginMeta(); it != grid->endMeta(); ++it)
-            if (it->first.rfind("sylva_", 0) == 0 && it->first != "sylva_parameters")
-                text += "  " + it->first + " = " + it->second->str() + "\n";
+            if (it->first.rfind("sylva_", 0) == 0 && it->first != "sylva_parameters") m[it->first] = it->second->str();
+    }
+    std::map<std::string, std::string> shared = metadata.empty() ? std::map<std::string, std::string>() : metadata.front();
+    for (const auto& m : metadata)
+        for (auto it = shared.begin(); it != shared.end();) {
+            const auto found = m.find(it->first);
+            it = found == m.end() || found->second != it->second ? shared.erase(it) : std::next(it);
+        }
+    if (metadata.size() < 2) shared.clear();
+    for (size_t g = 0; g < lines.size(); ++g) {
+        text += lines[g];
+        for (const auto& [key, value] : metadata[g])
+            if (!shared.count(key)) text += "  " + key + " = " + value + "\n";
+    }
+    if (!shared.empty()) {
+        text += "every grid:\n";
+        for (const auto& [key, value] : shared) text += "  " + key + " = " + value + "\n";
     }
     // What `sylva light --density` would make of it.
     try {

@@ -422,7 +422,7 @@ private Q_SLOTS:
         r = runSylva({"info", m_dir + "/d.vdb"});
         QVERIFY2(r.code == 0, qPrintable(r.err));
         QVERIFY2(r.out.contains("OpenVDB file") && r.out.contains("grid 'density': float, class fog volume") &&
-                     r.out.contains("grid 'wood_fraction'") && r.out.contains("sylva_dims = [16"),
+                     r.out.contains("grid 'wood_fraction'") && r.out.contains("every grid:\n  sylva_dims = [16"),
                  qPrintable(r.out));
 
         for (const char* input : {"d.npy", "d.vdb"}) {
