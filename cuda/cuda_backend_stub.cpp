@@ -4,7 +4,7 @@
 namespace sylva::cuda {
 
 namespace {
-const char* const kNoCuda = "this build has no CUDA backend (nvcc was not found at configure time)";
+const char* const kNoCuda = "this build has no CUDA backend (configured without CUDA: nvcc missing or older than 12, or SYLVA_ENABLE_CUDA=OFF)";
 }
 
 std::unique_ptr<Backend> makeCudaBackend(std::string* why)

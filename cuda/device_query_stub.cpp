@@ -6,7 +6,7 @@ namespace sylva::cuda {
 DeviceQuery queryDevices()
 {
     DeviceQuery q;
-    q.message = "this build has no CUDA backend (nvcc was not found at configure time)";
+    q.message = "this build has no CUDA backend (configured without CUDA: nvcc missing or older than 12, or SYLVA_ENABLE_CUDA=OFF)";
     return q;
 }
 

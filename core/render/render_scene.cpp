@@ -11,6 +11,7 @@
 #include "core/base/error.h"
 #include "core/render/prune.h"
 #include "core/render/tonemap.h"
+#include "core/terrain/height_field.h"
 
 namespace sylva {
 namespace {
@@ -114,6 +115,7 @@ void countBytes(RenderScene& rs)
     st.blasBytes = bytes[size_t(ArrayStat::Blas)] + bytes[size_t(kd ? ArrayStat::KdBlas : ArrayStat::BvhBlas)];
     st.wideBlasBytes = bytes[size_t(ArrayStat::WideBlas)];
     st.triangleBytes = bytes[size_t(kd ? ArrayStat::KdTriangles : ArrayStat::BvhTriangles)];
+    st.terrainBytes = bytes[size_t(ArrayStat::Terrain)];
 }
 
 void addCutout(const ImageRgba& img, RenderScene& rs, MaterialRecord& m)
@@ -185,11 +187,51 @@ RenderView RenderScene::view() const
     return v;
 }
 
-RenderScene buildSceneGeometry(const Scene& scene, const std::vector<SpeciesAssets>& assets, LodLevels lod, Progress* progress)
+namespace {
+
+// `scene` with its on-terrain instances standing on the terrain (world y = the surface's height at their
+// x, z + their y): `storage` holds that copy, or `scene` itself is returned when no instance stands on
+// the terrain. Throws Error naming an on-terrain instance without a terrain or off its footprint.
+const Scene& onTerrain(const Scene& scene, Scene& storage)
 {
+    bool any = false;
+    for (const InstanceDesc& d : scene.instances) any = any || d.onTerrain;
+    if (!any) return scene;
+    storage = scene;
+    const TerrainDesc& t = scene.terrain;
+    for (size_t i = 0; i < storage.instances.size(); ++i) {
+        InstanceDesc& d = storage.instances[i];
+        if (!d.onTerrain) continue;
+        if (!t.enabled() || !t.field) throw Error(std::string("render: instance ") + std::to_string(i) + " stands on the terrain, and the scene has none");
+        const double h = surfaceHeight(*t.field, d.position.x - t.origin.x, d.position.z - t.origin.z);
+        if (std::isnan(h))
+            throw Error(std::string("render: instance ") + std::to_string(i) + " at x " + std::to_string(d.position.x) + ", z " + std::to_string(d.position.z) +
+                        " stands off the terrain");
+        d.position.y += t.origin.y + h;
+        d.onTerrain = false;
+    }
+    return storage;
+}
+
+} // namespace
+
+RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAssets>& assets, LodLevels lod, Progress* progress)
+{
+    Scene lifted;
+    const Scene& scene = onTerrain(sceneIn, lifted);
     if (assets.size() != scene.species.size()) throw Error("render: one set of assets per species is required");
-    if (scene.instances.empty()) throw Error("render: the scene has no instances");
+    if (scene.instances.empty() && !scene.terrain.enabled()) throw Error("render: the scene has no instances and no terrain");
+    if (scene.terrain.enabled() && !scene.terrain.field)
+        throw Error("render: the terrain's heights were not loaded (" + scene.terrain.dem + ")");
     RenderScene rs;
+    if (scene.terrain.enabled()) {
+        const HeightField& hf = *scene.terrain.field;
+        rs.terrainHeights = hf.heights;
+        rs.terrainRanges = hf.ranges;
+        rs.base.terrain = hf.layout;
+        rs.m_stats.terrainSamplesX = hf.layout.nx;
+        rs.m_stats.terrainSamplesZ = hf.layout.nz;
+    }
     rs.accel = scene.render.accel;
     rs.lodLevels = lod;
     const size_t ns = assets.size(), ni = scene.instances.size();
@@ -522,9 +564,11 @@ RenderScene buildSceneGeometry(const Scene& scene, const std::vector<SpeciesAsse
     return rs;
 }
 
-bool hasLevelsFor(const RenderScene& rs, const Scene& scene)
+bool hasLevelsFor(const RenderScene& rs, const Scene& sceneIn)
 {
-    if (!(scene.render.pruneDistance > 0.0)) return true;
+    if (!(sceneIn.render.pruneDistance > 0.0)) return true;
+    Scene lifted;
+    const Scene& scene = onTerrain(sceneIn, lifted);
     if (rs.meshLevels.size() != scene.species.size()) return false;
     for (const RenderScene::MeshLevels& m : rs.meshLevels)
         if (m.levels == 0) return false;   // built without pruning: the levels were never made
@@ -536,10 +580,14 @@ bool hasLevelsFor(const RenderScene& rs, const Scene& scene)
     return true;
 }
 
-void placeTopLevel(RenderScene& rs, const Scene& scene, const glm::vec3& sunRadiance, int width, int height, int spp)
+void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRadiance, int width, int height, int spp)
 {
+    Scene lifted;
+    const Scene& scene = onTerrain(sceneIn, lifted);
     const size_t ni = scene.instances.size();
-    if (ni == 0) throw Error("render: the scene has no instances");
+    if (ni == 0 && !scene.terrain.enabled()) throw Error("render: the scene has no instances and no terrain");
+    if (scene.terrain.enabled() != !rs.terrainHeights.empty())
+        throw Error("render: the scene's terrain differs from the one the frame was built with");
     if (rs.meshLevels.size() != scene.species.size() || rs.groupGeometry.size() != scene.groups.size())
         throw Error("render: the scene's species or groups differ from the ones the frame was built with");
     for (size_t i = 0; i < ni; ++i) checkReference(scene, scene.instances[i], "instance " + std::to_string(i));
@@ -562,22 +610,37 @@ void placeTopLevel(RenderScene& rs, const Scene& scene, const glm::vec3& sunRadi
         st.instancedTriangles += rs.geometryTriangles[rec.geometry];
         if (d.group == kNoGroup) ++st.instancesPerLevel[size_t(level[i])];
     }
-    BvhBuildSettings ts;
-    ts.maxLeafSize = 2;
-    ts.wide = true;   // the host's 8-wide copy
-    Bvh tlas = buildBvh(boxes, ts);
-    rs.tlasNodes = std::move(tlas.nodes);
-    rs.tlasWideNodes = std::move(tlas.wideNodes);
-    rs.tlasOrder = std::move(tlas.primOrder);
-    st.tlasDepth = tlas.depth;
-    st.wideTlasDepth = tlas.wideDepth;
+    rs.tlasNodes.clear();
+    rs.tlasWideNodes.clear();
+    rs.tlasOrder.clear();
+    st.tlasDepth = st.wideTlasDepth = 0;
+    if (ni > 0) {
+        BvhBuildSettings ts;
+        ts.maxLeafSize = 2;
+        ts.wide = true;   // the host's 8-wide copy
+        Bvh tlas = buildBvh(boxes, ts);
+        rs.tlasNodes = std::move(tlas.nodes);
+        rs.tlasWideNodes = std::move(tlas.wideNodes);
+        rs.tlasOrder = std::move(tlas.primOrder);
+        st.tlasDepth = tlas.depth;
+        st.wideTlasDepth = tlas.wideDepth;
+    }
     st.instances = ni;
 
     // Environment, camera, settings.
     RenderView& b = rs.base;
-    b.groundEnabled = scene.ground.enabled;
+    const TerrainDesc& t = scene.terrain;
+    b.groundEnabled = scene.ground.enabled && !t.enabled();   // a terrain is the ground
     b.groundY = float(scene.ground.height - origin.y);
     b.groundColor = scene.ground.color;
+    b.terrainEnabled = t.enabled();
+    if (t.enabled()) {
+        b.terrainOrigin = glm::vec3(t.origin - origin);   // camera-relative, in double first
+        b.terrainRock = t.rock;
+        b.terrainSnow = t.snow;
+        b.terrainRockCos = float(std::cos(double(t.rockSlope) * 3.14159265358979323846 / 180.0));
+        b.terrainSnowY = t.snowLine > 0.0f ? float(double(t.snowLine) - t.origin.y) : 3.0e38f;
+    }
     const glm::vec3 sd = scene.sun.direction;
     if (!(glm::length(sd) > 0.0f)) throw Error("sun: direction must not be zero");
     b.sunDir = glm::normalize(sd);

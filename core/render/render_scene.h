@@ -35,6 +35,8 @@ struct AccelStats {
     size_t pruneBytes = 0;               // their BVH nodes, triangles and blocks (included in the sizes above)
     size_t instancesPerLevel[kMaxPruneLevels] = {};   // instances per level of detail, 0 = full
     size_t groups = 0, groupInstances = 0;   // instance groups and the instances inside them
+    size_t terrainBytes = 0;             // the terrain's heights and min/max pyramid
+    size_t terrainSamplesX = 0, terrainSamplesZ = 0;
 };
 
 // The pruned levels of detail a scene build makes meshes for: those the scene's camera gives some

@@ -9,6 +9,7 @@
 #include "core/accel/kdtree.h"
 #include "core/base/defines.h"
 #include "core/scene/scene.h"
+#include "core/terrain/height_field.h"
 
 namespace sylva {
 
@@ -165,11 +166,13 @@ struct CameraRecord {
     X(Scene, Both, glm::vec4, texels, None)                                                                    \
     X(Scene, Both, AlphaMaskRecord, alphaMasks, None)                                                          \
     X(Scene, Both, uint32_t, alphaBits, None)                                                                  \
-    X(Scene, Both, float, lighting, None)                  /* normalized LB photon density, 3 per node */
+    X(Scene, Both, float, lighting, None)                  /* normalized LB photon density, 3 per node */     \
+    X(Scene, Both, float, terrainHeights, Terrain)         /* the terrain's samples (core/terrain) */          \
+    X(Scene, Both, glm::vec2, terrainRanges, Terrain)      /* its min/max pyramid */
 
 enum class ArrayPart { Top, Scene };
 enum class ArrayWhere { Both, Host };
-enum class ArrayStat { Tlas, WideTlas, Instances, Blas, BvhBlas, KdBlas, WideBlas, KdTriangles, BvhTriangles, None };
+enum class ArrayStat { Tlas, WideTlas, Instances, Blas, BvhBlas, KdBlas, WideBlas, KdTriangles, BvhTriangles, Terrain, None };
 
 // Everything a frame needs, as pointers into flat arrays (host or device memory).
 struct RenderView {
@@ -181,7 +184,13 @@ struct RenderView {
     // environment
     bool groundEnabled;
     float groundY;                   // camera-relative height of the ground plane
-    glm::vec3 groundColor;
+    glm::vec3 groundColor;           // the ground plane's albedo, and the terrain's below the rock slope and snow line
+    bool terrainEnabled;
+    HeightFieldLayout terrain;       // of terrainHeights / terrainRanges
+    glm::vec3 terrainOrigin;         // camera-relative position of the terrain frame's origin (its first sample)
+    glm::vec3 terrainRock, terrainSnow;
+    float terrainRockCos;            // normals with a y below this are rock
+    float terrainSnowY;              // terrain-frame height above which the ground is snow (> max height: none)
     glm::vec3 sunDir;                // toward the sun, normalized
     glm::vec3 sunRadiance;           // blackbody colour (luminance 1) x intensity
     glm::vec3 sky;

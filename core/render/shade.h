@@ -129,6 +129,16 @@ SYLVA_HD inline SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, c
         s.albedo = v.groundColor;
         return s;
     }
+    if (hit.inst == kTerrainInst) {
+        // The triangle's normal (terrain frame = world orientation) facing the viewer; the colour from
+        // slope and altitude: rock where steeper than the rock slope, snow above the snow line.
+        s.ground = true;
+        const glm::vec3 n = heightFieldNormal(HeightFieldView{v.terrain, v.terrainHeights, v.terrainRanges}, hit.prim);
+        s.ng = glm::dot(n, s.viewDir) < 0.0f ? -n : n;
+        const float y = (s.p - v.terrainOrigin).y;
+        s.albedo = y > v.terrainSnowY ? v.terrainSnow : (n.y < v.terrainRockCos ? v.terrainRock : v.groundColor);
+        return s;
+    }
     const InstanceRecord in = hitInstance(v, hit);
     const SpeciesRecord& sp = v.species[v.geometries[in.geometry].species];
     const glm::uvec3 tv = v.triVerts[hit.prim];
@@ -173,9 +183,9 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
 {
     SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward)};
     const float nl = glm::dot(s.ng, v.sunDir);
-    if (s.ground) {
-        if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng))) out.local = v.groundColor * v.sunRadiance * nl;
-        out.indirect = v.groundColor * v.sky;
+    if (s.ground) {   // the plane or the terrain: Lambertian, lit by the sun and the uniform sky
+        if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng))) out.local = s.albedo * v.sunRadiance * nl;
+        out.indirect = s.albedo * v.sky;
         return out;
     }
     if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng, s.extent))) {

@@ -9,6 +9,7 @@
 namespace sylva {
 
 inline constexpr uint32_t kGroundPrim = 0xfffffffeu;   // Hit::prim of the ground plane
+inline constexpr uint32_t kTerrainInst = 0xfffffffdu;  // Hit::inst of the terrain (Hit::prim: its triangle)
 
 // Texel lookup in a 1-bit cut-out, uv wrapped (OBJ convention: v = 0 is the image's bottom row).
 SYLVA_HD SYLVA_INLINE bool alphaOpaque(const RenderView& v, uint32_t maskIndex, glm::vec2 uv)
@@ -264,7 +265,7 @@ SYLVA_HD inline bool traceLevel(Query& q, const BvhNode* nodes, const BvhNode8* 
 
 } // namespace trace_detail
 
-// Closest hit along the ray (camera-relative world frame) over the ground and the top level's instances,
+// Closest hit along the ray (camera-relative world frame) over the ground plane, the terrain and the top level's instances,
 // descending through instance groups to meshes traced through their BVHs (Kd = false) or kd-trees
 // (Kd = true; groups and the top level always use BVHs). AnyHit stops at the first accepted hit (shadow
 // rays). Cut-outs are tested up to alphaTestLimit. Returns true on a hit.
@@ -283,6 +284,20 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
             hit.prim = kGroundPrim;
             hit.t = tg;
             hit.u = hit.v = 0.0f;
+        }
+    }
+    // The terrain next (seed 002 section 4.1): its hit shortens the ray before the plants are traversed.
+    if (v.terrainEnabled) {
+        const Ray local{ray.org - v.terrainOrigin, ray.tmin, ray.dir, tmax};
+        uint32_t tri = kNoHit;
+        float u = 0.0f, w = 0.0f;
+        if (intersectHeightField<AnyHit>(HeightFieldView{v.terrain, v.terrainHeights, v.terrainRanges}, local, tmax, tri, u, w)) {
+            if (AnyHit) return true;
+            hit.prim = tri;
+            hit.inst = kTerrainInst;
+            hit.t = tmax;
+            hit.u = u;
+            hit.v = w;
         }
     }
     if (v.instanceCount == 0) return AnyHit ? false : hit.prim != kNoHit;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -45,13 +46,14 @@ inline constexpr uint32_t kNoGroup = 0xffffffffu;
 
 // One placed plant (or group of them). Metres of the parent frame (the world, or the group it belongs
 // to); rotation in degrees applied X, then Y, then Z (R = Rz * Ry * Rx), then uniform scale, then
-// translation. 48 bytes.
+// translation. 56 bytes.
 struct InstanceDesc {
     uint32_t species = 0;                // index into Scene::species (when group == kNoGroup)
     uint32_t group = kNoGroup;           // else: index into Scene::groups, placed as a whole
     glm::dvec3 position{0.0};            // world metres of the mesh origin (doubles: terrains are km wide)
     glm::vec3 rotationDeg{0.0f};
     float scale = 1.0f;                  // uniform, > 0
+    bool onTerrain = false;              // position.y is the height above the terrain's surface at (x, z)
 };
 
 // A reusable set of instances in its own frame (a tile of plants, a stand), placed by instances of the
@@ -67,6 +69,24 @@ struct GroundDesc {
     bool enabled = true;
     double height = 0.0;                 // world y of the plane, metres
     glm::vec3 color{0.18f, 0.15f, 0.10f};   // linear RGB albedo
+};
+
+struct HeightField;   // core/terrain/height_field.h
+
+// A terrain from a digital elevation model: a regular grid of heights, triangulated on the fly (two
+// triangles a cell), with a ground colour from altitude and slope. Replaces the ground plane.
+struct TerrainDesc {
+    std::string dem;                     // height image (16-bit PNG, float TIFF or EXR); absolute once read; empty = none
+    glm::dvec3 origin{0.0};              // world position of the DEM's first sample (row 0, column 0), metres
+    double spacing = 10.0;               // metres between samples (rows run along +z, columns along +x)
+    double heightScale = 1.0;            // metres per DEM unit (the integer value of integer images)
+    glm::vec3 rock{0.24f, 0.22f, 0.20f}; // albedo of slopes steeper than rockSlope degrees
+    glm::vec3 snow{0.80f, 0.82f, 0.86f}; // albedo above snowLine
+    float rockSlope = 35.0f;             // degrees
+    float snowLine = 0.0f;               // world y, metres; 0 = no snow
+    // The loaded heights (pipeline/io/dem_io: loadSceneTerrain), shared by the scene's copies; not in the file.
+    std::shared_ptr<const HeightField> field;
+    bool enabled() const { return !dem.empty(); }
 };
 
 // Sun: direction toward the sun (world, +Y up), blackbody colour temperature, intensity (scales radiance).
@@ -108,6 +128,7 @@ struct Scene {
     std::vector<InstanceDesc> instances;
     std::vector<GroupDesc> groups;       // instance groups (built in code today; scene files hold none yet)
     GroundDesc ground;
+    TerrainDesc terrain;                 // with a DEM, the terrain is the ground (the plane is not traced)
     SunDesc sun;
     glm::vec3 sky{0.55f, 0.70f, 0.95f};  // linear RGB radiance of the background
     CameraDesc camera;

@@ -11,17 +11,29 @@
 
 namespace sylva {
 
+double surfaceHeight(const HeightField& h, double x, double z)
+{
+    const HeightFieldLayout& L = h.layout;
+    const double u = x / double(L.dx), w = z / double(L.dz);
+    if (!(u >= 0.0 && u <= double(L.nx - 1) && w >= 0.0 && w <= double(L.nz - 1))) return std::nan("");
+    const uint32_t i = std::min(uint32_t(u), L.nx - 2), j = std::min(uint32_t(w), L.nz - 2);
+    const double s = u - double(i), r = w - double(j);
+    const double h00 = h.at(i, j), h10 = h.at(i + 1, j), h01 = h.at(i, j + 1), h11 = h.at(i + 1, j + 1);
+    // Triangle 2c = (p00, p11, p10) holds s >= r, triangle 2c + 1 = (p00, p01, p11) the rest.
+    return s >= r ? h00 + s * (h10 - h00) + r * (h11 - h10) : h00 + r * (h01 - h00) + s * (h11 - h01);
+}
+
 HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t nz, float dx, float dz)
 {
     if (nx < 2 || nz < 2)
-        throw Error("height field: " + std::to_string(nx) + " x " + std::to_string(nz) + " samples; it needs at least 2 x 2");
+        throw Error(std::string("height field: ") + std::to_string(nx) + " x " + std::to_string(nz) + " samples; it needs at least 2 x 2");
     if (heights.size() != size_t(nx) * size_t(nz))
-        throw Error("height field: " + std::to_string(heights.size()) + " heights for " + std::to_string(nx) + " x " + std::to_string(nz) + " samples");
+        throw Error(std::string("height field: ") + std::to_string(heights.size()) + " heights for " + std::to_string(nx) + " x " + std::to_string(nz) + " samples");
     if (!std::isfinite(dx) || !(dx > 0.0f) || !std::isfinite(dz) || !(dz > 0.0f))
-        throw Error("height field: sample spacing " + std::to_string(dx) + " x " + std::to_string(dz) + " must be finite and > 0");
+        throw Error(std::string("height field: sample spacing ") + std::to_string(dx) + " x " + std::to_string(dz) + " must be finite and > 0");
     for (size_t k = 0; k < heights.size(); ++k)
         if (!std::isfinite(heights[k]))
-            throw Error("height field: sample (" + std::to_string(k % nx) + ", " + std::to_string(k / nx) + ") is not a finite height");
+            throw Error(std::string("height field: sample (") + std::to_string(k % nx) + ", " + std::to_string(k / nx) + ") is not a finite height");
     HeightField h;
     HeightFieldLayout& L = h.layout;
     L.nx = nx;

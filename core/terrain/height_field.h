@@ -51,6 +51,10 @@ struct HeightField {
     size_t bytes() const { return heights.size() * sizeof(float) + ranges.size() * sizeof(glm::vec2); }
 };
 
+// The height of the triangulated surface at (x, z) of the terrain frame (on the triangle over that
+// point, as the traversal sees it); NaN outside the samples' footprint [0, (nx-1) dx] x [0, (nz-1) dz].
+double surfaceHeight(const HeightField& h, double x, double z);
+
 // Builds the pyramid over `heights` (nx * nz finite samples, row j = z). Throws Error when nx or nz < 2,
 // the sizes disagree, a sample is not finite, or a spacing is not finite and > 0.
 HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t nz, float dx, float dz);

@@ -71,6 +71,9 @@ void printStats(const AccelStats& st, const RenderTimings& timings, const Render
         for (size_t n : st.instancesPerLevel) std::printf(" %zu", n);
         std::printf("\n");
     }
+    if (st.terrainBytes > 0)
+        std::printf("terrain: %zu x %zu samples, %.0f triangles implied, %.1f MB of heights and min/max pyramid\n", st.terrainSamplesX,
+                    st.terrainSamplesZ, double(st.terrainSamplesX - 1) * double(st.terrainSamplesZ - 1) * 2.0, double(st.terrainBytes) / 1e6);
     if (r.mode == RenderMode::Ambient) std::printf("ambient constant %.4f\n", ambient);
 }
 

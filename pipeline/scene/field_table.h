@@ -349,7 +349,8 @@ public:
         return f;
     }
 
-    // A required array of objects, one a line when written; at least one (else the problem `empty`),
+    // A required array of objects, one a line when written; at least one (else the problem `empty`; null:
+    // an empty array is allowed),
     // at most max (else the problem `tooMany`).
     template <class Get, class U>
     Field<T>& array(const char* key, Get get, const Table<U>& sub, const char* empty, size_t max = std::numeric_limits<size_t>::max(),
@@ -359,7 +360,7 @@ public:
             key,
             [get, &sub, empty, max, tooMany](JsonReader& r, const QJsonValue& v, const KeyPath& p, T& t) {
                 const QJsonArray list = r.array(v, p);
-                if (list.isEmpty()) r.fail(p, empty);
+                if (list.isEmpty() && empty) r.fail(p, empty);
                 if (size_t(list.size()) > max) r.fail(p, tooMany);
                 auto& items = ref(get, t);
                 items.resize(size_t(list.size()));

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/terrain/height_field.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/scene/scene_species.h"
@@ -174,6 +175,9 @@ const Table<InstanceDesc>& instanceTable()
             .doc("`[rx, ry, rz]` or number", "degrees, applied X, then Y, then Z; a number is degrees about +Y")
             .shown("[0, 0, 0]");
         b.number("scale", &InstanceDesc::scale, above(0.0)).doc("number", "uniform, > 0");
+        b.boolean("on_terrain", &InstanceDesc::onTerrain)
+            .doc("bool", "`position`'s y is the height above the terrain's surface at its x, z (needs a `terrain`); false: world y")
+            .writtenIf([](const InstanceDesc& d) { return d.onTerrain; });
         return b.table;
     }();
     return table;
@@ -192,6 +196,39 @@ const Table<GroundDesc>& groundTable()
         b.color("color", &GroundDesc::color, 0.0f, 1.0f).doc("`[r, g, b]`", "albedo, each in [0, 1]").summarized([](const GroundDesc& g) {
             return g.enabled ? "albedo " + human3(g.color) : std::string();
         });
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<TerrainDesc>& terrainTable()
+{
+    static const Table<TerrainDesc> table = [] {
+        TableBuilder<TerrainDesc> b(Layout::Block);
+        b.custom(
+             "dem", [](JsonReader& r, const QJsonValue& v, const KeyPath& p, TerrainDesc& t) { t.dem = readFilePath(in(r), v, p, "a DEM image"); },
+             [](JsonWriter& w, const TerrainDesc& t, const KeyPath&, int) { w.string(storedMeshPath(t.dem, out(w).base)); })
+            .doc("string",
+                 "elevation image (16-bit PNG, 8-bit image, float TIFF or EXR; first channel); relative paths start at the scene "
+                 "file's folder")
+            .required("missing (required: the elevation image)")
+            .shown("required")
+            .summarized([](const TerrainDesc& t) { return t.dem; });
+        b.vector("origin", &TerrainDesc::origin)
+            .doc("`[x, y, z]`", "world position of the DEM's first sample (row 0, column 0), metres; rows run along +z, columns along +x")
+            .summarized([](const TerrainDesc& t) { return "origin " + human3(t.origin); });
+        b.number("spacing", &TerrainDesc::spacing, above(0.0)).doc("number", "metres between samples, > 0").summarized([](const TerrainDesc& t) {
+            return human(t.spacing) + " m spacing";
+        });
+        b.number("height_scale", &TerrainDesc::heightScale, above(0.0))
+            .doc("number", "metres per DEM unit (the stored integer of integer images, the value of float ones), > 0")
+            .summarized([](const TerrainDesc& t) { return human(t.heightScale) + " m per unit"; });
+        b.color("rock_color", &TerrainDesc::rock, 0.0f, 1.0f).doc("`[r, g, b]`", "albedo of slopes steeper than `rock_slope`, each in [0, 1]");
+        b.color("snow_color", &TerrainDesc::snow, 0.0f, 1.0f).doc("`[r, g, b]`", "albedo above `snow_line`, each in [0, 1]");
+        b.number("rock_slope", &TerrainDesc::rockSlope, Bounds{.lo = 0.0, .hi = 90.0, .unit = " degrees"})
+            .doc("number", "degrees from horizontal, [0, 90]; gentler slopes take `ground.color`");
+        b.number("snow_line", &TerrainDesc::snowLine, atLeast(0.0, " (metres; 0 = no snow)"))
+            .doc("number", "world y above which the ground is snow, metres; 0 = no snow");
         return b.table;
     }();
     return table;
@@ -372,13 +409,27 @@ const Table<Scene>& sceneTable()
             .doc("object", "at least one")
             .shown("")
             .summarized(describeSpecies);
-        b.array("instances", &Scene::instances, instanceTable(), "needs at least one instance")
-            .doc("object", "at least one")
+        b.array("instances", &Scene::instances, instanceTable(), nullptr)
+            .doc("object", "at least one, unless the scene has a terrain")
             .shown("")
             .summarized(describeInstances);
         b.object("ground", &Scene::ground, groundTable())
             .doc("object", "")
             .summarized(sectionLine("ground", [](const Scene& s) -> const GroundDesc& { return s.ground; }, groundTable()));
+        {
+            json::Field<Scene>& f = b.custom(
+                "terrain",
+                [](JsonReader& r, const QJsonValue& v, const KeyPath& p, Scene& sc) {
+                    readObject(r, r.object(v, p), p, sc.terrain, terrainTable());
+                },
+                [](JsonWriter& w, const Scene& sc, const KeyPath& p, int indent) { writeObject(w, sc.terrain, p, terrainTable(), indent); });
+            f.writeIf = [](const Scene& sc) { return sc.terrain.enabled(); };
+            f.nested = true;
+            f.children = [](std::vector<json::FieldDoc>& o, const std::string& path) { documentFields(terrainTable(), path, o); };
+            f.doc("object", "a terrain from a DEM (replaces the ground plane); optional")
+                .shown("")
+                .summarized(sectionLine("terrain", [](const Scene& sc) -> const TerrainDesc& { return sc.terrain; }, terrainTable()));
+        }
         b.object("sun", &Scene::sun, sunTable())
             .doc("object", "`direction`, or `elevation` with `azimuth`; not both")
             .summarized(sectionLine("sun", [](const Scene& s) -> const SunDesc& { return s.sun; }, sunTable()));
@@ -391,6 +442,12 @@ const Table<Scene>& sceneTable()
         b.object("render", &Scene::render, renderTable())
             .doc("object", "")
             .summarized(sectionLine("render", [](const Scene& s) -> const RenderSettings& { return s.render; }, renderTable()));
+        b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& path, Scene& sc) {
+            if (sc.instances.empty() && !sc.terrain.enabled()) r.fail(path.field("instances"), "needs at least one instance (or a terrain)");
+            for (size_t i = 0; i < sc.instances.size() && !sc.terrain.enabled(); ++i)
+                if (sc.instances[i].onTerrain)
+                    r.fail(path.field("instances").at(qsizetype(i)).field("on_terrain"), "needs a terrain (the scene has no \"terrain\")");
+        };
         return b.table;
     }();
     return table;

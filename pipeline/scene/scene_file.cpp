@@ -9,6 +9,7 @@
 
 #include "core/base/error.h"
 #include "pipeline/io/atomic_file.h"
+#include "pipeline/io/dem_io.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/scene/scene_fields.h"
 #include "pipeline/scene/scene_species.h"
@@ -44,7 +45,13 @@ Scene readSceneFile(const std::string& path)
         const QByteArray bytes = file.readAll();
         text.assign(bytes.constData(), size_t(bytes.size()));
     }
-    return parseScene(text, fs::absolute(path).parent_path().string(), path);
+    Scene scene = parseScene(text, fs::absolute(path).parent_path().string(), path);
+    try {
+        loadSceneTerrain(scene);   // the terrain's heights, read and checked with the file
+    } catch (const Error& e) {
+        throw Error(path + ": terrain.dem: " + e.what());
+    }
+    return scene;
 }
 
 std::string sceneToJson(const Scene& scene, const std::string& baseDir)

@@ -14,7 +14,8 @@ inline constexpr int kSceneFileVersion = 1;
 // name existing files; SpeciesDesc::meshPath holds the absolute, lexically normal path. Throws Error
 // "PATH: KEY.PATH: problem" (e.g. "forest.sylva.json: instances[3].scale: must be > 0, got -1") on
 // unreadable files, malformed JSON (with line and column), unknown or duplicate keys, wrong types,
-// out-of-range values and LB parameters that lb::validate refuses.
+// out-of-range values and LB parameters that lb::validate refuses. A terrain's DEM is read too
+// (loadSceneTerrain), and its problems reported the same way.
 Scene readSceneFile(const std::string& path);
 
 // As readSceneFile, from text. baseDir: folder relative mesh paths start from (empty: the current

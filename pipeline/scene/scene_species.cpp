@@ -44,7 +44,9 @@ void checkMeshOrGrow(SceneReadContext& r, const QJsonObject& o, const KeyPath& p
     if (!hasMesh && !hasGrow) r.fail(path, "needs \"mesh\" (a mesh file) or \"grow\" (a procedural tree)");
 }
 
-std::string readMeshPath(SceneReadContext& r, const QJsonValue& v, const KeyPath& path)
+std::string readMeshPath(SceneReadContext& r, const QJsonValue& v, const KeyPath& path) { return readFilePath(r, v, path, "a mesh file"); }
+
+std::string readFilePath(SceneReadContext& r, const QJsonValue& v, const KeyPath& path, const char* what)
 {
     const std::string text = r.string(v, path).toStdString();
     if (text.empty()) r.fail(path, "must not be empty");
@@ -55,7 +57,7 @@ std::string readMeshPath(SceneReadContext& r, const QJsonValue& v, const KeyPath
     const fs::file_status st = fs::status(abs, ec);
     if (st.type() == fs::file_type::not_found) r.fail(path, "no such file: " + abs);
     if (ec) r.fail(path, "cannot access " + abs + " (" + ec.message() + ")");
-    if (st.type() == fs::file_type::directory) r.fail(path, "is a folder, not a mesh file: " + abs);
+    if (st.type() == fs::file_type::directory) r.fail(path, std::string("is a folder, not ") + what + ": " + abs);
     if (st.type() != fs::file_type::regular) r.fail(path, "not a regular file: " + abs);
     return abs;
 }

@@ -19,6 +19,9 @@ void readSpeciesName(SceneReadContext& r, const QJsonValue& v, const json::KeyPa
 void checkMeshOrGrow(SceneReadContext& r, const QJsonObject& o, const json::KeyPath& path);
 // The absolute, lexically normal path of an existing regular file.
 std::string readMeshPath(SceneReadContext& r, const QJsonValue& v, const json::KeyPath& path);
+// A path to an existing regular file (`what`, e.g. "a DEM image", names it in messages), resolved against
+// the scene file's folder; absolute and lexically normal.
+std::string readFilePath(SceneReadContext& r, const QJsonValue& v, const json::KeyPath& path, const char* what);
 void writeMeshPath(SceneWriteContext& w, const SpeciesDesc& d, const json::KeyPath& path);
 // Mesh path relative to base when they share more than the root; absolute otherwise.
 std::string storedMeshPath(const std::string& mesh, const std::filesystem::path& base);

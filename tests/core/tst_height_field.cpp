@@ -169,6 +169,26 @@ private Q_SLOTS:
         }
     }
 
+    // surfaceHeight (instances standing on the terrain) is where a vertical ray meets the triangles.
+    void surfaceHeightMeetsVerticalRays()
+    {
+        const HeightField h = ridgeTerrain(61, 45, 1.5f, 0.75f, 4);
+        const HeightFieldView v = h.view();
+        std::mt19937 rng(9);
+        std::uniform_real_distribution<double> ux(0.0, 90.0), uz(0.0, 33.0);
+        for (int k = 0; k < 20000; ++k) {
+            const double x = k == 0 ? 90.0 : ux(rng), z = k == 0 ? 33.0 : uz(rng);   // the far corner too
+            Ray r{glm::vec3(float(x), 100.0f, float(z)), 0.0f, glm::vec3(0.0f, -1.0f, 0.0f), INFINITY};
+            float t = INFINITY, uu, vv;
+            uint32_t prim;
+            QVERIFY(intersectHeightField<false>(v, r, t, prim, uu, vv));
+            const double y = surfaceHeight(h, x, z);
+            QVERIFY2(std::fabs((100.0 - double(t)) - y) < 1e-4, qPrintable(QString("%1 %2: %3 vs %4").arg(x).arg(z).arg(100.0 - t).arg(y)));
+        }
+        QVERIFY(std::isnan(surfaceHeight(h, -0.01, 3.0)));
+        QVERIFY(std::isnan(surfaceHeight(h, 3.0, 33.01)));
+    }
+
     void badInputThrows()
     {
         QVERIFY_THROWS_EXCEPTION(Error, buildHeightField(std::vector<float>(3, 0.0f), 3, 1, 1.0f, 1.0f));
