@@ -10,27 +10,14 @@
 
 #include "core/grid/grid.h"
 #include "pipeline/io/npy.h"
+#include "tests/common/run_program.h"
 
 using namespace sylva;
 
 namespace {
 
-struct Run {
-    int code = -1;
-    QString out, err;
-};
-
-Run runSylva(const QStringList& args, const QString& cacheDir = {})
-{
-    QProcess p;
-    QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
-    if (!cacheDir.isEmpty()) env.insert("XDG_CACHE_HOME", cacheDir);
-    p.setProcessEnvironment(env);
-    p.start(SYLVA_CLI_PATH, args);
-    p.waitForFinished(600000);
-    return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
-            QString::fromUtf8(p.readAllStandardError())};
-}
+using test::Run;
+using test::runSylva;
 
 QString outDir()
 {

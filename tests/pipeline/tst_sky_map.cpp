@@ -22,6 +22,7 @@
 #include "core/sky/virtual_lights.h"
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/render/render_job.h"
+#include "tests/common/run_program.h"
 
 using namespace sylva;
 
@@ -67,19 +68,8 @@ std::string errorOf(const std::string& path)
     return {};
 }
 
-struct Run {
-    int code = -1;
-    QString out, err;
-};
-
-Run runSylva(const QStringList& args)
-{
-    QProcess p;
-    p.start(SYLVA_CLI_PATH, args);
-    p.waitForFinished(120000);
-    return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
-            QString::fromUtf8(p.readAllStandardError())};
-}
+using test::Run;
+using test::runSylva;
 
 double lumOf(glm::dvec3 c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 

@@ -28,24 +28,14 @@
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/exports.h"
+#include "tests/common/run_program.h"
 
 using namespace sylva;
 
 namespace {
 
-struct Run {
-    int code = -1;
-    QString out, err;
-};
-
-Run runSylva(const QStringList& args)
-{
-    QProcess p;
-    p.start(SYLVA_CLI_PATH, args);
-    p.waitForFinished(300000);
-    return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
-            QString::fromUtf8(p.readAllStandardError())};
-}
+using test::Run;
+using test::runSylva;
 
 // A density with empty borders (the low corner too, so the dims must come from the metadata), random
 // values with many zeros, and a block of 1.0 covering whole 8^3 leaves (stored as tiles).
