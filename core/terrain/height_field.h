@@ -101,10 +101,21 @@ SYLVA_HD SYLVA_INLINE bool intersectBlock(const HeightFieldView& h, uint32_t bi,
     const float ddx = si != 0 ? h.layout.dx / fabsf(dir.x) : big, ddz = sj != 0 ? h.layout.dz / fabsf(dir.z) : big;
     float nextX = si > 0 ? (float(ci + 1) * h.layout.dx - org.x) / dir.x : (si < 0 ? (float(ci) * h.layout.dx - org.x) / dir.x : big);
     float nextZ = sj > 0 ? (float(cj + 1) * h.layout.dz - org.z) / dir.z : (sj < 0 ? (float(cj) * h.layout.dz - org.z) / dir.z : big);
+    float tIn = t0;
     for (;;) {
-        if (intersectCell(h, uint32_t(ci), uint32_t(cj), org, dir, tmin, tmax, prim, u, v)) return true;
         const float tExit = minf(nextX, nextZ);
+        // Only where the ray's height over the cell's column overlaps the cell's samples (padded for
+        // rounding) can it meet the cell's triangles: most cells under a ray are skipped here.
+        const float ya = dir.y != 0.0f ? org.y + tIn * dir.y : org.y, yb = dir.y != 0.0f ? org.y + minf(tExit, t1) * dir.y : org.y;
+        const float s00 = sampleAt(h, uint32_t(ci), uint32_t(cj)), s10 = sampleAt(h, uint32_t(ci) + 1, uint32_t(cj));
+        const float s01 = sampleAt(h, uint32_t(ci), uint32_t(cj) + 1), s11 = sampleAt(h, uint32_t(ci) + 1, uint32_t(cj) + 1);
+        const float clo = minf(minf(s00, s10), minf(s01, s11)), chi = maxf(maxf(s00, s10), maxf(s01, s11));
+        const float pad = 1e-5f * (fabsf(ya) + fabsf(yb) + fabsf(clo) + fabsf(chi)) + 1e-6f;
+        if (!(minf(ya, yb) > chi + pad || maxf(ya, yb) < clo - pad) &&
+            intersectCell(h, uint32_t(ci), uint32_t(cj), org, dir, tmin, tmax, prim, u, v))
+            return true;
         if (tExit > t1 || tExit >= tmax) return false;
+        tIn = tExit;
         if (nextX < nextZ) {
             ci += si;
             nextX += ddx;
@@ -144,10 +155,11 @@ SYLVA_HD SYLVA_INLINE bool intersectHeightField(const HeightFieldView& h, const 
         const float tNear = rayBoxEntry(lo, hi, ray.org, inv, ray.tmin, tmax);
         if (!(tNear <= tmax)) continue;
         if (e.level == 0) {
-            // The ray's span over the block's columns (height ignored: the DDA starts at the entry point).
-            const float tx0 = (lo.x - ray.org.x) * inv.x, tx1 = (hi.x - ray.org.x) * inv.x;
-            const float tz0 = (lo.z - ray.org.z) * inv.z, tz1 = (hi.z - ray.org.z) * inv.z;
-            const float tFar = minf(minf(maxf(tx0, tx1), maxf(tz0, tz1)), tmax);
+            // Where the ray leaves the block's columns (height ignored); an axis the ray does not move
+            // along sets no limit (the box test above found the ray inside that slab).
+            const float txFar = ray.dir.x != 0.0f ? maxf((lo.x - ray.org.x) * inv.x, (hi.x - ray.org.x) * inv.x) : 3.0e38f;
+            const float tzFar = ray.dir.z != 0.0f ? maxf((lo.z - ray.org.z) * inv.z, (hi.z - ray.org.z) * inv.z) : 3.0e38f;
+            const float tFar = minf(minf(txFar, tzFar), tmax);
             if (height_detail::intersectBlock(h, e.bi, e.bj, ray.org, ray.dir, tNear, tFar, ray.tmin, tmax, prim, u, v)) {
                 got = true;
                 if (AnyHit) return true;
