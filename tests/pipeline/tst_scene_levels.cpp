@@ -89,7 +89,8 @@ NestedScenes makeNested(int levels, uint32_t seed)
     const int groups = levels - 1;
     for (int g = 0; g < groups; ++g) {
         GroupDesc gd;
-        gd.name = "g" + std::to_string(g);
+        gd.name = std::to_string(g);
+        gd.name.insert(gd.name.begin(), 'g');   // not "g" + to_string: GCC 12 warns falsely (-Wrestrict)
         const double spread = 6.0 * std::pow(2.5, g);
         const int n = g == 0 ? 4 : 3;
         for (int i = 0; i < n; ++i) {
