@@ -15,6 +15,7 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/view_frame.h"
+#include "tests/bench/bench_timing.h"
 #include "tests/gpu/egl_context.h"
 #if SYLVA_HAVE_CUDA
 #include "cuda/gl_interop.h"
@@ -26,19 +27,12 @@ using namespace sylva;
 
 namespace {
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+using bench::now;
 
 template <class F>
 double median(int reps, F&& f)
 {
-    std::vector<double> t;
-    for (int r = 0; r < reps; ++r) {
-        const double t0 = now();
-        f();
-        t.push_back(now() - t0);
-    }
-    std::sort(t.begin(), t.end());
-    return t[t.size() / 2];
+    return bench::timeReps(reps, f).median;
 }
 
 // A 128^3 crown-like grid: an ellipsoid of medium with random holes (as bench_lb's synthetic crown).

@@ -20,6 +20,7 @@
 #include "core/render/trace.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
+#include "tests/bench/bench_timing.h"
 
 #ifdef SYLVA_HAVE_EMBREE
 #include <embree3/rtcore.h>
@@ -29,25 +30,9 @@ using namespace sylva;
 
 namespace {
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
-
-// Median and minimum of repeated timings, seconds.
-struct Timing {
-    double median = 0.0, min = 0.0;
-};
-
-template <class F>
-Timing timeReps(int reps, F&& f)
-{
-    std::vector<double> t;
-    for (int r = 0; r < reps; ++r) {
-        const double t0 = now();
-        f();
-        t.push_back(now() - t0);
-    }
-    std::sort(t.begin(), t.end());
-    return {t[t.size() / 2], t.front()};
-}
+using bench::now;
+using bench::Timing;
+using bench::timeReps;
 
 // The renderer's schedule: oneTBB over 8x8 pixel tiles, 4 tiles per task. f(x0, y0, x1, y1).
 constexpr int kTile = 8;

@@ -18,6 +18,7 @@
 
 #include "core/terrain/height_field.h"
 #include "pipeline/io/dem_io.h"
+#include "tests/bench/bench_timing.h"
 
 #ifdef SYLVA_HAVE_EMBREE
 #include <embree3/rtcore.h>
@@ -27,19 +28,12 @@ using namespace sylva;
 
 namespace {
 
-double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+using bench::now;
 
 template <class F>
 double medianSeconds(int reps, F&& f)
 {
-    std::vector<double> t;
-    for (int r = 0; r < reps; ++r) {
-        const double t0 = now();
-        f();
-        t.push_back(now() - t0);
-    }
-    std::sort(t.begin(), t.end());
-    return t[t.size() / 2];
+    return bench::timeReps(reps, f).median;
 }
 
 struct Hit1 {
