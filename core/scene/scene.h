@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "core/lb/lb_params.h"
+#include "core/sky/sky.h"
 
 namespace sylva {
 
@@ -96,6 +97,29 @@ struct SunDesc {
     float intensity = 1.0f;
 };
 
+namespace sky {
+struct Sky;   // core/sky/sky_light.h
+}
+
+// The sky beyond the constant colour (Scene::sky): a Preetham sky or an HDR map, seen by camera rays that
+// leave the scene and lighting surfaces through `lights` virtual directional lights (core/sky), split over
+// `interleave` subsets by interleaved sampling. kind Constant (old files, the default): Scene::sky as
+// before, none of the rest is used.
+struct SkyDesc {
+    sky::SkyKind kind = sky::SkyKind::Constant;
+    double turbidity = 3.0;              // Preetham, 2 .. 10
+    float scale = 0.03f;                 // Preetham: kcd/m^2 -> the renderer's unit (0.03: a high sun near sun.intensity 1's)
+    std::string path;                    // HDR map (absolute once read; relative to the scene file in it)
+    float rotationDeg = 0.0f;            // map: about +Y, adds to every azimuth
+    float intensity = 1.0f;              // map: multiplies its pixels (and its sun)
+    int lights = 64;                     // N virtual lights (provisional default, see docs/SCENE.md)
+    int interleave = 8;                  // K subsets: N / K shadow rays per pixel and sample
+    bool sunFromMap = true;              // map: its sun found, taken out and made the sun (replacing `sun`)
+    // The built sky (pipeline/io/env_map_io: loadSceneSky), shared by the scene's copies; not in the file.
+    std::shared_ptr<const sky::Sky> built;
+    bool analytic() const { return kind != sky::SkyKind::Constant; }
+};
+
 // Pinhole camera. fovY in degrees (vertical field of view).
 struct CameraDesc {
     glm::dvec3 position{0.0, 1.7, -10.0};
@@ -130,10 +154,15 @@ struct Scene {
     GroundDesc ground;
     TerrainDesc terrain;                 // with a DEM, the terrain is the ground (the plane is not traced)
     SunDesc sun;
-    glm::vec3 sky{0.55f, 0.70f, 0.95f};  // linear RGB radiance of the background
+    glm::vec3 sky{0.55f, 0.70f, 0.95f};  // linear RGB radiance of the background (the constant sky: sky.color)
+    SkyDesc skyModel;                    // the rest of the sky block (Preetham, HDR map, virtual lights)
     CameraDesc camera;
     RenderSettings render;
 };
+
+// The constant background radiance a film's skyCover multiplies when composed: Scene::sky for the
+// constant sky, 0 for the others (their background is in SampleParts::background).
+inline glm::vec3 composeSky(const Scene& s) { return s.skyModel.analytic() ? glm::vec3(0.0f) : s.sky; }
 
 const char* renderModeName(RenderMode mode);      // "full", "local", "ambient", "lb"
 bool parseRenderMode(const std::string& name, RenderMode* out);

@@ -8,6 +8,9 @@
 #include <OpenImageIO/imageio.h>
 
 #include "core/base/error.h"
+#include "core/scene/scene.h"
+#include "core/sky/sky_light.h"
+#include "pipeline/render/render_job.h"
 
 namespace sylva {
 
@@ -48,6 +51,24 @@ std::string envMapCleanSummary(const std::string& path, const EnvMapFile& file)
                   "compression (isolated: -> the neighbours' maximum, %.4g luminance x sr removed; single-channel: -> grey)",
                   r.negative, r.nonFinite, r.spikes, r.spikeEnergy);
     return s + buf;
+}
+
+std::string loadSceneSky(Scene& scene)
+{
+    SkyDesc& d = scene.skyModel;
+    if (!d.analytic() || d.built) return std::string();
+    if (d.kind == sky::SkyKind::Preetham) {
+        sky::PreethamParams p;
+        p.turbidity = d.turbidity;
+        p.sunDirection = scene.sun.direction;
+        p.scale = d.scale;
+        d.built = std::make_shared<const sky::Sky>(sky::preethamSky(p, bundledCieTable()));
+        return std::string();
+    }
+    EnvMapFile f = readEnvMap(d.path);
+    const std::string summary = envMapCleanSummary(d.path, f);
+    d.built = std::make_shared<const sky::Sky>(sky::mapSky(std::move(f.map), d.rotationDeg, d.intensity, d.sunFromMap));
+    return summary;
 }
 
 } // namespace sylva

@@ -8,6 +8,8 @@
 
 namespace sylva {
 
+struct Scene;
+
 struct EnvMapFile {
     sky::EnvMap map;                  // cleaned: no negative, NaN or infinite values
     sky::EnvMapCleanReport cleaned;   // what the cleaning changed
@@ -20,5 +22,11 @@ EnvMapFile readEnvMap(const std::string& path, float spikeRatio = 16.0f);
 
 // One line for the log: "PATH: 512 x 256, cleaned: 1234 negative pixels -> 0, ..." (or "clean").
 std::string envMapCleanSummary(const std::string& path, const EnvMapFile& file);
+
+// Builds scene.skyModel.built for a Preetham sky (the scene's sun direction, turbidity, scale) or an HDR map
+// (readEnvMap of skyModel.path, its sun taken out when sunFromMap, rotated and scaled); nothing for the
+// constant sky or when already built. Returns the map's envMapCleanSummary line (empty for other skies).
+// Throws sylva::Error for a bad map or Preetham parameters the model refuses (sun below -10 degrees).
+std::string loadSceneSky(Scene& scene);
 
 } // namespace sylva

@@ -7,6 +7,8 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/sky/preetham.h"
+#include "core/sky/virtual_lights.h"
 #include "core/terrain/height_field.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/scene/scene_file.h"
@@ -286,13 +288,100 @@ const Table<SunDesc>& sunTable()
     return table;
 }
 
+const char* skyKindName(sky::SkyKind k)
+{
+    switch (k) {
+    case sky::SkyKind::Preetham: return "preetham";
+    case sky::SkyKind::Map: return "hdri";
+    default: return "constant";
+    }
+}
+
+bool parseSkyKind(const std::string& name, sky::SkyKind* out)
+{
+    for (sky::SkyKind k : {sky::SkyKind::Constant, sky::SkyKind::Preetham, sky::SkyKind::Map})
+        if (name == skyKindName(k)) {
+            *out = k;
+            return true;
+        }
+    return false;
+}
+
 const Table<Scene>& skyTable()
 {
     static const Table<Scene> table = [] {
         TableBuilder<Scene> b(Layout::Inline);
-        b.color("color", &Scene::sky, 0.0f, kNoUpperBound).doc("`[r, g, b]`", "background radiance, each >= 0").summarized([](const Scene& s) {
-            return "radiance " + human3(s.sky);
-        });
+        b.enumeration("kind", [](auto& s) -> auto& { return s.skyModel.kind; }, parseSkyKind, skyKindName, "sky kind", "constant, preetham, hdri")
+            .doc("string", "`constant` (`color` everywhere), `preetham` (Preetham et al. 1999, the sun's direction), `hdri` (an equirectangular map, `path`)")
+            .writtenIf([](const Scene& s) { return s.skyModel.analytic(); })
+            .summarized([](const Scene& s) { return std::string(skyKindName(s.skyModel.kind)) + " sky"; });
+        b.color("color", &Scene::sky, 0.0f, kNoUpperBound)
+            .doc("`[r, g, b]`", "the constant sky's radiance, each >= 0 (background and the ground's ambient light)")
+            .writtenIf([](const Scene& s) { return !s.skyModel.analytic(); })
+            .summarized([](const Scene& s) { return s.skyModel.analytic() ? std::string() : "radiance " + human3(s.sky); });
+        b.number("turbidity", [](auto& s) -> auto& { return s.skyModel.turbidity; }, Bounds{.lo = sky::kMinTurbidity, .hi = sky::kMaxTurbidity})
+            .doc("number", "`preetham`: atmospheric turbidity, 2 .. 10")
+            .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Preetham; })
+            .summarized([](const Scene& s) {
+                return s.skyModel.kind == sky::SkyKind::Preetham ? "turbidity " + human(s.skyModel.turbidity) : std::string();
+            });
+        b.number("scale", [](auto& s) -> auto& { return s.skyModel.scale; }, above(0.0))
+            .doc("number", "`preetham`: multiplies the model's kcd/m^2 (sky and sun), > 0; 0.03 puts a high sun near `sun.intensity` 1's")
+            .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Preetham; });
+        b.custom(
+             "path",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, Scene& sc) { sc.skyModel.path = readFilePath(in(r), v, p, "an environment map"); },
+             [](JsonWriter& w, const Scene& sc, const KeyPath&, int) { w.string(storedMeshPath(sc.skyModel.path, out(w).base)); })
+            .doc("string", "`hdri`: equirectangular map (`.exr`, `.hdr`; 2:1, row 0 at the zenith); relative paths start at the scene file's folder")
+            .shown("-")
+            .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Map; })
+            .summarized([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Map ? s.skyModel.path : std::string(); });
+        b.number("rotation_deg", [](auto& s) -> auto& { return s.skyModel.rotationDeg; })
+            .doc("number", "`hdri`: degrees about +Y, added to every azimuth of the map (its sun turns with it)")
+            .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Map; });
+        b.number("intensity", [](auto& s) -> auto& { return s.skyModel.intensity; }, atLeast(0.0))
+            .doc("number", "`hdri`: multiplies the map's pixels (and its sun), >= 0")
+            .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Map; });
+        b.boolean("sun_from_map", [](auto& s) -> auto& { return s.skyModel.sunFromMap; })
+            .doc("bool",
+                 "`hdri`: the map's sun (its brightest compact region) is taken out of the map and replaces `sun` (direction and "
+                 "radiance, x `sun.intensity`); false: the map lights as it is and `sun` stays")
+            .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Map; });
+        b.integer("lights", [](auto& s) -> auto& { return s.skyModel.lights; }, sky::kMinVirtualLights, sky::kMaxVirtualLights)
+            .doc("integer",
+                 "`preetham`, `hdri`: virtual directional lights the sky is split into (equal power), 1 .. 65536; the default 64 "
+                 "is provisional (not yet measured on the speed/accuracy front)")
+            .writtenIf([](const Scene& s) { return s.skyModel.analytic(); })
+            .summarized([](const Scene& s) {
+                return s.skyModel.analytic() ? std::to_string(s.skyModel.lights) + " lights / " + std::to_string(s.skyModel.interleave) + " subsets"
+                                             : std::string();
+            });
+        b.integer("interleave", [](auto& s) -> auto& { return s.skyModel.interleave; }, 1, sky::kMaxVirtualLights)
+            .doc("integer",
+                 "`preetham`, `hdri`: K subsets of the lights, one per pixel of each K-pixel block and cycled over the samples "
+                 "(lights / K shadow rays a pixel and sample; spp >= K uses every light in every pixel), 1 .. `lights`; default 8 "
+                 "(provisional)")
+            .writtenIf([](const Scene& s) { return s.skyModel.analytic(); });
+        b.table.after = [](JsonReader& r, const QJsonObject& o, const KeyPath& path, Scene& sc) {
+            const SkyDesc& d = sc.skyModel;
+            auto only = [&](const char* key, bool allowed, const char* kinds) {
+                if (o.contains(QLatin1String(key)) && !allowed)
+                    r.fail(path.field(key), std::string("only with kind ") + kinds + " (the sky is " + skyKindName(d.kind) + ")");
+            };
+            only("color", !d.analytic(), "constant");
+            only("turbidity", d.kind == sky::SkyKind::Preetham, "preetham");
+            only("scale", d.kind == sky::SkyKind::Preetham, "preetham");
+            only("path", d.kind == sky::SkyKind::Map, "hdri");
+            only("rotation_deg", d.kind == sky::SkyKind::Map, "hdri");
+            only("intensity", d.kind == sky::SkyKind::Map, "hdri");
+            only("sun_from_map", d.kind == sky::SkyKind::Map, "hdri");
+            only("lights", d.analytic(), "preetham or hdri");
+            only("interleave", d.analytic(), "preetham or hdri");
+            if (d.kind == sky::SkyKind::Map && d.path.empty()) r.fail(path.field("path"), "missing (required with kind hdri: the map)");
+            if (d.interleave > d.lights)
+                r.fail(path.field("interleave"), "must be at most lights (" + std::to_string(d.lights) + "), got " + std::to_string(d.interleave));
+            if (!std::isfinite(d.rotationDeg)) r.fail(path.field("rotation_deg"), "must be finite");
+        };
         return b.table;
     }();
     return table;

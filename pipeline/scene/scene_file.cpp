@@ -2,6 +2,7 @@
 // and writes them; AtomicFile puts the file in place.
 #include "pipeline/scene/scene_file.h"
 
+#include <cstdio>
 #include <filesystem>
 
 #include <QByteArray>
@@ -10,6 +11,7 @@
 #include "core/base/error.h"
 #include "pipeline/io/atomic_file.h"
 #include "pipeline/io/dem_io.h"
+#include "pipeline/io/env_map_io.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/scene/scene_fields.h"
 #include "pipeline/scene/scene_species.h"
@@ -50,6 +52,12 @@ Scene readSceneFile(const std::string& path)
         loadSceneTerrain(scene);   // the terrain's heights, read and checked with the file
     } catch (const Error& e) {
         throw Error(path + ": terrain.dem: " + e.what());
+    }
+    try {
+        const std::string cleaned = loadSceneSky(scene);   // the sky's map read and cleaned, or its Preetham model built
+        if (cleaned.find("cleaned:") != std::string::npos) std::fprintf(stderr, "sylva: sky.path: %s\n", cleaned.c_str());
+    } catch (const Error& e) {
+        throw Error(path + ": sky: " + e.what());
     }
     return scene;
 }
