@@ -38,8 +38,8 @@ namespace {
 
 QImage picture(const Film& film, const Scene& scene, const std::optional<RenderMode>& compare)
 {
-    return compare ? compareImage(film, scene.render.mode, *compare, scene.sky, scene.render.exposureKey)
-                   : filmImage(film, scene.render.mode, scene.sky, scene.render.exposureKey);
+    return compare ? compareImage(film, scene.render.mode, *compare, composeSky(scene), scene.render.exposureKey)
+                   : filmImage(film, scene.render.mode, composeSky(scene), scene.render.exposureKey);
 }
 
 } // namespace

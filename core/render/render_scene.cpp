@@ -11,6 +11,7 @@
 #include "core/base/error.h"
 #include "core/render/prune.h"
 #include "core/render/tonemap.h"
+#include "core/sky/sky_light.h"
 #include "core/terrain/height_field.h"
 
 namespace sylva {
@@ -215,6 +216,30 @@ const Scene& onTerrain(const Scene& scene, Scene& storage)
 
 } // namespace
 
+// The sky's part of the frame: a Preetham or map sky's per-ray parameters, its map pixels and its
+// virtual lights (N of them, K interleaved subsets). The constant sky: none (the frame as before).
+static void setSky(RenderScene& rs, const SkyDesc& d)
+{
+    rs.base.skyModel = sky::SkyView{};
+    rs.base.skyLightCount = 0;
+    rs.base.skyInterleave = sky::Interleave{};
+    rs.skyMap.clear();
+    rs.skyLights.clear();
+    if (!d.analytic()) return;
+    if (!d.built) throw Error("render: the scene's sky was not built (loadSceneSky)");
+    if (d.lights < sky::kMinVirtualLights || d.lights > sky::kMaxVirtualLights)
+        throw Error("render: sky.lights must be " + std::to_string(sky::kMinVirtualLights) + " .. " + std::to_string(sky::kMaxVirtualLights));
+    if (d.interleave < 1) throw Error("render: sky.interleave must be >= 1");
+    const sky::Sky& built = *d.built;
+    sky::SkyView v = built.view();
+    if (built.kind == sky::SkyKind::Map && built.map) rs.skyMap = built.map->rgb;
+    v.map.rgb = nullptr;   // the frame's skyMap array (host or device) is read instead
+    rs.base.skyModel = v;
+    rs.skyLights = sky::skyLights(built, d.lights);
+    rs.base.skyLightCount = uint32_t(rs.skyLights.size());
+    rs.base.skyInterleave = sky::makeInterleave(d.interleave, int(rs.skyLights.size()));
+}
+
 RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAssets>& assets, LodLevels lod, Progress* progress)
 {
     Scene lifted;
@@ -232,6 +257,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
         rs.m_stats.terrainSamplesX = hf.layout.nx;
         rs.m_stats.terrainSamplesZ = hf.layout.nz;
     }
+    setSky(rs, scene.skyModel);
     rs.accel = scene.render.accel;
     rs.lodLevels = lod;
     const size_t ns = assets.size(), ni = scene.instances.size();
@@ -645,7 +671,16 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     if (!(glm::length(sd) > 0.0f)) throw Error("sun: direction must not be zero");
     b.sunDir = glm::normalize(sd);
     b.sunRadiance = sunRadiance;
-    b.sky = scene.sky;
+    b.sky = composeSky(scene);
+    const SkyDesc& skyDesc = scene.skyModel;
+    if (skyDesc.analytic() && skyDesc.built && (skyDesc.kind == sky::SkyKind::Preetham || skyDesc.sunFromMap)) {
+        // The sky's own sun replaces the scene's (scaled by sun.intensity). Its radiance() is the irradiance
+        // facing it; the renderer's sun shows albedo x sunRadiance x cos, so the irradiance / pi (the same
+        // Lambertian surface the virtual lights light with albedo / pi x their power).
+        const sky::SkySun& sun = skyDesc.built->sun;
+        if (sun.present) b.sunDir = glm::normalize(sun.direction);
+        b.sunRadiance = sun.present ? sun.radiance() * (scene.sun.intensity / sky::kPi) : glm::vec3(0.0f);
+    }
     b.camera = makeCamera(scene.camera, width, height);
     b.width = width;
     b.height = height;

@@ -9,6 +9,8 @@
 #include "core/accel/kdtree.h"
 #include "core/base/defines.h"
 #include "core/scene/scene.h"
+#include "core/sky/sky.h"
+#include "core/sky/virtual_lights.h"
 #include "core/terrain/height_field.h"
 
 namespace sylva {
@@ -168,7 +170,9 @@ struct CameraRecord {
     X(Scene, Both, uint32_t, alphaBits, None)                                                                  \
     X(Scene, Both, float, lighting, None)                  /* normalized LB photon density, 3 per node */     \
     X(Scene, Both, float, terrainHeights, Terrain)         /* the terrain's samples (core/terrain) */          \
-    X(Scene, Both, glm::vec2, terrainRanges, Terrain)      /* its min/max pyramid */
+    X(Scene, Both, glm::vec2, terrainRanges, Terrain)      /* its min/max pyramid */                           \
+    X(Scene, Both, float, skyMap, None)                    /* the sky's map pixels (RGB, skyModel.map's) */    \
+    X(Scene, Both, sky::VirtualLight, skyLights, None)     /* the sky's virtual directional lights */
 
 enum class ArrayPart { Top, Scene };
 enum class ArrayWhere { Both, Host };
@@ -193,7 +197,10 @@ struct RenderView {
     float terrainSnowY;              // terrain-frame height above which the ground is snow (> max height: none)
     glm::vec3 sunDir;                // toward the sun, normalized
     glm::vec3 sunRadiance;           // blackbody colour (luminance 1) x intensity
-    glm::vec3 sky;
+    glm::vec3 sky;                   // the constant sky (skyModel.kind Constant), else 0
+    sky::SkyView skyModel;           // the sky camera rays see; Map: its pixels are skyMap (skyModel.map.rgb unused)
+    uint32_t skyLightCount;          // skyLights (0: the constant sky's ambient ground light as before)
+    sky::Interleave skyInterleave;   // the K subsets of skyLights over pixels and samples
     CameraRecord camera;
 
     // settings

@@ -12,7 +12,10 @@ namespace sylva {
 // for the render passes only (no mode reads them): normal = the unit surface normal facing the
 // viewer (world orientation; 0 for the sky), averaged over a pixel's samples like the parts, and
 // depth = the distance along the camera's forward axis to the surface, the nearest over the samples
-// (kSkyDepth for the sky). 56 bytes.
+// (kSkyDepth for the sky). background = the radiance of a Preetham or map sky where samples saw it
+// (averaged like the parts; 0 for the constant sky, which composes as skyCover x its colour). A
+// Preetham or map sky's light on surfaces (its virtual lights) is direct light: it is in `local`.
+// 68 bytes.
 struct SampleParts {
     glm::vec3 local;
     glm::vec3 indirect;
@@ -20,13 +23,15 @@ struct SampleParts {
     float skyCover;
     glm::vec3 normal;
     float depth;
+    glm::vec3 background;
 };
 
 // The depth of a sample that saw the sky (Cycles' value for the background of its Z pass).
 inline constexpr float kSkyDepth = 1e10f;
 
 // Linear RGB of a render mode from a pixel's parts: full = local + indirect, local = sun light only,
-// ambient = local + a constant ambient x albedo, lb = indirect only; plus the sky where samples saw it.
+// ambient = local + a constant ambient x albedo, lb = indirect only; plus the sky where samples saw it
+// (skyCover x the constant sky `sky`, composeSky(scene), plus the other skies' background).
 SYLVA_HD SYLVA_INLINE glm::vec3 composeSample(const SampleParts& p, RenderMode mode, const glm::vec3& sky, float ambient)
 {
     glm::vec3 c(0.0f);
@@ -36,7 +41,8 @@ SYLVA_HD SYLVA_INLINE glm::vec3 composeSample(const SampleParts& p, RenderMode m
     case RenderMode::Ambient: c = p.local + ambient * p.albedo; break;
     case RenderMode::Lb: c = p.indirect; break;
     }
-    return c + p.skyCover * sky;
+    const glm::vec3 withSky = c + p.skyCover * sky;
+    return withSky + p.background;
 }
 
 // Bilinear, wrapped texture lookup (v = 0 is the bottom row, as in OBJ).
@@ -77,13 +83,49 @@ SYLVA_HD inline glm::vec3 sampleLighting(const RenderView& v, const SpeciesRecor
     return out;
 }
 
-// Is the sun visible from camera-relative point p (already offset off its surface)?
-SYLVA_HD inline bool sunVisible(const RenderView& v, const glm::vec3& p)
+// Is the distant light toward unit `dir` visible from camera-relative point p (already offset off its
+// surface)? The alpha-tested any-hit query; always with shadows off.
+SYLVA_HD inline bool directionVisible(const RenderView& v, const glm::vec3& p, const glm::vec3& dir)
 {
     if (!v.shadows) return true;
-    Ray r{p, 0.0f, v.sunDir, 1e30f};
+    Ray r{p, 0.0f, dir, 1e30f};
     Hit h{};
     return !traceScene<true>(v, r, h);
+}
+
+// Is the sun visible from camera-relative point p (already offset off its surface)?
+SYLVA_HD inline bool sunVisible(const RenderView& v, const glm::vec3& p) { return directionVisible(v, p, v.sunDir); }
+
+// Radiance of the view's Preetham or map sky (without its sun) toward unit direction d; the map's pixels
+// are the skyMap array (on the device too).
+SYLVA_HD inline glm::vec3 viewSkyRadiance(const RenderView& v, const glm::vec3& d)
+{
+    if (v.skyModel.kind == sky::SkyKind::Map) {
+        sky::EnvMapView m = v.skyModel.map;
+        m.rgb = v.skyMap;
+        return sky::envMapRadiance(m, d);
+    }
+    return sky::skyRadiance(v.skyModel, d);
+}
+
+// Irradiance / pi at camera-relative point p (offset already) with unit normal n from the virtual sky
+// lights of the subset pixel (px, py) uses for its sample s (interleaved sampling, core/sky/
+// virtual_lights.h): each light of the subset weighted by K, one shadow ray each. A diffuse surface of
+// albedo a shows a x this. 0 without sky lights.
+SYLVA_HD inline glm::vec3 skyLightIrradiance(const RenderView& v, const glm::vec3& p, const glm::vec3& n, int px, int py, int s)
+{
+    glm::vec3 e(0.0f);
+    const int count = int(v.skyLightCount);
+    if (count == 0) return e;
+    const sky::Interleave& il = v.skyInterleave;
+    const int subset = sky::interleavedSubset(il, px, py, s);
+    const int size = sky::subsetSize(il, subset, count);
+    for (int k = 0; k < size; ++k) {
+        const sky::VirtualLight& l = v.skyLights[sky::subsetLight(il, subset, k)];
+        const float c = glm::dot(n, l.direction);
+        if (c > 0.0f && directionVisible(v, p, l.direction)) e += l.power * c;
+    }
+    return e * (sky::interleaveWeight(il) / sky::kPi);
 }
 
 // Offset along the geometric normal, scaled to the magnitude of the coordinates the hit was computed
@@ -171,20 +213,24 @@ SYLVA_HD SYLVA_INLINE void volumeStage(const RenderView& v, const Ray& ray, floa
     (void)v, (void)ray, (void)tEnd, (void)parts;
 }
 
-// Stage 4, background and lights: a ray that hit nothing sees the sky; a surface gets the sun (with a
-// shadow ray) and its indirect light (LB on meshes, the uniform sky on the Lambertian ground).
+// Stage 4, background and lights: a ray that hit nothing sees the sky (the constant one through
+// skyCover, a Preetham or map sky's radiance toward the ray in `background`); a surface gets the sun
+// (with a shadow ray), the sky's virtual lights of its interleaved subset (shadow rays, into `local`)
+// and its indirect light (LB on meshes, the uniform constant sky on the Lambertian ground).
 SYLVA_HD SYLVA_INLINE SampleParts backgroundStage(const RenderView& v, const Ray& ray)
 {
-    (void)v, (void)ray;
-    return SampleParts{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 1.0f, glm::vec3(0.0f), kSkyDepth};
+    SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 1.0f, glm::vec3(0.0f), kSkyDepth, glm::vec3(0.0f)};
+    if (v.skyModel.kind != sky::SkyKind::Constant) out.background = viewSkyRadiance(v, ray.dir);
+    return out;
 }
 
-SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& s)
+SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& s, int px = 0, int py = 0, int sample = 0)
 {
-    SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward)};
+    SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
     const float nl = glm::dot(s.ng, v.sunDir);
     if (s.ground) {   // the plane or the terrain: Lambertian, lit by the sun and the uniform sky
         if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng))) out.local = s.albedo * v.sunRadiance * nl;
+        if (v.skyLightCount > 0) out.local += s.albedo * skyLightIrradiance(v, offsetPoint(s.p, s.ng), s.ng, px, py, sample);
         out.indirect = s.albedo * v.sky;
         return out;
     }
@@ -197,16 +243,17 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
         }
         out.local = c * v.sunRadiance;
     }
+    if (v.skyLightCount > 0) out.local += s.albedo * skyLightIrradiance(v, offsetPoint(s.p, s.ng, s.extent), s.ng, px, py, sample);
     out.indirect = s.albedo * s.lighting * v.sunRadiance * v.indirectScale;
     return out;
 }
 
-// Shades one camera ray: the stages in order.
-SYLVA_HD inline SampleParts shadeRay(const RenderView& v, const Ray& ray)
+// Shades one camera ray, sample s of pixel (px, py) (which subset of the sky lights it uses): the stages in order.
+SYLVA_HD inline SampleParts shadeRay(const RenderView& v, const Ray& ray, int px = 0, int py = 0, int s = 0)
 {
     Hit hit{};
     const bool found = intersectStage(v, ray, hit);
-    SampleParts out = found ? lightStage(v, surfaceStage(v, ray, hit)) : backgroundStage(v, ray);
+    SampleParts out = found ? lightStage(v, surfaceStage(v, ray, hit), px, py, s) : backgroundStage(v, ray);
     volumeStage(v, ray, found ? hit.t : ray.tmax, out);
     return out;
 }
@@ -254,16 +301,17 @@ SYLVA_HD SYLVA_INLINE glm::vec2 samplePosition(int px, int py, int s, int spp)
 // All samples of one pixel, box-filtered.
 SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
 {
-    SampleParts sum{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, glm::vec3(0.0f), kSkyDepth};
+    SampleParts sum{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, glm::vec3(0.0f), kSkyDepth, glm::vec3(0.0f)};
     for (int s = 0; s < v.spp; ++s) {
         const glm::vec2 pos = samplePosition(px, py, s, v.spp);
-        const SampleParts p = shadeRay(v, cameraRay(v, pos.x, pos.y));
+        const SampleParts p = shadeRay(v, cameraRay(v, pos.x, pos.y), px, py, s);
         sum.local += p.local;
         sum.indirect += p.indirect;
         sum.albedo += p.albedo;
         sum.skyCover += p.skyCover;
         sum.normal += p.normal;
         sum.depth = fminf(sum.depth, p.depth);
+        sum.background += p.background;
     }
     const float inv = 1.0f / float(v.spp);
     sum.local *= inv;
@@ -271,6 +319,7 @@ SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
     sum.albedo *= inv;
     sum.skyCover *= inv;
     sum.normal *= inv;
+    sum.background *= inv;
     return sum;
 }
 

@@ -125,11 +125,11 @@ int runRender(const Args& args)
         const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get());
         bar.finish();
         if (passes) {
-            const RenderPasses layers = renderPasses(result.film, r.mode, scene.sky);
+            const RenderPasses layers = renderPasses(result.film, r.mode, composeSky(scene));
             writeRenderPasses(out, layers);
             ambient = layers.ambient;
         } else {
-            const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, scene.sky, &ambient);
+            const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, composeSky(scene), &ambient);
             writeRender(out, linear, r.width, r.height, r.exposureKey);
         }
         st = result.stats;

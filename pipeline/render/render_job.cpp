@@ -266,7 +266,7 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
     const bool ambientMode = r.mode == RenderMode::Ambient;
     // Between the passes each pixel waits on disk: its composed linear RGB, or for ambient (whose
     // constant needs the whole frame) local, albedo and sky cover.
-    const size_t floatsPerPixel = ambientMode ? 7 : 3;
+    const size_t floatsPerPixel = ambientMode ? 10 : 3;
     const size_t width = size_t(r.width), height = size_t(r.height);
     const double tempBytes = double(width * height * floatsPerPixel * sizeof(float));
     std::filesystem::path dir = std::filesystem::absolute(outPath).parent_path();
@@ -322,16 +322,17 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
             addAmbientSums(film, &indirectSum, &albedoSum);
             for (size_t p = 0; p < film.pixels.size(); ++p) {
                 const SampleParts& s = film.pixels[p];
-                float* d = &buf[p * 7];
+                float* d = &buf[p * 10];
                 for (int c = 0; c < 3; ++c) {
                     d[c] = s.local[c];
                     d[3 + c] = s.albedo[c];
+                    d[7 + c] = s.background[c];
                 }
                 d[6] = s.skyCover;
             }
         } else {
             for (size_t p = 0; p < film.pixels.size(); ++p) {
-                const glm::vec3 c = composeSample(film.pixels[p], r.mode, scene.sky, 0.0f);
+                const glm::vec3 c = composeSample(film.pixels[p], r.mode, composeSky(scene), 0.0f);
                 for (int k = 0; k < 3; ++k) buf[p * 3 + size_t(k)] = c[k];
             }
             if (!linearOut) logAverage.add(buf.data(), film.pixels.size(), 3);
@@ -355,12 +356,13 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
             return pixels;
         }
         for (size_t p = 0; p < pixels; ++p) {
-            const float* d = &buf[p * 7];
-            SampleParts s;
+            const float* d = &buf[p * 10];
+            SampleParts s{};
             s.local = glm::vec3(d[0], d[1], d[2]);
             s.albedo = glm::vec3(d[3], d[4], d[5]);
             s.skyCover = d[6];
-            const glm::vec3 c = composeSample(s, RenderMode::Ambient, scene.sky, out.ambient);
+            s.background = glm::vec3(d[7], d[8], d[9]);
+            const glm::vec3 c = composeSample(s, RenderMode::Ambient, composeSky(scene), out.ambient);
             for (int k = 0; k < 3; ++k) rgb[p * 3 + size_t(k)] = c[k];
         }
         return pixels;

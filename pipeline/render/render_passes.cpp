@@ -40,7 +40,7 @@ RenderPasses renderPasses(const Film& film, RenderMode mode, const glm::vec3& sk
         out.diffDir[i] = direct ? divideByColour(p.local, p.albedo) : glm::vec3(0.0f);
         out.diffInd[i] = divideByColour(indirect, p.albedo);
         out.diffCol[i] = p.albedo;
-        out.env[i] = p.skyCover * sky;
+        out.env[i] = p.skyCover * sky + p.background;
         out.normal[i] = p.normal;
         out.depth[i] = p.depth;
         out.alpha[i] = 1.0f - p.skyCover;

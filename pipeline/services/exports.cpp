@@ -36,9 +36,9 @@ void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, 
     const Film film = backend ? backend->render(rs, &traceProgress) : renderFilm(rs.view(), &traceProgress);
     if (progress) progress->report(0.96, "writing");
     if (passes) {
-        writeRenderPasses(path, renderPasses(film, scene.render.mode, scene.sky));
+        writeRenderPasses(path, renderPasses(film, scene.render.mode, composeSky(scene)));
     } else {
-        const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, scene.sky);
+        const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, composeSky(scene));
         writeRender(path, linear, film.width, film.height, scene.render.exposureKey);
     }
     if (progress) progress->report(1.0, "written");
