@@ -2,8 +2,12 @@
 // close camera, small enough for CI.
 #pragma once
 
+#include <vector>
+
 #include "core/lb/lb_params.h"
+#include "core/render/render_scene.h"
 #include "core/scene/scene.h"
+#include "pipeline/grow/tree_grower.h"
 
 namespace sylva::test {
 
@@ -35,6 +39,19 @@ inline Scene smallForest()
     s.render.height = 80;
     s.render.spp = 4;
     return s;
+}
+
+// One small grown shrub (1,500 triangles, seed 3) as the assets of a one-species scene, unlit (the
+// indirect light as in open sky): the tests that need a plant but no LB solve.
+inline std::vector<SpeciesAssets> oneShrub()
+{
+    GrowOptions a;
+    a.species = TreeSpecies::Shrub;
+    a.targetTriangles = 1500;
+    a.seed = 3;
+    std::vector<SpeciesAssets> assets(1);
+    assets[0].mesh = growTree(a).mesh;
+    return assets;
 }
 
 } // namespace sylva::test

@@ -19,6 +19,7 @@
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/scene/scene_file.h"
+#include "tests/pipeline/small_forest.h"
 
 using namespace sylva;
 
@@ -26,16 +27,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::vector<SpeciesAssets> oneShrub()
-{
-    GrowOptions a;
-    a.species = TreeSpecies::Shrub;
-    a.targetTriangles = 1500;
-    a.seed = 3;
-    std::vector<SpeciesAssets> assets(1);
-    assets[0].mesh = growTree(a).mesh;
-    return assets;
-}
+using test::oneShrub;
 
 // A white ground plane seen from above, the one shrub the renderer needs far below it (never in view,
 // never in a shadow ray's way: those all go up); the sun off. The sky is set by the caller.

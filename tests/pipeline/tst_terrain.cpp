@@ -17,21 +17,13 @@
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/io/dem_io.h"
 #include "pipeline/scene/scene_file.h"
+#include "tests/pipeline/small_forest.h"
 
 using namespace sylva;
 
 namespace {
 
-std::vector<SpeciesAssets> oneShrub()
-{
-    GrowOptions a;
-    a.species = TreeSpecies::Shrub;
-    a.targetTriangles = 1500;
-    a.seed = 3;
-    std::vector<SpeciesAssets> assets(1);
-    assets[0].mesh = growTree(a).mesh;
-    return assets;
-}
+using test::oneShrub;
 
 // Shrubs on a patch of ground seen from above at an angle, the whole view on the ground.
 Scene shrubPatch()
