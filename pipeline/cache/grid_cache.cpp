@@ -689,19 +689,32 @@ std::string cacheSettingsPath()
     return settings.fileName().toStdString();
 }
 
+namespace {
+
+// The non-negative number a size or duration starts with ("1.5G", "30d"): its value and the unit text
+// after it; false when the text does not start with one (signs refused).
+bool leadingNumber(const std::string& t, double* value, std::string* unit)
+{
+    size_t used = 0;
+    try {
+        *value = std::stod(t, &used);
+    } catch (...) {
+        return false;
+    }
+    if (used == 0 || !std::isfinite(*value) || *value < 0.0 || t[0] == '-' || t[0] == '+') return false;
+    *unit = t.substr(used);
+    return true;
+}
+
+} // namespace
+
 std::optional<uint64_t> parseByteSize(std::string_view text)
 {
     std::string t(text);
     while (!t.empty() && std::isspace((unsigned char)t.back())) t.pop_back();
-    size_t used = 0;
     double value = 0.0;
-    try {
-        value = std::stod(t, &used);
-    } catch (...) {
-        return std::nullopt;
-    }
-    if (used == 0 || !std::isfinite(value) || value < 0.0 || t[0] == '-' || t[0] == '+') return std::nullopt;
-    std::string unit = t.substr(used);
+    std::string unit;
+    if (!leadingNumber(t, &value, &unit)) return std::nullopt;
     while (!unit.empty() && unit.front() == ' ') unit.erase(unit.begin());
     for (char& c : unit) c = char(std::tolower((unsigned char)c));
     if (unit.size() >= 2 && unit.substr(unit.size() - 2) == "ib") unit.resize(unit.size() - 2);
@@ -722,15 +735,9 @@ std::optional<uint64_t> parseByteSize(std::string_view text)
 std::optional<int64_t> parseDuration(std::string_view text)
 {
     const std::string t(text);
-    size_t used = 0;
     double value = 0.0;
-    try {
-        value = std::stod(t, &used);
-    } catch (...) {
-        return std::nullopt;
-    }
-    if (used == 0 || !std::isfinite(value) || value < 0.0 || t[0] == '-' || t[0] == '+') return std::nullopt;
-    const std::string unit = t.substr(used);
+    std::string unit;
+    if (!leadingNumber(t, &value, &unit)) return std::nullopt;
     double scale = 0.0;
     if (unit.empty() || unit == "d") scale = 86400.0;
     else if (unit == "s") scale = 1.0;

@@ -30,12 +30,6 @@ namespace {
 
 using bench::now;
 
-template <class F>
-double medianSeconds(int reps, F&& f)
-{
-    return bench::timeReps(reps, f).median;
-}
-
 struct Hit1 {
     float t;
     uint32_t prim;
@@ -210,12 +204,12 @@ int main(int argc, char** argv)
     const glm::vec3 target(float(sizeX * 0.7), range.x, float(sizeZ * 0.8));
     const std::vector<Ray> cam = cameraRays(eye, target, 60.0f, width, height);
     std::vector<Hit1> ours(cam.size());
-    const double ourPrimary = medianSeconds(reps, [&] { traceOurs(view, cam, ours, false); });
+    const double ourPrimary = bench::timeReps(reps, [&] { traceOurs(view, cam, ours, false); }).median;
     size_t active = 0;
     const glm::vec3 sun = glm::normalize(glm::vec3(-0.6f, 0.45f, -0.4f));
     const std::vector<Ray> shadow = shadowRays(cam, ours, sun, &active);
     std::vector<Hit1> oursShadow(shadow.size());
-    const double ourShadow = medianSeconds(reps, [&] { traceOurs(view, shadow, oursShadow, true); });
+    const double ourShadow = bench::timeReps(reps, [&] { traceOurs(view, shadow, oursShadow, true); }).median;
     size_t hitCount = 0, occluded = 0;
     for (const Hit1& x : ours) hitCount += x.prim != kNoHit;
     for (const Hit1& x : oursShadow) occluded += x.prim != kNoHit;
@@ -231,8 +225,8 @@ int main(int argc, char** argv)
         embreeBuild = peer.buildSeconds;
         embreeMB = double(peer.bytes) / 1e6;
         std::vector<Hit1> theirs(cam.size()), theirsShadow(shadow.size());
-        const double p = medianSeconds(reps, [&] { peer.trace(cam, theirs, false); });
-        const double s = medianSeconds(reps, [&] { peer.trace(shadow, theirsShadow, true); });
+        const double p = bench::timeReps(reps, [&] { peer.trace(cam, theirs, false); }).median;
+        const double s = bench::timeReps(reps, [&] { peer.trace(shadow, theirsShadow, true); }).median;
         embreePrimaryRate = double(cam.size()) / p / 1e6;
         embreeShadowRate = double(shadow.size()) / s / 1e6;
         for (size_t i = 0; i < cam.size(); ++i) {
