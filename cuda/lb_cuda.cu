@@ -199,7 +199,7 @@ public:
             m_totB.allocate(m_nodes * size_t(m_solves), "totals");
         }
         // Boundary condition for unit intensity; the solve is linear in intensity (scaled at the end).
-        const std::vector<float> bc = lb::boundaryDistribution(m_params.sun);
+        const std::vector<float> bc = lb::boundaryOf(m_params);
         check(cudaMemcpyToSymbol(c_bc, bc.data(), sizeof(float) * kDirections), "boundary condition to constant memory");
         for (DeviceBuffer<S>* copy : {&m_a, &m_b})
             initKernel<S><<<blocksFor(count, kThreads), kThreads>>>(copy->get(), count, m_X, m_Y, m_Z,

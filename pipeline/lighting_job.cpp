@@ -51,6 +51,7 @@ CacheKey lightKey(const DensityGrid& density, const lb::LbParams& p)
     const glm::dvec3 sun = glm::normalize(glm::dvec3(p.sun));   // in double: a float length can overflow
     key.add("sun x", sun.x).add("sun y", sun.y).add("sun z", sun.z);
     key.add("zero f0", int64_t(p.zeroF0));
+    if (!p.boundary.empty()) key.add("boundary", bytesOf(p.boundary));   // else the sun's, keyed above
     key.add("brown threshold", double(p.brownThreshold));
     key.add("storage", int64_t(p.storage == lb::Storage::Fp16 ? 16 : 32));
     key.add("warm start", int64_t(p.warmStart));

@@ -90,6 +90,12 @@ void validate(const LbParams& params)
     for (int c = 0; c < 3; ++c)
         if (!std::isfinite(params.intensity[c]) || params.intensity[c] < 0.0f)
             throw Error(std::string("invalid sun intensity for channel ") + names[c] + ": must be finite and >= 0");
+    if (!params.boundary.empty()) {
+        if (params.boundary.size() != size_t(kDirections))
+            throw Error("invalid LB boundary distribution: " + std::to_string(params.boundary.size()) + " values, expected 19");
+        for (float v : params.boundary)
+            if (!std::isfinite(v) || v < 0.0f) throw Error("invalid LB boundary distribution: values must be finite and >= 0");
+    }
     if (params.steps < 0) throw Error("invalid step count " + std::to_string(params.steps) + ": must be >= 1");
     if (params.stepsPerEdge < 1 || params.stepsPerEdge > 64)
         throw Error("invalid steps per edge " + std::to_string(params.stepsPerEdge) + ": must be in [1, 64]");

@@ -38,6 +38,10 @@ struct LbParams {
     int blockSteps = 0;                        // steps per cache-blocked wavefront; 0 = sized to the cache
     float brownThreshold = 0.5f;               // wood fraction above which a node is brown (g = -1)
     Storage storage = Storage::Fp32;
+    // The boundary distribution f_m for unit intensity, m = 0..18 (19 values, finite, >= 0): empty = the
+    // sun's max(0, n_m . d) (LB_MODEL.md "Boundary condition"). A sky boundary, a relighting basis
+    // direction (lb_basis.h) or a sum of suns goes here; every channel gets it x its intensity.
+    std::vector<float> boundary;
 };
 
 struct Preset {

@@ -242,7 +242,7 @@ public:
     void setSolves(const std::vector<ChannelParams>& solves, bool interiorFollows) override
     {
         // Boundary condition for unit intensity; the solve is linear in intensity (scaled at the end).
-        const std::vector<float> bc = boundaryDistribution(m_params.sun);
+        const std::vector<float> bc = boundaryOf(m_params);
         const size_t count = size_t(m_X) * size_t(m_Y) * size_t(kDirections) * size_t(m_Z);
         S bcValue[kDirections];
         for (int m = 0; m < kDirections; ++m) bcValue[m] = toStorage<S>(bc[size_t(m)]);
@@ -636,6 +636,11 @@ std::vector<float> boundaryDistribution(const glm::vec3& sun)
         bc[size_t(m)] = float(std::max(0.0, glm::dot(n, d)));
     }
     return bc;
+}
+
+std::vector<float> boundaryOf(const LbParams& params)
+{
+    return params.boundary.empty() ? boundaryDistribution(params.sun) : params.boundary;
 }
 
 std::unique_ptr<LbDevice> makeCpuDevice() { return std::make_unique<CpuDevice>(); }

@@ -33,5 +33,7 @@ void advance(const DensityGrid& density, const LbParams& params, std::vector<flo
 
 // Boundary value f_m = max(0, n_m . d) for unit intensity, d = -normalize(sun) (LB_MODEL.md "Boundary condition").
 std::vector<float> boundaryDistribution(const glm::vec3& sun);
+// The boundary a solve with these parameters uses, for unit intensity: params.boundary, or the sun's.
+std::vector<float> boundaryOf(const LbParams& params);
 
 } // namespace sylva::lb

@@ -249,7 +249,7 @@ void tracePath(const Medium& md, const std::vector<Beam>& beams, const std::vect
 
 std::vector<Beam> incidentBeams(const lb::LbParams& params, Incidence incidence, const glm::dvec3& extent)
 {
-    const std::vector<float> bc = lb::boundaryDistribution(params.sun);
+    const std::vector<float> bc = lb::boundaryOf(params);
     std::vector<std::pair<glm::dvec3, double>> dirs;   // direction, fluence at unit intensity
     if (incidence == Incidence::LatticeBeams) {
         for (int m = 1; m < lb::kDirections; ++m)
@@ -414,7 +414,7 @@ ReferenceResult solveReference(const DensityGrid& density, const lb::LbParams& p
 double unobstructedValue(const lb::LbParams& params, int channel)
 {
     double total = 0.0;
-    for (float v : lb::boundaryDistribution(params.sun)) total += double(v);
+    for (float v : lb::boundaryOf(params)) total += double(v);
     return double(params.intensity[channel]) * total;
 }
 
