@@ -19,7 +19,9 @@ PACKAGES=(cmake ninja-build ccache g++ pkg-config
   # sylva-studio's GL tests run under Xvfb with Mesa's software OpenGL
   qt6-qpa-plugins xvfb xauth libgl1-mesa-dri
   # sylva study draws the plots of docs/ACCURACY.md
-  gnuplot-nox)
+  gnuplot-nox
+  # sylva render --mpi and its tests (docs/DISTRIBUTED.md)
+  libopenmpi-dev openmpi-bin)
 
 install_missing() {
   local missing=()

@@ -49,6 +49,18 @@ Film renderFilmRows(const RenderView& v, int y0Frame, int y1Frame, Progress* pro
     return film;
 }
 
+void renderFilmRect(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts* out)
+{
+    if (x0 < 0 || y0 < 0 || x1 > v.width || y1 > v.height || x0 > x1 || y0 > y1)
+        throw Error("renderFilmRect: the rectangle [" + std::to_string(x0) + ", " + std::to_string(x1) + ") x [" + std::to_string(y0) +
+                    ", " + std::to_string(y1) + ") is outside the " + std::to_string(v.width) + "x" + std::to_string(v.height) + " frame");
+    const int w = x1 - x0;
+    tbb::parallel_for(tbb::blocked_range<int>(y0, y1), [&](const tbb::blocked_range<int>& r) {
+        for (int y = r.begin(); y < r.end(); ++y)
+            for (int x = x0; x < x1; ++x) out[size_t(y - y0) * size_t(w) + size_t(x - x0)] = shadePixel(v, x, y);
+    });
+}
+
 // Mean luminance of full = mean of local + a * albedo  =>  a = mean(lum(indirect)) / mean(lum(albedo)).
 void addAmbientSums(const Film& film, double* indirect, double* albedo)
 {

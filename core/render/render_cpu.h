@@ -23,6 +23,12 @@ Film renderFilm(const RenderView& v, Progress* progress = nullptr);
 // those rows (a frame too large to hold whole is rendered in bands). film.height = y1 - y0.
 Film renderFilmRows(const RenderView& v, int y0, int y1, Progress* progress = nullptr);
 
+// The rectangle [x0, x1) x [y0, y1) of the frame (frame pixels) into out, row-major, (x1 - x0) x (y1 - y0)
+// parts: exactly the pixels renderFilm computes there (shadePixel per pixel; nothing depends on the
+// rectangle), in parallel over its rows. The tiles of `sylva render --mpi` (pipeline/mpi). Throws Error
+// for a rectangle outside the frame.
+void renderFilmRect(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts* out);
+
 // The sums ambient mode matches (luminance of indirect and of albedo over the film's pixels, in pixel
 // order), added to *indirect and *albedo so a frame in bands sums exactly as the whole film does.
 void addAmbientSums(const Film& film, double* indirect, double* albedo);

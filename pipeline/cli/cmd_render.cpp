@@ -12,6 +12,9 @@
 #include "pipeline/render/render_passes.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/render_stats.h"
+#if SYLVA_HAVE_MPI
+#include "pipeline/mpi/mpi_render.h"
+#endif
 
 namespace fs = std::filesystem;
 
@@ -77,8 +80,30 @@ void printStats(const AccelStats& st, const RenderTimings& timings, const Render
     if (r.mode == RenderMode::Ambient) std::printf("ambient constant %.4f\n", ambient);
 }
 
+// Whether this process writes the picture: always, except on the ranks other than 0 of --mpi.
+bool writesPicture(bool useMpi)
+{
+#if SYLVA_HAVE_MPI
+    return !useMpi || mpi::launchRank() == 0;
+#else
+    (void)useMpi;
+    return true;
+#endif
+}
+
 int runRender(const Args& args)
 {
+    const bool useMpi = args.has("--mpi");
+#if SYLVA_HAVE_MPI
+    if (useMpi && !mpi::launchedByMpi())
+        throw UsageError("option --mpi: this process was not started by mpirun; run: mpirun -np N sylva render --mpi ... "
+                         "(docs/DISTRIBUTED.md), or drop --mpi");
+#else
+    if (useMpi)
+        throw UsageError("option --mpi: this sylva was built without MPI (configure with -DSYLVA_ENABLE_MPI=ON where an MPI "
+                         "library is installed, e.g. Debian's libopenmpi-dev)");
+#endif
+    if (!useMpi && args.has("--mpi-timeout")) throw UsageError("option --mpi-timeout: applies to --mpi only");
     auto threads = threadLimit(args);
     const std::string backend = backendName(args);
     std::string stem;
@@ -92,7 +117,8 @@ int runRender(const Args& args)
     if (passes && ext != ".exr")
         throw UsageError("option --passes: the passes are layers of one multi-layer EXR; use -o NAME.exr, not " + out);
     if (passes && args.has("--band-rows")) throw UsageError("option --passes: a frame in bands cannot be written with passes; drop --band-rows");
-    requireReplaceableFile(out);
+    const bool writer = writesPicture(useMpi);
+    if (writer) requireReplaceableFile(out);
     int bandRows = 0;   // 0: the whole frame at once
     if (args.has("--band-rows")) bandRows = int(parseInteger("--band-rows", args.get("--band-rows"), 1, 32768));
     else if (!frameFitsMemory(r)) bandRows = bandRowsFor(r);
@@ -103,44 +129,61 @@ int runRender(const Args& args)
                     "render a smaller frame or without --passes");
     auto compute = openBackend(backend);
     auto cache = openCache(args);
-    JobLog log;
-    AccelStats st;
-    RenderTimings timings;
-    float ambient = 0.0f;
-    std::string device = compute->name();
-    if (bandRows > 0) {
-        const int bands = (r.height + bandRows - 1) / bandRows;
-        std::fprintf(stderr, "note: tracing the %dx%d frame in %d bands of %d rows%s\n", r.width, r.height, bands, bandRows,
-                     args.has("--band-rows") ? "" : " (the whole frame does not fit in the available memory)");
-        if (device != "cpu") std::fprintf(stderr, "note: a frame in bands is traced on the CPU (the LB solves still run on %s)\n", device.c_str());
-        ProgressPrinter bar("render", args.has("--quiet"));
-        const BandedRender result = renderSceneInBands(scene, out, bandRows, cache.get(), &bar.progress(), &log, compute.get());
-        bar.finish();
-        st = result.stats;
-        timings = result.timings;
-        ambient = result.ambient;
-        device = "cpu, " + std::to_string(bands) + " bands";
-    } else {
-        ProgressPrinter bar("render", args.has("--quiet"));
-        const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get());
-        bar.finish();
-        if (passes) {
-            const RenderPasses layers = renderPasses(result.film, r.mode, composeSky(scene));
-            writeRenderPasses(out, layers);
-            ambient = layers.ambient;
+    // The render and its picture, its tracing by `tracer` when given (--mpi: the ranks'), on `ranks` processes.
+    auto renderAndWrite = [&](const FilmRowsTracer& tracer, int ranks) {
+        JobLog log;
+        AccelStats st;
+        RenderTimings timings;
+        float ambient = 0.0f;
+        std::string device = compute->name();
+        if (bandRows > 0) {
+            const int bands = (r.height + bandRows - 1) / bandRows;
+            std::fprintf(stderr, "note: tracing the %dx%d frame in %d bands of %d rows%s\n", r.width, r.height, bands, bandRows,
+                         args.has("--band-rows") ? "" : " (the whole frame does not fit in the available memory)");
+            if (device != "cpu") std::fprintf(stderr, "note: a frame in bands is traced on the CPU (the LB solves still run on %s)\n", device.c_str());
+            ProgressPrinter bar("render", args.has("--quiet"));
+            const BandedRender result = renderSceneInBands(scene, out, bandRows, cache.get(), &bar.progress(), &log, compute.get(), tracer);
+            bar.finish();
+            st = result.stats;
+            timings = result.timings;
+            ambient = result.ambient;
+            device = "cpu, " + std::to_string(bands) + " bands";
         } else {
-            const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, composeSky(scene), &ambient);
-            writeRender(out, linear, r.width, r.height, r.exposureKey);
+            ProgressPrinter bar("render", args.has("--quiet"));
+            const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get(), tracer);
+            bar.finish();
+            if (passes) {
+                const RenderPasses layers = renderPasses(result.film, r.mode, composeSky(scene));
+                writeRenderPasses(out, layers);
+                ambient = layers.ambient;
+            } else {
+                const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, composeSky(scene), &ambient);
+                writeRender(out, linear, r.width, r.height, r.exposureKey);
+            }
+            st = result.stats;
+            timings = result.timings;
         }
-        st = result.stats;
-        timings = result.timings;
-    }
-    for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
-    std::printf("rendered %dx%d, %d spp, mode %s, %zu instances of %zu species (%.0f instanced triangles) on %s\nwrote %s\n",
-                r.width, r.height, r.spp, renderModeName(r.mode), st.instances, scene.species.size(), st.instancedTriangles,
-                device.c_str(), out.c_str());
-    if (args.has("--stats")) printStats(st, timings, r, ambient);
-    return kOk;
+        if (tracer) device = (bandRows > 0 ? device : std::string("cpu")) + ", " + std::to_string(ranks) + (ranks == 1 ? " MPI rank" : " MPI ranks");
+        for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
+        std::printf("rendered %dx%d, %d spp, mode %s, %zu instances of %zu species (%.0f instanced triangles) on %s\nwrote %s\n",
+                    r.width, r.height, r.spp, renderModeName(r.mode), st.instances, scene.species.size(), st.instancedTriangles,
+                    device.c_str(), out.c_str());
+        if (args.has("--stats")) printStats(st, timings, r, ambient);
+        return kOk;
+    };
+    if (!useMpi) return renderAndWrite({}, 1);
+#if SYLVA_HAVE_MPI
+    mpi::RenderJob job;
+    job.prepare = [&](Progress* progress) {
+        RenderTimings t;
+        return prepareRenderScene(scene, cache.get(), progress, nullptr, compute.get(), t);
+    };
+    job.lead = renderAndWrite;
+    if (args.has("--mpi-timeout")) job.timeoutSeconds = double(parseInteger("--mpi-timeout", args.get("--mpi-timeout"), 1, 86400));
+    return mpi::runRender(job);
+#else
+    return kFailure;
+#endif
 }
 
 } // namespace
@@ -162,6 +205,8 @@ Command renderCommand()
              {"--band-rows", "N", "trace and write the frame in bands of N rows (default: only when the whole frame does not fit in memory)"},
              {"--passes", "", "write one multi-layer EXR (32-bit float) of the render passes: Combined, DiffDir, DiffInd, DiffCol, Env, Normal, Depth, Alpha (docs/RENDERING.md); default output NAME.exr"},
              {"--stats", "", "print timings and acceleration structure sizes"},
+             {"--mpi", "", "trace the frame across the ranks of an MPI job, tiles from a work queue on rank 0: mpirun -np N sylva render --mpi ... (docs/DISTRIBUTED.md)"},
+             {"--mpi-timeout", "S", "with --mpi: end the job when a rank stays silent S seconds (default 10)"},
              kOutput, kCache, kNoCache, kThreads, kQuiet},
             0, 1, &runRender};
 }

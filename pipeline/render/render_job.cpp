@@ -193,11 +193,8 @@ SpeciesGrids loadSpeciesGrids(const Scene& scene, size_t species, GridCache* cac
     return gridsForMesh(scene, sp, geometry.mesh, cache, progress, log, backend);
 }
 
-namespace {
-
-// Assets (0-60% of progress) and acceleration structures (60-70%) of a frame.
-RenderScene prepareFrame(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend,
-                         RenderTimings& timings)
+RenderScene prepareRenderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend,
+                               RenderTimings& timings)
 {
     auto t0 = std::chrono::steady_clock::now();
     SubProgress assetsPart(progress, 0.0, 0.6);
@@ -216,20 +213,21 @@ RenderScene prepareFrame(const Scene& scene, GridCache* cache, Progress* progres
     return rs;
 }
 
-} // namespace
-
-RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend)
+RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend,
+                         const FilmRowsTracer& tracer)
 {
     checkFrameMemory(scene.render);
     RenderOutput out;
-    const RenderScene rs = prepareFrame(scene, cache, progress, log, backend, out.timings);
+    const RenderScene rs = prepareRenderScene(scene, cache, progress, log, backend, out.timings);
     out.stats = rs.stats();
 
     const auto t0 = std::chrono::steady_clock::now();
     SubProgress tracePart(progress, 0.7, 1.0);
     Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
     if (progress && progress->isCancelled()) traceProgress.cancel();
-    out.film = backend ? backend->render(rs, &traceProgress) : renderFilm(rs.view(), &traceProgress);
+    out.film = tracer    ? tracer(rs.view(), 0, scene.render.height, &traceProgress)
+               : backend ? backend->render(rs, &traceProgress)
+                         : renderFilm(rs.view(), &traceProgress);
     if (log) log->stages.push_back("trace");
     out.timings.trace = secondsSince(t0);
     return out;
@@ -254,7 +252,7 @@ struct FileCloser {
 } // namespace
 
 BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, int bandRows, GridCache* cache,
-                                Progress* progress, JobLog* log, Backend* backend)
+                                Progress* progress, JobLog* log, Backend* backend, const FilmRowsTracer& tracer)
 {
     const RenderSettings& r = scene.render;
     if (bandRows < 1) throw Error("render: rows per band must be at least 1, got " + std::to_string(bandRows));
@@ -297,7 +295,7 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
     };
 
     BandedRender out;
-    const RenderScene rs = prepareFrame(scene, cache, progress, log, backend, out.timings);
+    const RenderScene rs = prepareRenderScene(scene, cache, progress, log, backend, out.timings);
     out.stats = rs.stats();
     const RenderView view = rs.view();
     const int bands = (r.height + bandRows - 1) / bandRows;
@@ -316,7 +314,7 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
             tracePart.report((double(b) + f) / double(bands), "tracing band " + std::to_string(b + 1) + "/" + std::to_string(bands));
         });
         if (progress && progress->isCancelled()) bandProgress.cancel();
-        const Film film = renderFilmRows(view, y0, y1, &bandProgress);
+        const Film film = tracer ? tracer(view, y0, y1, &bandProgress) : renderFilmRows(view, y0, y1, &bandProgress);
         buf.resize(film.pixels.size() * floatsPerPixel);
         if (ambientMode) {
             addAmbientSums(film, &indirectSum, &albedoSum);

@@ -1,6 +1,7 @@
 // `sylva render` as a library call: species meshes, textures and lighting grids for a scene, the frame, the picture.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -65,9 +66,17 @@ struct RenderOutput {
 // picture is composed, so a frame needs about kFrameBytesPerPixel bytes per pixel (film + composed
 // picture; 16384 x 8192 about 9 GB): one that does not fit in 80% of the available memory is refused
 // up front (Error naming the size and the memory), before any asset is loaded.
+// tracer: traces the frame's rows in place of the backend (sylva render --mpi hands them to the ranks as tiles).
 inline constexpr size_t kFrameBytesPerPixel = sizeof(SampleParts) + sizeof(glm::vec3);
+// Rows y0 (inclusive) to y1 (exclusive) of a view as a film: renderFilmRows's contract.
+using FilmRowsTracer = std::function<Film(const RenderView& view, int y0, int y1, Progress* progress)>;
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr,
-                         Backend* backend = nullptr);
+                         Backend* backend = nullptr, const FilmRowsTracer& tracer = {});
+
+// The assets (0-60% of progress) and the acceleration structures (60-70%) of the scene's frame, the
+// steps renderScene takes before tracing; timings.assets and timings.build are set.
+RenderScene prepareRenderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend,
+                               RenderTimings& timings);
 
 // Whether a whole frame (film and composed picture, kFrameBytesPerPixel per pixel) fits in 80% of the
 // available memory (core/base/memory.h; true when unknown).
@@ -90,9 +99,11 @@ struct BandedRender {
 // exactly the one renderScene + composeMode + writeRender produce: the ambient constant and the
 // log-average luminance sum the bands in the whole frame's order. Throws Error or Cancelled; the
 // target file is only replaced at the end.
-// backend: where the species' LB solves run (null = the CPU); the bands are traced on the CPU.
+// backend: where the species' LB solves run (null = the CPU); the bands are traced on the CPU (by
+// renderFilmRows, or by tracer when given).
 BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, int bandRows, GridCache* cache,
-                                Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
+                                Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr,
+                                const FilmRowsTracer& tracer = {});
 
 // Tone-mapped (Reinhard, log-average key) sRGB picture of linear RGB pixels, alpha 1.
 ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key);

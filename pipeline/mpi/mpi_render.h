@@ -1,0 +1,50 @@
+// `sylva render --mpi`: one frame traced by the ranks of an MPI job (docs/DISTRIBUTED.md). Built only with
+// MPI (SYLVA_ENABLE_MPI); nothing outside pipeline/mpi includes an MPI header.
+//
+// Every rank loads the scene and builds its frame (species assets through the shared grid cache).
+// Rank 0 runs the render exactly as the single-process path does, except that its tracing goes
+// through a FilmRowsTracer that cuts the rows into tiles (32 x 32, smaller when a frame has few per
+// rank) and hands them from a work queue to the ranks that ask; rank 0 traces tiles too between its
+// messages. A tile is renderFilmRect, shadePixel per pixel, so the picture is bit-identical to a
+// single-process CPU render at any rank count. Rank 0 gathers, composes and writes with the
+// single-process writer.
+//
+// Faults: ranks send heartbeats while they work; rank 0 sends them to ranks that wait. A rank that
+// stays silent longer than the timeout (or reports an error) ends the job: rank 0 names it on stderr
+// and aborts the job (MPI_Abort, exit 1) before any picture is written. Ranks whose executables
+// differ (version or build) are refused at start.
+#pragma once
+
+#include <functional>
+#include <string>
+
+#include "core/base/progress.h"
+#include "core/render/render_scene.h"
+#include "pipeline/render/render_job.h"
+
+namespace sylva::mpi {
+
+// Whether this process was started by an MPI launcher (mpirun, mpiexec, srun): its environment
+// names the process's rank.
+bool launchedByMpi();
+// This process's rank as the launcher's environment gives it before MPI starts (0 when unknown).
+int launchRank();
+
+struct RenderJob {
+    // Ranks other than 0: the frame's scene (prepareRenderScene), the same call as rank 0's.
+    std::function<RenderScene(Progress* progress)> prepare;
+    // Rank 0: the whole render and its output, with the tracing through `tracer`. Returns the exit
+    // code; an exception is reported as "sylva render: error: ..." and ends the job with 1.
+    std::function<int(const FilmRowsTracer& tracer, int ranks)> lead;
+    // Seconds a rank may stay silent before the job ends.
+    double timeoutSeconds = 10.0;
+    // Tile edge in pixels (halved down to 8 while the frame has fewer than 4 tiles per rank).
+    int tile = 32;
+};
+
+// Runs this rank's part: MPI_Init, the build check, then the work queue (rank 0) or a worker.
+// Returns the process's exit code: 0, 1 (an error, reported on rank 0), or 128 + signal when the job
+// was stopped by a signal (mpirun sends SIGTERM to every rank when one dies).
+int runRender(const RenderJob& job);
+
+} // namespace sylva::mpi
