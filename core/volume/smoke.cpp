@@ -1,0 +1,726 @@
+// Stable fluids on a MAC grid (smoke.h): forces, semi-Lagrangian advection, MGPCG pressure projection.
+#include "core/volume/smoke.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "core/base/error.h"
+#include "core/base/memory.h"
+#include "core/base/parallel.h"
+#include "core/base/progress.h"
+#include "core/volume/noise.h"
+
+namespace sylva::volume {
+namespace {
+
+std::string num(double v)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", v);
+    return buf;
+}
+
+bool finite3(const glm::vec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// Runs body(i) for every x slab i in [0, n): disjoint writes, so the result is independent of threads.
+template <class Body>
+void forSlabs(int n, const Body& body)
+{
+    tbb::parallel_for(tbb::blocked_range<int>(0, n), [&](const tbb::blocked_range<int>& r) {
+        for (int i = r.begin(); i != r.end(); ++i) body(i);
+    });
+}
+
+// A staggered field: samples at (index + offset) in cell units.
+struct FieldView {
+    const float* data;
+    glm::ivec3 n;
+    glm::vec3 offset;
+    float at(int i, int j, int k) const { return data[(size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z) + size_t(k)]; }
+};
+
+float sampleLinear(const FieldView& f, const glm::vec3& pos)
+{
+    int i0[3];
+    float t[3];
+    for (int a = 0; a < 3; ++a) {
+        const float s = std::clamp(pos[a] - f.offset[a], 0.0f, float(f.n[a] - 1));
+        i0[a] = std::min(int(s), f.n[a] - 2);
+        t[a] = s - float(i0[a]);
+    }
+    const int i = i0[0], j = i0[1], k = i0[2];
+    const float c00 = f.at(i, j, k) + t[2] * (f.at(i, j, k + 1) - f.at(i, j, k));
+    const float c01 = f.at(i, j + 1, k) + t[2] * (f.at(i, j + 1, k + 1) - f.at(i, j + 1, k));
+    const float c10 = f.at(i + 1, j, k) + t[2] * (f.at(i + 1, j, k + 1) - f.at(i + 1, j, k));
+    const float c11 = f.at(i + 1, j + 1, k) + t[2] * (f.at(i + 1, j + 1, k + 1) - f.at(i + 1, j + 1, k));
+    const float c0 = c00 + t[1] * (c01 - c00), c1 = c10 + t[1] * (c11 - c10);
+    return c0 + t[0] * (c1 - c0);
+}
+
+// Monotonic cubic Hermite through f1 (t = 0) and f2 (t = 1), Fedkiw et al. 2001 eq. (8)-(9): the
+// slopes are central differences, set to 0 where their sign differs from the secant's (or it is 0)
+// and capped at 3 times the secant (Fritsch and Carlson 1980), so the curve never leaves [min(f1, f2), max(f1, f2)] between the samples.
+float monotonicCubic(float f0, float f1, float f2, float f3, float t)
+{
+    const float delta = f2 - f1;
+    float d1 = 0.5f * (f2 - f0), d2 = 0.5f * (f3 - f1);
+    if (delta == 0.0f) {
+        d1 = d2 = 0.0f;
+    } else {
+        if ((d1 > 0.0f) != (delta > 0.0f) || d1 == 0.0f) d1 = 0.0f;
+        if ((d2 > 0.0f) != (delta > 0.0f) || d2 == 0.0f) d2 = 0.0f;
+        // Fritsch-Carlson: slopes at most 3 times the secant keep the Hermite piece monotone.
+        const float cap = 3.0f * std::fabs(delta);
+        d1 = std::clamp(d1, -cap, cap);
+        d2 = std::clamp(d2, -cap, cap);
+    }
+    const float a3 = d1 + d2 - 2.0f * delta, a2 = 3.0f * delta - 2.0f * d1 - d2;
+    return ((a3 * t + a2) * t + d1) * t + f1;
+}
+
+float sampleCubic(const FieldView& f, const glm::vec3& pos)
+{
+    int i0[3];
+    float t[3];
+    for (int a = 0; a < 3; ++a) {
+        const float s = std::clamp(pos[a] - f.offset[a], 0.0f, float(f.n[a] - 1));
+        i0[a] = std::min(int(s), f.n[a] - 2);
+        t[a] = s - float(i0[a]);
+    }
+    auto ci = [&](int a, int d) { return std::clamp(i0[a] + d, 0, f.n[a] - 1); };
+    float plane[4];
+    for (int di = 0; di < 4; ++di) {
+        float row[4];
+        for (int dj = 0; dj < 4; ++dj) {
+            const int i = ci(0, di - 1), j = ci(1, dj - 1);
+            row[dj] = monotonicCubic(f.at(i, j, ci(2, -1)), f.at(i, j, ci(2, 0)), f.at(i, j, ci(2, 1)), f.at(i, j, ci(2, 2)), t[2]);
+        }
+        plane[di] = monotonicCubic(row[0], row[1], row[2], row[3], t[1]);
+    }
+    return monotonicCubic(plane[0], plane[1], plane[2], plane[3], t[0]);
+}
+
+float sample(const FieldView& f, const glm::vec3& pos, SmokeInterp interp)
+{
+    return interp == SmokeInterp::MonotonicCubic ? sampleCubic(f, pos) : sampleLinear(f, pos);
+}
+
+} // namespace
+
+bool SmokeShape::contains(const glm::vec3& p) const
+{
+    if (kind == Kind::Sphere) return glm::dot(p - centre, p - centre) <= radius * radius;
+    const glm::vec3 d = glm::abs(p - centre);
+    return d.x <= halfSize.x && d.y <= halfSize.y && d.z <= halfSize.z;
+}
+
+double smokeBytes(const glm::ivec3& c)
+{
+    const double cells = double(c.x) * double(c.y) * double(c.z);
+    // 5 fields + 5 scratch floats, masks, pressure + 4 CG vectors and the multigrid levels (3 vectors,
+    // 1/7 of the cells more) in double.
+    return cells * (10.0 * 4.0 + 4.0 + 5.0 * 8.0 + 3.0 * 8.0 * 8.0 / 7.0);
+}
+
+void validateSmoke(const SmokeSettings& s)
+{
+    auto fail = [](const std::string& what) { throw Error("simulate: " + what); };
+    for (int a = 0; a < 3; ++a)
+        if (s.cells[a] < kSmokeMinCells || s.cells[a] > kSmokeMaxCells)
+            fail("grid size " + std::to_string(s.cells.x) + "x" + std::to_string(s.cells.y) + "x" + std::to_string(s.cells.z) +
+                 ": every axis needs " + std::to_string(kSmokeMinCells) + ".." + std::to_string(kSmokeMaxCells) + " cells");
+    const double need = smokeBytes(s.cells), have = availableMemoryBytes();
+    if (have > 0.0 && need > have)
+        fail("a " + std::to_string(s.cells.x) + "x" + std::to_string(s.cells.y) + "x" + std::to_string(s.cells.z) + " grid needs " +
+             num(need / 1048576.0) + " MiB but only " + num(have / 1048576.0) + " MiB are available");
+    if (!(std::isfinite(s.cellSize) && s.cellSize > 0.0f)) fail("cell size " + num(s.cellSize) + " must be finite and > 0");
+    if (!(std::isfinite(s.dt) && s.dt > 0.0f)) fail("time step " + num(s.dt) + " must be finite and > 0");
+    if (!finite3(s.origin)) fail("origin must be finite");
+    if (!std::isfinite(s.buoyancyDensity) || !std::isfinite(s.buoyancyTemperature)) fail("buoyancy must be finite");
+    if (!(std::isfinite(s.vorticity) && s.vorticity >= 0.0f)) fail("vorticity " + num(s.vorticity) + " must be finite and >= 0");
+    if (!(s.densityDecay >= 0.0f && s.densityDecay * s.dt <= 1.0f))
+        fail("density decay " + num(s.densityDecay) + " must be >= 0 and at most 1 / dt");
+    if (!(s.temperatureDecay >= 0.0f && s.temperatureDecay * s.dt <= 1.0f))
+        fail("temperature decay " + num(s.temperatureDecay) + " must be >= 0 and at most 1 / dt");
+    if (!(s.jitter >= 0.0f && s.jitter <= 1.0f)) fail("jitter " + num(s.jitter) + " must lie in [0, 1]");
+    if (!(s.pressureTolerance > 0.0 && s.pressureTolerance < 1.0)) fail("pressure tolerance must lie in (0, 1)");
+    if (s.pressureMaxIterations < 1) fail("pressure iterations must be >= 1");
+    if (!(std::isfinite(s.cflLimit) && s.cflLimit > 0.0f)) fail("CFL limit must be finite and > 0");
+    auto checkShape = [&](const SmokeShape& sh, const std::string& what) {
+        if (!finite3(sh.centre)) fail(what + ": centre must be finite");
+        if (sh.kind == SmokeShape::Kind::Sphere && !(std::isfinite(sh.radius) && sh.radius > 0.0f))
+            fail(what + ": radius " + num(sh.radius) + " must be finite and > 0");
+        if (sh.kind == SmokeShape::Kind::Box && !(finite3(sh.halfSize) && glm::all(glm::greaterThan(sh.halfSize, glm::vec3(0.0f)))))
+            fail(what + ": box half sizes must be finite and > 0");
+    };
+    for (size_t i = 0; i < s.sources.size(); ++i) {
+        const SmokeSource& src = s.sources[i];
+        const std::string what = "source " + std::to_string(i + 1);
+        checkShape(src.shape, what);
+        if (!(src.density >= 0.0f && src.density <= 1.0f)) fail(what + ": density " + num(src.density) + " must lie in [0, 1]");
+        if (!(std::isfinite(src.temperature) && src.temperature >= 0.0f)) fail(what + ": temperature must be finite and >= 0");
+        if (!finite3(src.velocity)) fail(what + ": velocity must be finite");
+        const float cfl = glm::length(src.velocity) * s.dt / s.cellSize;
+        if (cfl > s.cflLimit)
+            fail(what + ": its velocity moves " + num(cfl) + " cells per step, over the CFL limit " + num(s.cflLimit) +
+                 " (lower the time step or the speed)");
+    }
+    for (size_t i = 0; i < s.obstacles.size(); ++i) checkShape(s.obstacles[i], "obstacle " + std::to_string(i + 1));
+}
+
+// ---- the pressure solve: CG in double, preconditioned by a multigrid V-cycle ----
+
+struct SmokeSim::Solver {
+    struct Level {
+        glm::ivec3 n;
+        std::vector<uint8_t> fluid, diag;
+        std::vector<double> x, b, tmp;
+        size_t index(int i, int j, int k) const { return (size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z) + size_t(k); }
+        size_t count() const { return size_t(n.x) * size_t(n.y) * size_t(n.z); }
+    };
+    std::vector<Level> levels;
+    std::vector<double> r, z, s, q;
+
+    explicit Solver(const std::vector<uint8_t>& fluid0, const glm::ivec3& n0)
+    {
+        Level l0;
+        l0.n = n0;
+        l0.fluid = fluid0;
+        levels.push_back(std::move(l0));
+        while (true) {
+            const Level& f = levels.back();
+            if (glm::min(f.n.x, glm::min(f.n.y, f.n.z)) < 8 || f.count() <= 4096) break;
+            Level c;
+            c.n = (f.n + 1) / 2;
+            c.fluid.assign(c.count(), 0);
+            for (int i = 0; i < f.n.x; ++i)
+                for (int j = 0; j < f.n.y; ++j)
+                    for (int k = 0; k < f.n.z; ++k)
+                        if (f.fluid[f.index(i, j, k)]) c.fluid[c.index(i / 2, j / 2, k / 2)] = 1;
+            levels.push_back(std::move(c));
+        }
+        for (Level& l : levels) {
+            l.diag.assign(l.count(), 0);
+            for (int i = 0; i < l.n.x; ++i)
+                for (int j = 0; j < l.n.y; ++j)
+                    for (int k = 0; k < l.n.z; ++k) {
+                        const size_t c = l.index(i, j, k);
+                        if (!l.fluid[c]) continue;
+                        int d = j == l.n.y - 1 ? 1 : 0;   // the open top: a pressure-0 ghost
+                        if (i > 0) d += l.fluid[l.index(i - 1, j, k)];
+                        if (i < l.n.x - 1) d += l.fluid[l.index(i + 1, j, k)];
+                        if (j > 0) d += l.fluid[l.index(i, j - 1, k)];
+                        if (j < l.n.y - 1) d += l.fluid[l.index(i, j + 1, k)];
+                        if (k > 0) d += l.fluid[l.index(i, j, k - 1)];
+                        if (k < l.n.z - 1) d += l.fluid[l.index(i, j, k + 1)];
+                        l.diag[c] = uint8_t(d);
+                        if (d == 0) l.fluid[c] = 0;
+                    }
+            l.x.assign(l.count(), 0.0);
+            l.b.assign(l.count(), 0.0);
+            l.tmp.assign(l.count(), 0.0);
+        }
+        const size_t n = levels[0].count();
+        r.assign(n, 0.0);
+        z.assign(n, 0.0);
+        s.assign(n, 0.0);
+        q.assign(n, 0.0);
+    }
+
+    // y = A x on level l (y = 0 off the fluid).
+    static double applyAt(const Level& l, const double* x, int i, int j, int k)
+    {
+        const size_t c = l.index(i, j, k);
+        if (!l.fluid[c]) return 0.0;
+        double sum = 0.0;
+        const size_t sx = size_t(l.n.y) * size_t(l.n.z), sy = size_t(l.n.z);
+        if (i > 0 && l.fluid[c - sx]) sum += x[c - sx];
+        if (i < l.n.x - 1 && l.fluid[c + sx]) sum += x[c + sx];
+        if (j > 0 && l.fluid[c - sy]) sum += x[c - sy];
+        if (j < l.n.y - 1 && l.fluid[c + sy]) sum += x[c + sy];
+        if (k > 0 && l.fluid[c - 1]) sum += x[c - 1];
+        if (k < l.n.z - 1 && l.fluid[c + 1]) sum += x[c + 1];
+        return double(l.diag[c]) * x[c] - sum;
+    }
+
+    static void apply(const Level& l, const double* x, double* y)
+    {
+        forSlabs(l.n.x, [&](int i) {
+            for (int j = 0; j < l.n.y; ++j)
+                for (int k = 0; k < l.n.z; ++k) y[l.index(i, j, k)] = applyAt(l, x, i, j, k);
+        });
+    }
+
+    // Damped Jacobi sweeps (omega 6/7, the 3D 7-point smoother); `fromZero`: x starts at 0.
+    static void jacobi(Level& l, int sweeps, bool fromZero)
+    {
+        constexpr double omega = 6.0 / 7.0;
+        for (int s = 0; s < sweeps; ++s) {
+            if (fromZero && s == 0) {
+                forSlabs(l.n.x, [&](int i) {
+                    for (int j = 0; j < l.n.y; ++j)
+                        for (int k = 0; k < l.n.z; ++k) {
+                            const size_t c = l.index(i, j, k);
+                            l.x[c] = l.fluid[c] ? omega * l.b[c] / double(l.diag[c]) : 0.0;
+                        }
+                });
+                continue;
+            }
+            forSlabs(l.n.x, [&](int i) {
+                for (int j = 0; j < l.n.y; ++j)
+                    for (int k = 0; k < l.n.z; ++k) {
+                        const size_t c = l.index(i, j, k);
+                        l.tmp[c] = l.fluid[c] ? l.x[c] + omega * (l.b[c] - applyAt(l, l.x.data(), i, j, k)) / double(l.diag[c]) : 0.0;
+                    }
+            });
+            std::swap(l.x, l.tmp);
+        }
+    }
+
+    // x_l = V-cycle applied to b_l (a symmetric linear operator: equal Jacobi sweeps before and after,
+    // restriction = prolongation^T / 2, a fixed sweep count on the coarsest level).
+    void vcycle(size_t li)
+    {
+        Level& l = levels[li];
+        if (li + 1 == levels.size()) {
+            jacobi(l, 30, true);
+            return;
+        }
+        jacobi(l, 2, true);
+        Level& c = levels[li + 1];
+        forSlabs(l.n.x, [&](int i) {
+            for (int j = 0; j < l.n.y; ++j)
+                for (int k = 0; k < l.n.z; ++k) l.tmp[l.index(i, j, k)] = l.b[l.index(i, j, k)] - applyAt(l, l.x.data(), i, j, k);
+        });
+        forSlabs(c.n.x, [&](int I) {
+            for (int J = 0; J < c.n.y; ++J)
+                for (int K = 0; K < c.n.z; ++K) {
+                    double sum = 0.0;
+                    for (int di = 0; di < 2; ++di)
+                        for (int dj = 0; dj < 2; ++dj)
+                            for (int dk = 0; dk < 2; ++dk) {
+                                const int i = 2 * I + di, j = 2 * J + dj, k = 2 * K + dk;
+                                if (i < l.n.x && j < l.n.y && k < l.n.z) sum += l.tmp[l.index(i, j, k)];
+                            }
+                    // The coarse stencil is (2h)^2 / h^2 = 4 times the fine one on averages: 4 / 8.
+                    c.b[c.index(I, J, K)] = c.fluid[c.index(I, J, K)] ? 0.5 * sum : 0.0;
+                }
+        });
+        vcycle(li + 1);
+        forSlabs(l.n.x, [&](int i) {
+            for (int j = 0; j < l.n.y; ++j)
+                for (int k = 0; k < l.n.z; ++k) {
+                    const size_t f = l.index(i, j, k);
+                    if (l.fluid[f]) l.x[f] += c.x[c.index(i / 2, j / 2, k / 2)];
+                }
+        });
+        jacobi(l, 2, false);
+    }
+
+    static double dot(const std::vector<double>& a, const std::vector<double>& b)
+    {
+        double out = 0.0;
+        HostExec().sum<1>(a.size(), [&](size_t i, double* t) { t[0] = a[i] * b[i]; }, &out);
+        return out;
+    }
+
+    // Solves A x = rhs (x holds the start), relative residual tol. Returns {iterations, residual}.
+    std::pair<int, double> solve(const std::vector<double>& rhs, std::vector<double>& x, double tol, int maxIt)
+    {
+        Level& l0 = levels[0];
+        const size_t n = l0.count();
+        const double bnorm = std::sqrt(dot(rhs, rhs));
+        if (bnorm == 0.0) {
+            std::fill(x.begin(), x.end(), 0.0);
+            return {0, 0.0};
+        }
+        apply(l0, x.data(), q.data());
+        tbb::parallel_for(size_t(0), n, [&](size_t i) { r[i] = l0.fluid[i] ? rhs[i] - q[i] : 0.0; });
+        double rnorm = std::sqrt(dot(r, r));
+        if (rnorm <= tol * bnorm) return {0, rnorm / bnorm};
+        auto precondition = [&]() {
+            std::copy(r.begin(), r.end(), l0.b.begin());
+            vcycle(0);
+            std::copy(l0.x.begin(), l0.x.end(), z.begin());
+        };
+        precondition();
+        s = z;
+        double rho = dot(r, z);
+        int it = 0;
+        while (it < maxIt) {
+            ++it;
+            apply(l0, s.data(), q.data());
+            const double alpha = rho / dot(s, q);
+            tbb::parallel_for(size_t(0), n, [&](size_t i) {
+                x[i] += alpha * s[i];
+                r[i] -= alpha * q[i];
+            });
+            rnorm = std::sqrt(dot(r, r));
+            if (rnorm <= tol * bnorm) break;
+            precondition();
+            const double rhoNew = dot(r, z);
+            const double beta = rhoNew / rho;
+            rho = rhoNew;
+            tbb::parallel_for(size_t(0), n, [&](size_t i) { s[i] = z[i] + beta * s[i]; });
+        }
+        return {it, rnorm / bnorm};
+    }
+};
+
+// ---- the simulation ----
+
+SmokeSim::SmokeSim(const SmokeSettings& settings) : m_s(settings)
+{
+    validateSmoke(m_s);
+    const glm::ivec3 n = m_s.cells;
+    const size_t cells = size_t(n.x) * size_t(n.y) * size_t(n.z);
+    m_density.assign(cells, 0.0f);
+    m_temperature.assign(cells, 0.0f);
+    m_u.assign(size_t(n.x + 1) * size_t(n.y) * size_t(n.z), 0.0f);
+    m_v.assign(size_t(n.x) * size_t(n.y + 1) * size_t(n.z), 0.0f);
+    m_w.assign(size_t(n.x) * size_t(n.y) * size_t(n.z + 1), 0.0f);
+    m_solid.assign(cells, 0);
+    m_pressure.assign(cells, 0.0);
+    const float h = m_s.cellSize;
+    for (int i = 0; i < n.x; ++i)
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k) {
+                const glm::vec3 p = m_s.origin + h * (glm::vec3(i, j, k) + 0.5f);
+                for (const SmokeShape& o : m_s.obstacles)
+                    if (o.contains(p)) m_solid[(size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z) + size_t(k)] = 1;
+            }
+    // Fluid cells with no path to the open top would make the pressure system singular: they join the
+    // obstacles (flood fill from the top row).
+    std::vector<uint8_t> reach(cells, 0);
+    std::vector<size_t> stack;
+    auto cellIndex = [&](int i, int j, int k) { return (size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z) + size_t(k); };
+    for (int i = 0; i < n.x; ++i)
+        for (int k = 0; k < n.z; ++k) {
+            const size_t c = cellIndex(i, n.y - 1, k);
+            if (!m_solid[c]) {
+                reach[c] = 1;
+                stack.push_back(c);
+            }
+        }
+    while (!stack.empty()) {
+        const size_t c = stack.back();
+        stack.pop_back();
+        const int k = int(c % size_t(n.z)), j = int((c / size_t(n.z)) % size_t(n.y)), i = int(c / (size_t(n.z) * size_t(n.y)));
+        const glm::ivec3 nb[6] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k}, {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+        for (const glm::ivec3& q : nb) {
+            if (q.x < 0 || q.y < 0 || q.z < 0 || q.x >= n.x || q.y >= n.y || q.z >= n.z) continue;
+            const size_t d = cellIndex(q.x, q.y, q.z);
+            if (m_solid[d] || reach[d]) continue;
+            reach[d] = 1;
+            stack.push_back(d);
+        }
+    }
+    for (size_t c = 0; c < cells; ++c)
+        if (!reach[c]) m_solid[c] = 1;
+    std::vector<uint8_t> fluid(cells);
+    for (size_t c = 0; c < cells; ++c) fluid[c] = uint8_t(!m_solid[c]);
+    m_solver = new Solver(fluid, n);
+}
+
+SmokeSim::~SmokeSim() { delete m_solver; }
+
+namespace {
+
+struct Dims {
+    glm::ivec3 n;
+    size_t cell(int i, int j, int k) const { return (size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z) + size_t(k); }
+    size_t uIdx(int i, int j, int k) const { return (size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z) + size_t(k); }
+    size_t vIdx(int i, int j, int k) const { return (size_t(i) * size_t(n.y + 1) + size_t(j)) * size_t(n.z) + size_t(k); }
+    size_t wIdx(int i, int j, int k) const { return (size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z + 1) + size_t(k); }
+};
+
+} // namespace
+
+double SmokeSim::divergenceNorm() const
+{
+    const Dims d{m_s.cells};
+    const glm::ivec3 n = d.n;
+    const double h = m_s.cellSize;
+    double out = 0.0;
+    HostExec().sum<1>(size_t(n.x), [&](size_t ii, double* t) {
+        const int i = int(ii);
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k) {
+                if (m_solid[d.cell(i, j, k)]) continue;
+                const double div = (double(m_u[d.uIdx(i + 1, j, k)]) - double(m_u[d.uIdx(i, j, k)]) + double(m_v[d.vIdx(i, j + 1, k)]) -
+                                    double(m_v[d.vIdx(i, j, k)]) + double(m_w[d.wIdx(i, j, k + 1)]) - double(m_w[d.wIdx(i, j, k)])) / h;
+                t[0] += div * div;
+            }
+    }, &out);
+    return std::sqrt(out);
+}
+
+void SmokeSim::project()
+{
+    const Dims d{m_s.cells};
+    const glm::ivec3 n = d.n;
+    // Faces next to a wall or an obstacle carry velocity 0 (the top faces stay free).
+    forSlabs(n.x + 1, [&](int i) {
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k)
+                if (i == 0 || i == n.x || m_solid[d.cell(i - 1, j, k)] || m_solid[d.cell(i, j, k)]) m_u[d.uIdx(i, j, k)] = 0.0f;
+    });
+    forSlabs(n.x, [&](int i) {
+        for (int j = 0; j <= n.y; ++j)
+            for (int k = 0; k < n.z; ++k) {
+                const bool fixed = j == 0 || (j < n.y && m_solid[d.cell(i, j, k)]) || m_solid[d.cell(i, j - 1, k)];
+                if (fixed) m_v[d.vIdx(i, j, k)] = 0.0f;
+            }
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k <= n.z; ++k)
+                if (k == 0 || k == n.z || m_solid[d.cell(i, j, k - 1)] || m_solid[d.cell(i, j, k)]) m_w[d.wIdx(i, j, k)] = 0.0f;
+    });
+    m_stats.divergenceBefore = divergenceNorm();
+    // A psi = -D (D: the flux difference of a cell), then u -= grad psi over the open faces.
+    std::vector<double> rhs(d.cell(n.x - 1, n.y - 1, n.z - 1) + 1, 0.0);
+    forSlabs(n.x, [&](int i) {
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k) {
+                const size_t c = d.cell(i, j, k);
+                if (m_solid[c]) continue;
+                rhs[c] = -(double(m_u[d.uIdx(i + 1, j, k)]) - double(m_u[d.uIdx(i, j, k)]) + double(m_v[d.vIdx(i, j + 1, k)]) -
+                           double(m_v[d.vIdx(i, j, k)]) + double(m_w[d.wIdx(i, j, k + 1)]) - double(m_w[d.wIdx(i, j, k)]));
+            }
+    });
+    const auto [it, res] = m_solver->solve(rhs, m_pressure, m_s.pressureTolerance, m_s.pressureMaxIterations);
+    m_stats.pressureIterations = it;
+    m_stats.pressureResidual = res;
+    const std::vector<double>& p = m_pressure;
+    forSlabs(n.x, [&](int i) {
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k) {
+                const size_t c = d.cell(i, j, k);
+                if (m_solid[c]) continue;
+                if (i + 1 < n.x && !m_solid[d.cell(i + 1, j, k)])
+                    m_u[d.uIdx(i + 1, j, k)] = float(double(m_u[d.uIdx(i + 1, j, k)]) - (p[d.cell(i + 1, j, k)] - p[c]));
+                if (j + 1 < n.y && !m_solid[d.cell(i, j + 1, k)])
+                    m_v[d.vIdx(i, j + 1, k)] = float(double(m_v[d.vIdx(i, j + 1, k)]) - (p[d.cell(i, j + 1, k)] - p[c]));
+                if (j + 1 == n.y) m_v[d.vIdx(i, n.y, k)] = float(double(m_v[d.vIdx(i, n.y, k)]) + p[c]);   // ghost pressure 0
+                if (k + 1 < n.z && !m_solid[d.cell(i, j, k + 1)])
+                    m_w[d.wIdx(i, j, k + 1)] = float(double(m_w[d.wIdx(i, j, k + 1)]) - (p[d.cell(i, j, k + 1)] - p[c]));
+            }
+    });
+    m_stats.divergenceAfter = divergenceNorm();
+}
+
+void SmokeSim::advectScalars(float dt)
+{
+    const Dims d{m_s.cells};
+    const glm::ivec3 n = d.n;
+    const float scale = dt / m_s.cellSize;
+    const FieldView fu{m_u.data(), {n.x + 1, n.y, n.z}, {0.0f, 0.5f, 0.5f}};
+    const FieldView fv{m_v.data(), {n.x, n.y + 1, n.z}, {0.5f, 0.0f, 0.5f}};
+    const FieldView fw{m_w.data(), {n.x, n.y, n.z + 1}, {0.5f, 0.5f, 0.0f}};
+    const std::vector<float> oldD = m_density, oldT = m_temperature;
+    const FieldView fd{oldD.data(), n, glm::vec3(0.5f)}, ft{oldT.data(), n, glm::vec3(0.5f)};
+    const glm::vec3 hi = glm::vec3(n);
+    const SmokeInterp interp = m_s.interp;
+    forSlabs(n.x, [&](int i) {
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k) {
+                const size_t c = d.cell(i, j, k);
+                if (m_solid[c]) {
+                    m_density[c] = 0.0f;
+                    m_temperature[c] = 0.0f;
+                    continue;
+                }
+                const glm::vec3 x = glm::vec3(i, j, k) + 0.5f;
+                auto vel = [&](const glm::vec3& q) { return glm::vec3(sampleLinear(fu, q), sampleLinear(fv, q), sampleLinear(fw, q)); };
+                const glm::vec3 mid = glm::clamp(x - 0.5f * scale * vel(x), glm::vec3(0.0f), hi);
+                const glm::vec3 back = glm::clamp(x - scale * vel(mid), glm::vec3(0.0f), hi);
+                m_density[c] = std::clamp(sample(fd, back, interp), 0.0f, 1.0f);
+                m_temperature[c] = std::max(0.0f, sample(ft, back, interp));
+            }
+    });
+}
+
+void SmokeSim::step(Progress* progress)
+{
+    const Dims d{m_s.cells};
+    const glm::ivec3 n = d.n;
+    const float h = m_s.cellSize, dt = m_s.dt;
+    if (progress) progress->throwIfCancelled();
+
+    // 1. Forces on a copy of the velocity: buoyancy on the v faces, vorticity confinement on all.
+    std::vector<float> u1 = m_u, v1 = m_v, w1 = m_w;
+    forSlabs(n.x, [&](int i) {
+        for (int j = 1; j <= n.y; ++j)
+            for (int k = 0; k < n.z; ++k) {
+                const size_t below = d.cell(i, j - 1, k);
+                const size_t above = j < n.y ? d.cell(i, j, k) : below;
+                const float rho = 0.5f * (m_density[below] + m_density[above]);
+                const float temp = 0.5f * (m_temperature[below] + m_temperature[above]);
+                v1[d.vIdx(i, j, k)] += dt * (-m_s.buoyancyDensity * rho + m_s.buoyancyTemperature * temp);
+            }
+    });
+    if (m_s.vorticity > 0.0f) {
+        const size_t cells = m_density.size();
+        std::vector<glm::vec3> centre(cells), omega(cells);
+        std::vector<float> mag(cells);
+        forSlabs(n.x, [&](int i) {
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k)
+                    centre[d.cell(i, j, k)] = 0.5f * glm::vec3(m_u[d.uIdx(i, j, k)] + m_u[d.uIdx(i + 1, j, k)],
+                                                               m_v[d.vIdx(i, j, k)] + m_v[d.vIdx(i, j + 1, k)],
+                                                               m_w[d.wIdx(i, j, k)] + m_w[d.wIdx(i, j, k + 1)]);
+        });
+        auto at = [&](const std::vector<glm::vec3>& f, int i, int j, int k) {
+            return f[d.cell(std::clamp(i, 0, n.x - 1), std::clamp(j, 0, n.y - 1), std::clamp(k, 0, n.z - 1))];
+        };
+        const float inv2h = 0.5f / h;
+        forSlabs(n.x, [&](int i) {
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k) {
+                    const glm::vec3 dx = (at(centre, i + 1, j, k) - at(centre, i - 1, j, k)) * inv2h;
+                    const glm::vec3 dy = (at(centre, i, j + 1, k) - at(centre, i, j - 1, k)) * inv2h;
+                    const glm::vec3 dz = (at(centre, i, j, k + 1) - at(centre, i, j, k - 1)) * inv2h;
+                    const glm::vec3 om(dy.z - dz.y, dz.x - dx.z, dx.y - dy.x);
+                    omega[d.cell(i, j, k)] = om;
+                    mag[d.cell(i, j, k)] = glm::length(om);
+                }
+        });
+        auto magAt = [&](int i, int j, int k) {
+            return mag[d.cell(std::clamp(i, 0, n.x - 1), std::clamp(j, 0, n.y - 1), std::clamp(k, 0, n.z - 1))];
+        };
+        std::vector<glm::vec3>& force = centre;   // reused
+        forSlabs(n.x, [&](int i) {
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k) {
+                    const size_t c = d.cell(i, j, k);
+                    if (m_solid[c]) {
+                        force[c] = glm::vec3(0.0f);
+                        continue;
+                    }
+                    const glm::vec3 g((magAt(i + 1, j, k) - magAt(i - 1, j, k)) * inv2h, (magAt(i, j + 1, k) - magAt(i, j - 1, k)) * inv2h,
+                                      (magAt(i, j, k + 1) - magAt(i, j, k - 1)) * inv2h);
+                    const float len = glm::length(g);
+                    force[c] = len > 1e-20f ? m_s.vorticity * h * glm::cross(g / len, omega[c]) : glm::vec3(0.0f);
+                }
+        });
+        forSlabs(n.x + 1, [&](int i) {
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k)
+                    if (i > 0 && i < n.x) u1[d.uIdx(i, j, k)] += dt * 0.5f * (force[d.cell(i - 1, j, k)].x + force[d.cell(i, j, k)].x);
+            if (i == n.x) return;
+            for (int j = 1; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k) v1[d.vIdx(i, j, k)] += dt * 0.5f * (force[d.cell(i, j - 1, k)].y + force[d.cell(i, j, k)].y);
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 1; k < n.z; ++k) w1[d.wIdx(i, j, k)] += dt * 0.5f * (force[d.cell(i, j, k - 1)].z + force[d.cell(i, j, k)].z);
+        });
+    }
+    // Source velocities on the faces inside each source.
+    for (const SmokeSource& src : m_s.sources) {
+        if (src.velocity == glm::vec3(0.0f)) continue;
+        forSlabs(n.x + 1, [&](int i) {
+            for (int j = 0; j <= n.y; ++j)
+                for (int k = 0; k <= n.z; ++k) {
+                    if (j < n.y && k < n.z && src.shape.contains(m_s.origin + h * glm::vec3(float(i), j + 0.5f, k + 0.5f)))
+                        u1[d.uIdx(i, j, k)] = src.velocity.x;
+                    if (i < n.x && k < n.z && src.shape.contains(m_s.origin + h * glm::vec3(i + 0.5f, float(j), k + 0.5f)))
+                        v1[d.vIdx(i, j, k)] = src.velocity.y;
+                    if (i < n.x && j < n.y && src.shape.contains(m_s.origin + h * glm::vec3(i + 0.5f, j + 0.5f, float(k))))
+                        w1[d.wIdx(i, j, k)] = src.velocity.z;
+                }
+        });
+    }
+    // 2. The CFL check on the velocity that will advect: refuse before anything changes.
+    double maxSq = 0.0;
+    for (const auto* f : {&u1, &v1, &w1})
+        for (float x : *f) {
+            if (!std::isfinite(x)) throw Error("simulate: the velocity is no longer finite at step " + std::to_string(m_steps + 1));
+            maxSq = std::max(maxSq, double(x) * double(x));
+        }
+    const double cfl = std::sqrt(3.0 * maxSq) * dt / h;   // a bound: each component at most its maximum
+    if (cfl > m_s.cflLimit)
+        throw Error("simulate: step " + std::to_string(m_steps + 1) + " would move the smoke " + num(cfl) +
+                    " cells (CFL number), over the limit " + num(m_s.cflLimit) + "; lower the time step (--dt) or the forces");
+    m_stats.cfl = cfl;
+    if (progress) progress->throwIfCancelled();
+
+    // 3. Self-advection (RK2 back-trace through the forced velocity).
+    {
+        const float scale = dt / h;
+        const FieldView fu{u1.data(), {n.x + 1, n.y, n.z}, {0.0f, 0.5f, 0.5f}};
+        const FieldView fv{v1.data(), {n.x, n.y + 1, n.z}, {0.5f, 0.0f, 0.5f}};
+        const FieldView fw{w1.data(), {n.x, n.y, n.z + 1}, {0.5f, 0.5f, 0.0f}};
+        const glm::vec3 hi = glm::vec3(n);
+        const SmokeInterp interp = m_s.interp;
+        auto vel = [&](const glm::vec3& q) { return glm::vec3(sampleLinear(fu, q), sampleLinear(fv, q), sampleLinear(fw, q)); };
+        auto trace = [&](const glm::vec3& x) {
+            const glm::vec3 mid = glm::clamp(x - 0.5f * scale * vel(x), glm::vec3(0.0f), hi);
+            return glm::clamp(x - scale * vel(mid), glm::vec3(0.0f), hi);
+        };
+        forSlabs(n.x + 1, [&](int i) {
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k < n.z; ++k) m_u[d.uIdx(i, j, k)] = sample(fu, trace(glm::vec3(float(i), j + 0.5f, k + 0.5f)), interp);
+            if (i == n.x) return;
+            for (int j = 0; j <= n.y; ++j)
+                for (int k = 0; k < n.z; ++k) m_v[d.vIdx(i, j, k)] = sample(fv, trace(glm::vec3(i + 0.5f, float(j), k + 0.5f)), interp);
+            for (int j = 0; j < n.y; ++j)
+                for (int k = 0; k <= n.z; ++k) m_w[d.wIdx(i, j, k)] = sample(fw, trace(glm::vec3(i + 0.5f, j + 0.5f, float(k))), interp);
+        });
+    }
+    if (progress) progress->throwIfCancelled();
+    // 4. Projection, 5. scalars, decay and emission.
+    project();
+    if (progress) progress->throwIfCancelled();
+    advectScalars(dt);
+    const float keepD = 1.0f - m_s.densityDecay * dt, keepT = 1.0f - m_s.temperatureDecay * dt;
+    const uint64_t stepSeed = m_s.seed * 0x9E3779B97F4A7C15ull + uint64_t(m_steps);
+    forSlabs(n.x, [&](int i) {
+        for (int j = 0; j < n.y; ++j)
+            for (int k = 0; k < n.z; ++k) {
+                const size_t c = d.cell(i, j, k);
+                if (m_solid[c]) continue;
+                float rho = m_density[c] * keepD, temp = m_temperature[c] * keepT;
+                const glm::vec3 p = m_s.origin + h * (glm::vec3(i, j, k) + 0.5f);
+                for (const SmokeSource& src : m_s.sources) {
+                    if (!src.shape.contains(p)) continue;
+                    uint64_t state = stepSeed ^ (uint64_t(c) * 0xD1B54A32D192ED03ull);
+                    const float r = float(double(splitmix64(state) >> 11) * (1.0 / 9007199254740992.0)) * 2.0f - 1.0f;
+                    rho = std::max(rho, std::clamp(src.density * (1.0f + m_s.jitter * r), 0.0f, 1.0f));
+                    temp = std::max(temp, src.temperature);
+                }
+                m_density[c] = rho;
+                m_temperature[c] = temp;
+            }
+    });
+    double speedSq = 0.0;
+    for (const auto* f : {&m_u, &m_v, &m_w})
+        for (float x : *f) {
+            if (!std::isfinite(x)) throw Error("simulate: the velocity is no longer finite at step " + std::to_string(m_steps + 1));
+            speedSq = std::max(speedSq, double(x) * double(x));
+        }
+    m_stats.maxSpeed = std::sqrt(3.0 * speedSq);
+    ++m_steps;
+}
+
+DensityGrid SmokeSim::densityGrid() const
+{
+    DensityGrid g;
+    g.geometry.dims = m_s.cells;
+    g.geometry.spacing = m_s.cellSize;
+    g.geometry.origin = glm::dvec3(m_s.origin) + 0.5 * double(m_s.cellSize);
+    g.density = m_density;
+    g.woodFraction.assign(m_density.size(), 0.0f);
+    return g;
+}
+
+DensityGrid SmokeSim::temperatureGrid() const
+{
+    DensityGrid g = densityGrid();
+    g.density = m_temperature;
+    return g;
+}
+
+} // namespace sylva::volume

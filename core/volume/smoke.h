@@ -1,0 +1,138 @@
+// Smoke simulation (seed 003 "Adventures in Fluid Simulation"; Fedkiw, Stam & Jensen 2001 "Visual
+// Simulation of Smoke"): stable fluids on a MAC grid with buoyancy from temperature, vorticity
+// confinement, sources and obstacles. Public API for `sylva simulate` and for a studio job.
+//
+// Grid: nx x ny x nz cubic cells of side h, y up. Scalars (density, temperature) at cell centres;
+// velocity components on the faces (u on x faces, (nx+1) ny nz of them, and so on). The top face
+// (y = ny h) is open (pressure 0, smoke leaves); the other five are walls; obstacles are cells whose
+// centre lies in an obstacle shape (their faces carry velocity 0).
+// One step (dt): sources -> forces (buoyancy, vorticity confinement) -> self-advection of the velocity
+// (semi-Lagrangian, RK2 back-trace) -> pressure projection (CG preconditioned by a geometric multigrid
+// V-cycle, in double, relative residual below pressureTolerance) -> advection of density and temperature
+// by the divergence-free velocity. Interpolation: trilinear, or monotonic tricubic (Fedkiw et al. 2001,
+// section 5: Hermite with slopes zeroed where they disagree with the secant).
+// Deterministic: every parallel loop writes disjoint cells and every sum is added in a fixed chunk
+// order (HostExec), so the same settings (seed included) give the same bits for any thread count.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/grid/grid.h"
+
+namespace sylva {
+class Progress;
+}
+
+namespace sylva::volume {
+
+inline constexpr int kSmokeMinCells = 3;
+inline constexpr int kSmokeMaxCells = 512;
+
+enum class SmokeInterp { Linear, MonotonicCubic };
+
+// A sphere (radius > 0) or an axis-aligned box (halfSize > 0 on every axis), world metres.
+struct SmokeShape {
+    enum class Kind { Sphere, Box } kind = Kind::Sphere;
+    glm::vec3 centre{0.0f};
+    float radius = 0.1f;
+    glm::vec3 halfSize{0.1f};
+    bool contains(const glm::vec3& p) const;
+};
+
+// Each step, cells whose centre lies in the shape get density = max(density, this density * (1 + jitter
+// * r)) (r in [-1, 1] from the seed, the step and the cell), temperature = max(temperature, this one),
+// and the faces inside take the source velocity.
+struct SmokeSource {
+    SmokeShape shape;
+    float density = 1.0f;         // in [0, 1]
+    float temperature = 1.0f;     // above ambient, in the simulation's temperature unit (>= 0)
+    glm::vec3 velocity{0.0f};     // metres per second
+};
+
+struct SmokeSettings {
+    glm::ivec3 cells{64, 96, 64};   // nx, ny, nz (each 3..512)
+    float cellSize = 1.0f / 64.0f;  // h, metres
+    glm::vec3 origin{0.0f};         // world position of the domain's lower corner
+    float dt = 0.02f;               // seconds per step
+    float buoyancyDensity = 0.05f;  // alpha: downward force per unit density (m/s^2)
+    float buoyancyTemperature = 2.0f;  // beta: upward force per unit temperature (m/s^2)
+    float vorticity = 0.3f;         // epsilon of the confinement force (0: off)
+    float densityDecay = 0.0f;      // fraction of density lost per second (0: none)
+    float temperatureDecay = 0.5f;  // fraction of temperature lost per second
+    float jitter = 0.2f;            // source density noise amplitude in [0, 1]
+    SmokeInterp interp = SmokeInterp::Linear;
+    double pressureTolerance = 1e-6;   // relative residual of the pressure solve
+    int pressureMaxIterations = 200;
+    float cflLimit = 5.0f;          // a step that moves anything more than this many cells is refused
+    uint64_t seed = 1;
+    std::vector<SmokeSource> sources;
+    std::vector<SmokeShape> obstacles;
+};
+
+// Statistics of the last step.
+struct SmokeStepStats {
+    int pressureIterations = 0;
+    double pressureResidual = 0.0;    // relative
+    double divergenceBefore = 0.0;    // L2 norm over fluid cells of div u before projection (1/s)
+    double divergenceAfter = 0.0;     // ... after
+    double maxSpeed = 0.0;            // m/s, after the step
+    double cfl = 0.0;                 // maxSpeed * dt / h of the velocity that advected this step
+};
+
+// Throws sylva::Error naming the setting for values out of range (sizes 0 or over 512, a grid over the
+// memory limit (SYLVA_MEMORY_LIMIT_MB or what the machine has), dt <= 0, NaN, densities outside [0, 1]).
+void validateSmoke(const SmokeSettings& settings);
+// Bytes the simulation holds for these cells (the memory check uses it).
+double smokeBytes(const glm::ivec3& cells);
+
+class SmokeSim {
+public:
+    explicit SmokeSim(const SmokeSettings& settings);   // validates; starts at rest, empty
+    ~SmokeSim();
+    SmokeSim(const SmokeSim&) = delete;
+    SmokeSim& operator=(const SmokeSim&) = delete;
+
+    // One step. Throws sylva::Error when the step would violate the CFL limit (the velocity times dt
+    // exceeds cflLimit cells; nothing is changed) or the fields stop being finite; Cancelled when the
+    // progress object was cancelled (between stages).
+    void step(Progress* progress = nullptr);
+    int stepCount() const { return m_steps; }
+    const SmokeStepStats& lastStats() const { return m_stats; }
+    const SmokeSettings& settings() const { return m_s; }
+
+    // Fields (z fastest, as every grid): density and temperature per cell; velocity per face.
+    std::vector<float>& density() { return m_density; }
+    std::vector<float>& temperature() { return m_temperature; }
+    std::vector<float>& u() { return m_u; }
+    std::vector<float>& v() { return m_v; }
+    std::vector<float>& w() { return m_w; }
+    const std::vector<float>& density() const { return m_density; }
+    const std::vector<float>& temperature() const { return m_temperature; }
+    const std::vector<uint8_t>& solid() const { return m_solid; }   // 1 for obstacle cells
+
+    // Stages, public for tests: project the current velocity (returns the stats' divergence fields)
+    // and advect the scalars by the current velocity for dt.
+    void project();
+    void advectScalars(float dt);
+    // L2 norm of the divergence over fluid cells (1/s).
+    double divergenceNorm() const;
+
+    // The density (or temperature) as a grid: node (i,j,k) at the centre of cell (i,j,k).
+    DensityGrid densityGrid() const;
+    DensityGrid temperatureGrid() const;   // temperature in .density (not bounded to [0, 1])
+
+private:
+    struct Solver;
+    SmokeSettings m_s;
+    int m_steps = 0;
+    SmokeStepStats m_stats;
+    std::vector<float> m_density, m_temperature, m_u, m_v, m_w;
+    std::vector<uint8_t> m_solid;
+    std::vector<double> m_pressure;
+    Solver* m_solver = nullptr;
+};
+
+} // namespace sylva::volume
