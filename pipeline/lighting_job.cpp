@@ -6,8 +6,10 @@
 #include <span>
 #include <sstream>
 
+#include "core/base/error.h"
 #include "core/lb/lb_solver.h"
 #include "core/mesh/triangle_mesh.h"
+#include "core/voxel/solid_voxelize.h"
 #include "pipeline/cache/grid_cache.h"
 
 namespace sylva {
@@ -33,16 +35,17 @@ CacheKey meshKey(const TriangleMesh& mesh, const VoxelizeSettings& voxel)
     key.add("dims x", voxel.dims.x).add("dims y", voxel.dims.y).add("dims z", voxel.dims.z);
     key.add("longest axis nodes", voxel.longestAxisNodes);
     key.add("subcells", voxel.subcells);
+    if (voxel.solid) key.add("solid voxelizer version", kSolidVoxelizerVersion);   // surface keys unchanged
     return key;
 }
 
-CacheKey lightKey(const DensityGrid& density, const lb::LbParams& p)
+CacheKey lightKey(const std::string& densityHex, const DensityGrid& density, const lb::LbParams& p)
 {
     CacheKey key;
     key.add("cache format", int64_t(kCacheFormatVersion));
     key.add("stage", "lighting");
     key.add("lb algorithm version", lb::kAlgorithmVersion);
-    key.add("density", densityHash(density));
+    key.add("density", densityHex);
     for (int c = 0; c < 3; ++c) {
         const lb::ChannelParams& ch = p.channels[size_t(c)];
         key.add("sigma_a", double(ch.sigmaA)).add("sigma_s", double(ch.sigmaS)).add("g", double(ch.g));
@@ -66,7 +69,90 @@ CacheKey lightKey(const DensityGrid& density, const lb::LbParams& p)
     return key;
 }
 
+// The basis solve parameters of direction m as keyed: the sun does not matter (the boundary is e_m).
+lb::LbParams keyedBasisParams(const lb::LbParams& params, int m)
+{
+    lb::LbParams p = lb::basisParams(params, m);
+    p.sun = glm::vec3(0.0f, 1.0f, 0.0f);
+    return p;
+}
+
+std::optional<LightingBasis> loadBasis(const std::string& densityHex, const DensityGrid& density, const lb::LbParams& params,
+                                       GridCache& cache, JobLog* log)
+{
+    if (params.tolerance > 0.0) return std::nullopt;
+    LightingBasis b;
+    b.directions = lb::basisDirections(lb::BasisSet::All);
+    for (int m : b.directions) {
+        std::string why;
+        auto hit = cache.loadLighting(lightKey(densityHex, density, keyedBasisParams(params, m)), &why);
+        if (!hit) {
+            if (log && why.find("no cache entry") == std::string::npos) log->warnings.push_back(why);
+            return std::nullopt;
+        }
+        b.grids.push_back(std::move(*hit));
+    }
+    return b;
+}
+
 } // namespace
+
+lb::BoundaryWeights boundaryWeightsOf(const lb::LbParams& params)
+{
+    if (params.boundary.empty()) return lb::sunWeights(params.sun, params.intensity);
+    lb::BoundaryWeights w;
+    for (int c = 0; c < 3; ++c)
+        for (int m = 1; m < lb::kDirections; ++m) w.w[size_t(c)][size_t(m)] = params.intensity[c] * params.boundary[size_t(m)];
+    return w;
+}
+
+LightingGrid relight(const LightingBasis& basis, const lb::BoundaryWeights& weights)
+{
+    std::vector<const LightingGrid*> grids;
+    for (const LightingGrid& g : basis.grids) grids.push_back(&g);
+    return lb::composeLighting(basis.directions, grids, weights);
+}
+
+LightingGrid relight(const LightingBasis& basis, const lb::LbParams& params) { return relight(basis, boundaryWeightsOf(params)); }
+
+LightingBasis lightingBasisFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache, Progress* progress,
+                               JobLog* log, Backend* backend)
+{
+    lb::validate(params);
+    if (params.tolerance > 0.0)
+        throw Error("a relighting basis needs a fixed step count: a tolerance solve is not linear in the boundary");
+    LightingBasis b;
+    b.directions = lb::basisDirections(lb::BasisSet::All);
+    const size_t n = b.directions.size();
+    for (size_t k = 0; k < n; ++k) {
+        SubProgress part(progress, double(k) / double(n), double(k + 1) / double(n));
+        Progress sub([&](double f, const std::string& msg) {
+            part.report(f, "basis direction " + std::to_string(k + 1) + "/" + std::to_string(n) + ": " + msg);
+        });
+        if (progress && progress->isCancelled()) sub.cancel();
+        JobLog one;
+        b.grids.push_back(lightingFor(density, keyedBasisParams(params, b.directions[k]), cache, progress ? &sub : nullptr, &one, backend));
+        if (log) {
+            log->warnings.insert(log->warnings.end(), one.warnings.begin(), one.warnings.end());
+            if (!one.stages.empty() && one.stages.back() != "light (cache hit)") log->stages.push_back("basis light");
+        }
+    }
+    if (log) log->stages.push_back("basis");
+    return b;
+}
+
+std::optional<LightingBasis> cachedLightingBasis(const DensityGrid& density, const lb::LbParams& params, GridCache& cache,
+                                                 JobLog* log)
+{
+    return loadBasis(densityHash(density), density, params, cache, log);
+}
+
+double basisBytes(const LightingBasis& basis)
+{
+    double bytes = 0.0;
+    for (const LightingGrid& g : basis.grids) bytes += double(g.rgb.size()) * sizeof(float);
+    return bytes;
+}
 
 std::string densityHash(const DensityGrid& density)
 {
@@ -125,7 +211,8 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
                          JobLog* log, Backend* backend)
 {
     lb::validate(params);
-    const CacheKey key = cache ? lightKey(density, params) : CacheKey{};   // hashing the grid costs time
+    const std::string densityHex = cache ? densityHash(density) : std::string();   // hashing the grid costs time
+    const CacheKey key = cache ? lightKey(densityHex, density, params) : CacheKey{};
     if (cache) {
         std::string why;
         if (auto hit = cache->loadLighting(key, &why)) {
@@ -134,6 +221,13 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
             return *hit;
         }
         if (log && why.find("no cache entry") == std::string::npos) log->warnings.push_back(why);
+        // A cached relighting basis of the same grid and optics: the weighted sum, no solve.
+        if (auto basis = loadBasis(densityHex, density, params, *cache, log)) {
+            LightingGrid grid = relight(*basis, params);
+            if (log) log->stages.push_back("light (relit from the cached basis)");
+            if (progress) progress->report(1.0, "lighting grid relit from the cached basis");
+            return grid;
+        }
     }
     LightingGrid grid = backend ? backend->solveLighting(density, params, progress, nullptr)
                                 : lb::solveLighting(density, params, progress);

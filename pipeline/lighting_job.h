@@ -1,11 +1,13 @@
 // The lighting pipeline for one species: mesh -> density grid -> LB lighting grid, with the grid cache.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/base/progress.h"
 #include "core/grid/grid.h"
+#include "core/lb/lb_basis.h"
 #include "core/lb/lb_params.h"
 #include "core/voxel/voxelize.h"
 #include "pipeline/import/mesh_import.h"
@@ -45,6 +47,28 @@ std::string densityHash(const DensityGrid& density);
 // key does not name the backend.
 LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache,
                          Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
+
+// Relighting by linearity (issue 18 item 2): the lighting of a species for unit boundaries e_m, one grid
+// per moving lattice direction (18: every sun, above or below the horizon), each cached like a lighting
+// grid (key: the grid, the optics, steps and storage, the boundary e_m; not the sun). lightingFor uses a
+// complete cached basis of the same grid and optics when the exact solve is not cached.
+struct LightingBasis {
+    std::vector<int> directions;     // lattice directions m
+    std::vector<LightingGrid> grids;   // the solve for boundary e_m at unit intensity, per direction
+};
+// Solves (or loads) every basis grid. Throws Error in tolerance mode (not linear in the boundary).
+LightingBasis lightingBasisFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache,
+                               Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
+// The basis from the cache when every grid of it is there (same grid, optics, steps, storage), else nullopt.
+std::optional<LightingBasis> cachedLightingBasis(const DensityGrid& density, const lb::LbParams& params, GridCache& cache,
+                                                 JobLog* log = nullptr);
+// The weights of a solve's boundary: params.boundary (or the sun's) x the intensity per channel.
+lb::BoundaryWeights boundaryWeightsOf(const lb::LbParams& params);
+// The lighting for a boundary as the weighted sum of the basis grids: no solve.
+LightingGrid relight(const LightingBasis& basis, const lb::BoundaryWeights& weights);
+LightingGrid relight(const LightingBasis& basis, const lb::LbParams& params);
+// Memory the basis holds (fp32 grids).
+double basisBytes(const LightingBasis& basis);
 
 // The LB parameters of a solve as the JSON object a lighting sidecar stores under "parameters"
 // (`sylva light` and the studio's grid export): preset, per-channel sigma_a, sigma_s, g, intensity,

@@ -41,6 +41,12 @@ LbParams paramsFromPreset(const Preset& preset)
     return p;
 }
 
+void useFrontDefaults(LbParams& params)
+{
+    params.storage = Storage::Fp16;
+    params.stepsPerEdge = 1;
+}
+
 int defaultSteps(const glm::ivec3& dims) { return 2 * glm::max(dims.x, glm::max(dims.y, dims.z)); }
 
 int fixedSteps(const LbParams& params, const glm::ivec3& dims)

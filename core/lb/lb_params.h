@@ -61,6 +61,12 @@ void validate(const LbParams& params);
 // Checks the density grid: dims >= 3, values finite in [0,1], sizes consistent. Throws Error.
 void validateDensity(const DensityGrid& density);
 
+// The configuration `sylva light` runs by default, a point on the measured front (docs/ACCURACY.md,
+// docs/PERFORMANCE.md "sylva light's default"): fp16 storage, 1 x the longest edge in fixed steps (linear
+// in the boundary, so a relighting basis of it composes any sun). The seed's 2 x steps in fp32 is
+// `--seed-steps`.
+void useFrontDefaults(LbParams& params);
+
 // The seed's step count: 2 x the longest edge.
 int defaultSteps(const glm::ivec3& dims);
 // The step count of a fixed-step solve with these parameters: steps, or stepsPerEdge x the longest edge.
