@@ -17,6 +17,7 @@
 
 #include "core/base/error.h"
 #include "core/base/progress.h"
+#include "core/voxel/solid_voxelize.h"
 #include "core/voxel/tri_box.h"
 
 namespace sylva {
@@ -141,6 +142,7 @@ DensityGrid voxelize(const TriangleMesh& mesh, const VoxelizeSettings& settings,
         throw Error("voxelize: subcells is " + std::to_string(sc) + ", must be in 1.." +
                     std::to_string(kVoxelMaxSubcells));
     validateMesh(mesh);
+    if (settings.solid) return voxelizeSolid(mesh, settings, progress);
     if (progress) progress->report(0.0, "voxelizing");
 
     const Bounds3 bounds = meshBounds(mesh);

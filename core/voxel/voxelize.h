@@ -16,11 +16,12 @@ inline constexpr int kVoxelMaxNodes = 512;
 inline constexpr int kVoxelizerVersion = 1;
 inline constexpr int kVoxelMaxSubcells = 16;  // sub-cells per cell edge; 16^3 = 4096 density levels
 
-// How to size the grid and refine its cells. 20 bytes.
+// How to size the grid and refine its cells. 24 bytes.
 struct VoxelizeSettings {
     glm::ivec3 dims{0};          // nodes per axis (each 3..512) when all three are > 0; else automatic
     int longestAxisNodes = 128;  // automatic sizing: nodes along the longest axis of the mesh bounds (3..512)
     int subcells = 3;            // each cell is split into subcells^3 sub-cells (1..16)
+    bool solid = false;          // fill the interior (voxelizeSolid, solid_voxelize.h) instead of marking the surface
 };
 
 // Grid placement for mesh bounds (metres). Each node owns a cube cell of side `spacing` centred on
@@ -45,6 +46,7 @@ GridGeometry gridForMesh(const Bounds3& bounds, const VoxelizeSettings& settings
 // Output is identical for any thread count. Reports progress every 2% and honours cancel
 // (throws Cancelled). Throws sylva::Error for bad settings (see gridForMesh, subcells outside
 // 1..16), an empty mesh, non-finite coordinates, vertex or material indices out of range.
+// With settings.solid, returns voxelizeSolid(mesh, settings, progress) instead (solid_voxelize.h).
 DensityGrid voxelize(const TriangleMesh& mesh, const VoxelizeSettings& settings, Progress* progress = nullptr);
 
 } // namespace sylva

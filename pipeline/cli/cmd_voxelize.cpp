@@ -17,6 +17,7 @@ int runVoxelize(const Args& args)
     auto threads = threadLimit(args);
     const std::string mesh = args.positional()[0];
     DensityJob job{mesh, importOptions(args), voxelSettings(args)};   // usage errors before file errors
+    job.voxel.solid = args.has("--solid");
     const PictureOptions picture = pictureOptions(args);
     const std::string out = outputFile(args, gridFileExtensions());
     requireReadable(mesh, "mesh file");
@@ -46,7 +47,9 @@ int runVoxelize(const Args& args)
 Command voxelizeCommand()
 {
     return {"voxelize", "MESH -o DENSITY.npy|.vdb", "voxelize a mesh into a density grid (+ wood fraction)",
-            {kGrid, kSubcells, kLeafMaterials, kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
+            {kGrid, kSubcells, kLeafMaterials,
+             {"--solid", "", "fill the interior (winding numbers: open edges and gaps do not leak); the grid is a medium, wood 0"},
+             kOutput, kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
             1, 1, &runVoxelize};
 }
 

@@ -16,5 +16,7 @@ Command infoCommand();        // cmd_info.cpp
 Command skyCommand();         // cmd_sky.cpp
 Command cacheCommand();       // cmd_cache.cpp
 Command exportCommand();      // cmd_export.cpp
+Command volumeCommand();      // cmd_volume.cpp
+Command simulateCommand();    // cmd_simulate.cpp
 
 } // namespace sylva::cli

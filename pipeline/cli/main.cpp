@@ -24,7 +24,7 @@ namespace {
 // The commands in the order `sylva --help` lists them.
 std::vector<Command> commands()
 {
-    return {growCommand(), voxelizeCommand(), lightCommand(), referenceCommand(), renderCommand(), skyCommand(), exportCommand(), studyCommand(), infoCommand(), cacheCommand()};
+    return {growCommand(), voxelizeCommand(), lightCommand(), referenceCommand(), renderCommand(), skyCommand(), volumeCommand(), simulateCommand(), exportCommand(), studyCommand(), infoCommand(), cacheCommand()};
 }
 
 void printMainHelp(const std::vector<Command>& cmds)
