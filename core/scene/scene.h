@@ -11,6 +11,7 @@
 
 #include "core/lb/lb_params.h"
 #include "core/sky/sky.h"
+#include "core/sky/sun_position.h"
 
 namespace sylva {
 
@@ -91,10 +92,13 @@ struct TerrainDesc {
 };
 
 // Sun: direction toward the sun (world, +Y up), blackbody colour temperature, intensity (scales radiance).
+// place set: the sun by date, time and place (NOAA, core/sky/sun_position.h); direction is then its
+// result (placeSunDirection) and the file stores the place instead of the direction.
 struct SunDesc {
     glm::vec3 direction{0.4f, 0.8f, 0.3f};
     double temperature = 6500.0;         // kelvin
     float intensity = 1.0f;
+    std::optional<sky::SunPlace> place;
 };
 
 namespace sky {

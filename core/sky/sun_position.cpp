@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/base/error.h"
@@ -56,6 +57,44 @@ double julianDay(int year, int month, int day, double utHour)
     const int a = y / 100;
     const int b = 2 - a + a / 4;
     return std::floor(365.25 * (y + 4716)) + std::floor(30.6001 * (m + 1)) + day + b - 1524.5 + utHour / 24.0;
+}
+
+bool parseSunDate(const std::string& text, int* year, int* month, int* day)
+{
+    int y = 0, m = 0, d = 0, used = 0;
+    if (std::sscanf(text.c_str(), "%4d-%2d-%2d%n", &y, &m, &d, &used) != 3 || size_t(used) != text.size() || text.size() != 10) return false;
+    *year = y, *month = m, *day = d;
+    return true;
+}
+
+bool parseSunTime(const std::string& text, double* hour)
+{
+    int h = 0, mi = 0, used = 0;
+    double sec = 0.0;
+    const bool hms = std::sscanf(text.c_str(), "%2d:%2d:%lf%n", &h, &mi, &sec, &used) == 3 && size_t(used) == text.size();
+    if (!hms && !(std::sscanf(text.c_str(), "%2d:%2d%n", &h, &mi, &used) == 2 && size_t(used) == text.size())) return false;
+    if (text.size() < 5 || text[2] != ':' || h < 0 || mi < 0 || mi > 59 || !(sec >= 0.0 && sec < 60.0)) return false;
+    *hour = h + mi / 60.0 + sec / 3600.0;
+    return true;
+}
+
+std::string formatSunDate(const SunPlace& p)
+{
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%04d-%02d-%02d", p.year, p.month, p.day);
+    return buf;
+}
+
+std::string formatSunTime(double hour)
+{
+    const long long totalMs = std::llround(std::clamp(hour, 0.0, 24.0) * 3600000.0);
+    const int h = int(totalMs / 3600000), mi = int(totalMs / 60000 % 60);
+    const double sec = double(totalMs % 60000) / 1000.0;
+    char buf[32];
+    if (totalMs % 60000 == 0) std::snprintf(buf, sizeof buf, "%02d:%02d", h, mi);
+    else if (totalMs % 1000 == 0) std::snprintf(buf, sizeof buf, "%02d:%02d:%02d", h, mi, int(sec));
+    else std::snprintf(buf, sizeof buf, "%02d:%02d:%06.3f", h, mi, sec);
+    return buf;
 }
 
 SunPosition noaaSunPosition(const SunPlace& p)

@@ -9,6 +9,8 @@
 // lifts the sun by about 0.5 degrees at the horizon); no parallax, no local pressure or temperature.
 #pragma once
 
+#include <string>
+
 #include <glm/glm.hpp>
 
 namespace sylva::sky {
@@ -37,5 +39,16 @@ SunPosition noaaSunPosition(const SunPlace& place);
 
 // Julian day (UT) of a Gregorian calendar date at a UT hour (Meeus chapter 7).
 double julianDay(int year, int month, int day, double utHour);
+
+// The text forms of a place's date and clock time (scene files, the CLI's --sun-at, the studio):
+// "YYYY-MM-DD" and "HH:MM" or "HH:MM:SS" (seconds may have a fraction; 24:00 allowed). false: not of that
+// form (the ranges of the values are noaaSunPosition's to check, except minutes and seconds 0 .. 59).
+bool parseSunDate(const std::string& text, int* year, int* month, int* day);
+bool parseSunTime(const std::string& text, double* hour);
+std::string formatSunDate(const SunPlace& place);
+std::string formatSunTime(double hour);   // "HH:MM", or "HH:MM:SS" when the seconds are not whole minutes
+
+// The direction of noaaSunPosition(place).direction (throws as it does).
+inline glm::vec3 placeSunDirection(const SunPlace& place) { return noaaSunPosition(place).direction; }
 
 } // namespace sylva::sky

@@ -46,7 +46,7 @@ int runLight(const Args& args)
 
 Command lightCommand()
 {
-    return {"light", "(--density DENSITY.npy|.vdb | --mesh MESH) --sun X,Y,Z -o LIGHT.npy|.vdb",
+    return {"light", "(--density DENSITY.npy|.vdb | --mesh MESH) (--sun X,Y,Z | --sun-at DATE,TIME,ZONE,LAT,LON) -o LIGHT.npy|.vdb",
             "solve the lattice-Boltzmann lighting of a density grid",
             {{"--density", "FILE", "density grid: .npy from sylva voxelize, or .vdb (the float grid 'density', else the first float grid)"},
              {"--mesh", "FILE", "mesh to voxelize first (with --grid)"},
@@ -58,6 +58,7 @@ Command lightCommand()
              {"--keep-f0", "", "keep absorbed light (clouds, plastics)"},
              {"--zero-f0", "", "zero f_0 after each step (plants)"},
              {"--sun", "X,Y,Z", "direction toward the sun (any length)"},
+             kSunAt,
              {"--intensity", "R,G,B", "sun intensity per channel (default 1)"},
              {"--steps", "N", "fixed step count (default 2 x the longest grid edge)"},
              {"--tol", "T", "stop when the relative change per step falls under T"},

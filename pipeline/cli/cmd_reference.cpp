@@ -78,7 +78,7 @@ int runReference(const Args& args)
 
 Command referenceCommand()
 {
-    return {"reference", "(--density DENSITY.npy | --mesh MESH) --sun X,Y,Z -o REF.npy",
+    return {"reference", "(--density DENSITY.npy | --mesh MESH) (--sun X,Y,Z | --sun-at DATE,TIME,ZONE,LAT,LON) -o REF.npy",
             "Monte Carlo reference lighting (slow; measures the LB model): mean and standard error",
             {{"--density", "FILE", "density grid: .npy from sylva voxelize, or .vdb (the float grid 'density', else the first float grid)"},
              {"--mesh", "FILE", "mesh to voxelize first (with --grid)"},
@@ -90,6 +90,7 @@ Command referenceCommand()
              {"--keep-f0", "", "absorbed light is re-emitted isotropically (clouds, plastics)"},
              {"--zero-f0", "", "absorbed light is removed (plants)"},
              {"--sun", "X,Y,Z", "direction toward the sun (any length)"},
+             kSunAt,
              {"--intensity", "R,G,B", "sun intensity per channel (default 1)"},
              {"--paths", "N", "paths per channel (default 1000000); the error falls as 1/sqrt(N)"},
              {"--seed", "S", "random seed (default 1); the same seed gives the same bits"},

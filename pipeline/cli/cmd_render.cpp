@@ -6,6 +6,7 @@
 #include "pipeline/cli/cli_util.h"
 #include "pipeline/cli/commands.h"
 #include "pipeline/cli/common_options.h"
+#include "pipeline/io/env_map_io.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/lighting_job.h"
 #include "pipeline/render/render_job.h"
@@ -50,6 +51,21 @@ Scene sceneForArgs(const Args& args, std::string* stem)
     if (args.has("--accel") && !parseAccel(args.get("--accel"), &r.accel))
         throw UsageError("option --accel: expected bvh or kdtree, got '" + args.get("--accel") + "'");
     if (args.has("--no-shadows")) r.shadows = false;
+    if (args.has("--sun") && args.has("--sun-at")) throw UsageError("give either --sun or --sun-at, not both");
+    if (args.has("--sun")) {
+        if (args.get("--sun").find(',') == std::string::npos) throw UsageError("option --sun: expected X,Y,Z");
+        scene.sun.direction = parseTriple("--sun", args.get("--sun"));
+        if (!(glm::length(scene.sun.direction) > 0.0f)) throw UsageError("option --sun: the direction must not be zero");
+        scene.sun.place.reset();
+    }
+    if (args.has("--sun-at")) {
+        scene.sun.place = parseSunAt(args.get("--sun-at"));
+        scene.sun.direction = sky::placeSunDirection(*scene.sun.place);
+    }
+    if ((args.has("--sun") || args.has("--sun-at")) && scene.skyModel.kind == sky::SkyKind::Preetham) {
+        scene.skyModel.built.reset();   // the Preetham sky follows its sun
+        loadSceneSky(scene);
+    }
     for (auto [option, field] : {std::pair{"--alpha-distance", &r.alphaDistance}, std::pair{"--prune-distance", &r.pruneDistance}}) {
         if (!args.has(option)) continue;
         const double m = parseNumber(option, args.get(option));
@@ -199,6 +215,8 @@ Command renderCommand()
              {"--mode", "M", "full (LB indirect + sun), local (sun only), ambient (sun + matched constant), lb"},
              {"--accel", "bvh|kdtree", "acceleration structure (default: the scene's, bvh)"},
              {"--no-shadows", "", "no shadow rays"},
+             {"--sun", "X,Y,Z", "direction toward the sun (+Y up, any length), replacing the scene's"},
+             kSunAt,
              {"--alpha-distance", "M", "skip leaf cut-out tests beyond M metres from the camera (0: off, default)"},
              {"--prune-distance", "M", "prune leaves of plants beyond M metres, area-preserving (0: off, default)"},
              kBackend,

@@ -21,31 +21,6 @@
 namespace sylva::cli {
 namespace {
 
-// --sun-at YYYY-MM-DD,HH:MM[:SS],ZONE,LAT,LON -> the NOAA sun position (UsageError for a malformed value).
-sky::SunPosition sunAt(const std::string& text)
-{
-    const std::vector<std::string> parts = splitList(text);
-    const std::string expected = "expected YYYY-MM-DD,HH:MM[:SS],ZONE,LATITUDE,LONGITUDE (e.g. 2024-06-21,08:30,+2,48.14,11.58), got '" + text + "'";
-    if (parts.size() != 5) throw UsageError("option --sun-at: " + expected);
-    sky::SunPlace place;
-    int h = 0, mi = 0;
-    double sec = 0.0;
-    char tail = 0;
-    if (std::sscanf(parts[0].c_str(), "%d-%d-%d%c", &place.year, &place.month, &place.day, &tail) != 3 ||
-        (std::sscanf(parts[1].c_str(), "%d:%d:%lf%c", &h, &mi, &sec, &tail) != 3 && std::sscanf(parts[1].c_str(), "%d:%d%c", &h, &mi, &tail) != 2) ||
-        mi < 0 || mi > 59 || sec < 0.0 || sec >= 60.0)
-        throw UsageError("option --sun-at: " + expected);
-    place.hour = h + mi / 60.0 + sec / 3600.0;
-    place.timeZoneHours = parseNumber("--sun-at", parts[2]);
-    place.latitudeDeg = parseNumber("--sun-at", parts[3]);
-    place.longitudeDeg = parseNumber("--sun-at", parts[4]);
-    try {
-        return sky::noaaSunPosition(place);
-    } catch (const Error& e) {
-        throw UsageError(std::string("option --sun-at: ") + e.what());
-    }
-}
-
 int runSky(const Args& args)
 {
     const std::string out = args.require("--output");
@@ -65,7 +40,7 @@ int runSky(const Args& args)
     }
     if (args.has("--sun-at")) {
         if (args.has("--sun")) throw UsageError("give either --sun or --sun-at, not both");
-        const sky::SunPosition pos = sunAt(args.get("--sun-at"));
+        const sky::SunPosition pos = sky::noaaSunPosition(parseSunAt(args.get("--sun-at")));
         params.sunDirection = pos.direction;
         std::printf("sun at %s: elevation %.3f deg, azimuth %.3f deg (compass bearing %.3f deg; NOAA solar position)\n",
                     args.get("--sun-at").c_str(), pos.elevationDeg, pos.azimuthDeg, pos.compassAzimuthDeg);
@@ -123,8 +98,7 @@ Command skyCommand()
             {{"--turbidity", "T", "atmospheric turbidity, 2 (clear) .. 10 (hazy); default 3"},
              {"--sun", "X,Y,Z", "direction toward the sun (+Y up), elevation >= -10 degrees; default: the scene's sun, "
                                 "else (0.4, 0.8, 0.3). Until scenes have a sky field, SCENE gives only the sun"},
-             {"--sun-at", "DATE,TIME,ZONE,LAT,LON", "the sun by date and place instead of --sun: YYYY-MM-DD,HH:MM[:SS] local "
-                                                    "time, hours from UTC (east +), latitude (north +), longitude (east +)"},
+             kSunAt,
              {"--width", "W", "map width in pixels, even, 2 .. 16384 (height W/2); default 512"},
              {"--scale", "S", "multiplies the radiance (the model's unit is kcd/m^2); default 1"},
              kOutput},

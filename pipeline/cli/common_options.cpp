@@ -32,6 +32,25 @@ void requireReadable(const std::string& path, const char* what)
     if (fs::is_directory(path, ec)) throw Error(path + ": is a folder, not a " + std::string(what));
 }
 
+sky::SunPlace parseSunAt(const std::string& text)
+{
+    const std::vector<std::string> parts = splitList(text);
+    const std::string expected =
+        "expected YYYY-MM-DD,HH:MM[:SS],ZONE,LATITUDE,LONGITUDE (e.g. 2024-06-21,08:30,+2,48.14,11.58), got '" + text + "'";
+    sky::SunPlace place;
+    if (parts.size() != 5 || !sky::parseSunDate(parts[0], &place.year, &place.month, &place.day) || !sky::parseSunTime(parts[1], &place.hour))
+        throw UsageError("option --sun-at: " + expected);
+    place.timeZoneHours = parseNumber("--sun-at", parts[2]);
+    place.latitudeDeg = parseNumber("--sun-at", parts[3]);
+    place.longitudeDeg = parseNumber("--sun-at", parts[4]);
+    try {
+        sky::noaaSunPosition(place);
+    } catch (const Error& e) {
+        throw UsageError(std::string("option --sun-at: ") + e.what());
+    }
+    return place;
+}
+
 std::string backendName(const Args& args)
 {
     const std::string backend = args.get("--backend", "auto");

@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 
 #include "core/backend/backend.h"
+#include "core/sky/sun_position.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/cli/args.h"
 #include "pipeline/io/file_extension.h"
@@ -20,6 +21,9 @@ inline const OptionSpec kOutput{"--output", "FILE", "output file (also -o)"};
 inline const OptionSpec kCache{"--cache", "DIR", "grid cache folder (default $XDG_CACHE_HOME/sylva or ~/.cache/sylva)"};
 inline const OptionSpec kNoCache{"--no-cache", "", "neither read nor write the grid cache"};
 inline const OptionSpec kBackend{"--backend", "auto|cpu|cuda", "compute backend (default auto)"};
+inline const OptionSpec kSunAt{"--sun-at", "DATE,TIME,ZONE,LAT,LON",
+                               "the sun by date and place (NOAA's solar position, about 0.02 degrees): YYYY-MM-DD,HH:MM[:SS] "
+                               "local time, hours ahead of UTC (east +), latitude (north +), longitude (east +)"};
 
 // --threads N: the limit lives as long as the returned object (null without the option).
 std::unique_ptr<tbb::global_control> threadLimit(const Args& args);
@@ -27,6 +31,8 @@ std::unique_ptr<tbb::global_control> threadLimit(const Args& args);
 std::unique_ptr<GridCache> openCache(const Args& args);
 // Throws Error "PATH: no such WHAT" / "PATH: is a folder, not a WHAT".
 void requireReadable(const std::string& path, const char* what);
+// The value of --sun-at (kSunAt's form), its ranges checked (UsageError naming the option and the field).
+sky::SunPlace parseSunAt(const std::string& text);
 // --backend, checked (UsageError for another name); "auto" without the option.
 std::string backendName(const Args& args);
 // The backend of that name; notes (CUDA requested but absent, ...) go to stderr as "note: ...".

@@ -100,8 +100,13 @@ lb::LbParams lightParams(const Args& args)
     if (args.has("--keep-f0") && args.has("--zero-f0")) throw UsageError("--keep-f0 and --zero-f0 exclude each other");
     if (args.has("--keep-f0")) p.zeroF0 = false;
     if (args.has("--zero-f0")) p.zeroF0 = true;
-    p.sun = parseTriple("--sun", args.require("--sun"));
-    if (args.get("--sun").find(',') == std::string::npos) throw UsageError("option --sun: expected X,Y,Z");
+    if (args.has("--sun") && args.has("--sun-at")) throw UsageError("give either --sun or --sun-at, not both");
+    if (args.has("--sun-at")) {
+        p.sun = sky::placeSunDirection(parseSunAt(args.get("--sun-at")));
+    } else {
+        p.sun = parseTriple("--sun", args.require("--sun"));
+        if (args.get("--sun").find(',') == std::string::npos) throw UsageError("option --sun: expected X,Y,Z");
+    }
     if (args.has("--intensity")) p.intensity = parseTriple("--intensity", args.get("--intensity"));
     if (args.has("--steps") && args.has("--tol")) throw UsageError("--steps and --tol exclude each other");
     if (args.has("--steps")) p.steps = int(parseInteger("--steps", args.get("--steps"), 1, 1000000));

@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "core/sky/preetham.h"
+#include "core/sky/sun_position.h"
 #include "core/sky/virtual_lights.h"
 #include "core/terrain/height_field.h"
 #include "pipeline/grow/tree_grower.h"
@@ -243,6 +244,7 @@ const Table<SunDesc>& sunTable()
         TableBuilder<SunDesc> b(Layout::Inline);
         b.vector("direction", &SunDesc::direction, true)
             .doc("`[x, y, z]`", "toward the sun, any length (non-zero)")
+            .writtenIf([](const SunDesc& s) { return !s.place.has_value(); })
             .summarized([](const SunDesc& s) {
                 const glm::dvec3 sun(s.direction);   // elevation and azimuth in double
                 const double len = glm::length(sun);
@@ -265,6 +267,64 @@ const Table<SunDesc>& sunTable()
                     r.fail(path.field("elevation"), elevationBounds.problem() + ", got " + json::fmt(elevation));
                 sun.direction = sunDirection(elevation, azimuth);
             });
+        // A third form: the date, clock time and place (NOAA's solar position), stored instead of the direction.
+        auto placeField = [&b](const char* key, auto read, auto write) -> json::Field<SunDesc>& {
+            return b.custom(
+                         key,
+                         [read](JsonReader& r, const QJsonValue& v, const KeyPath& p, SunDesc& s) {
+                             if (!s.place) s.place = sky::SunPlace{};
+                             read(r, v, p, *s.place);
+                         },
+                         [write](JsonWriter& w, const SunDesc& s, const KeyPath& p, int) { write(w, *s.place, p); })
+                .writtenIf([](const SunDesc& s) { return s.place.has_value(); })
+                .shown("-");
+        };
+        placeField(
+            "date",
+            [](JsonReader& r, const QJsonValue& v, const KeyPath& p, sky::SunPlace& pl) {
+                if (!sky::parseSunDate(r.string(v, p).toStdString(), &pl.year, &pl.month, &pl.day))
+                    r.fail(p, "expected a date \"YYYY-MM-DD\", got " + json::quoted(v.toString()));
+            },
+            [](JsonWriter& w, const sky::SunPlace& pl, const KeyPath&) { w.string(sky::formatSunDate(pl)); })
+            .doc("string", "`\"YYYY-MM-DD\"`: the sun by date, time and place (NOAA's solar position, about 0.02 degrees); needs `time`, "
+                           "`timezone`, `latitude`, `longitude`; instead of `direction`")
+            .summarized([](const SunDesc& s) {
+                if (!s.place) return std::string();
+                char buf[200];
+                std::snprintf(buf, sizeof buf, "on %s at %s UTC%+g, latitude %.4f, longitude %.4f", sky::formatSunDate(*s.place).c_str(),
+                              sky::formatSunTime(s.place->hour).c_str(), s.place->timeZoneHours, s.place->latitudeDeg, s.place->longitudeDeg);
+                return std::string(buf);
+            });
+        placeField(
+            "time",
+            [](JsonReader& r, const QJsonValue& v, const KeyPath& p, sky::SunPlace& pl) {
+                if (!sky::parseSunTime(r.string(v, p).toStdString(), &pl.hour))
+                    r.fail(p, "expected a local clock time \"HH:MM\" or \"HH:MM:SS\", got " + json::quoted(v.toString()));
+            },
+            [](JsonWriter& w, const sky::SunPlace& pl, const KeyPath&) { w.string(sky::formatSunTime(pl.hour)); })
+            .doc("string", "`\"HH:MM[:SS]\"`: local clock time, 00:00 .. 24:00; with `date`");
+        const auto placeNumber = [&placeField](const char* key, double sky::SunPlace::*member, double limit, const char* rule) {
+            placeField(
+                key,
+                [member, limit](JsonReader& r, const QJsonValue& v, const KeyPath& p, sky::SunPlace& pl) {
+                    const double x = r.number(v, p);
+                    if (!(std::abs(x) <= limit)) r.fail(p, "must lie in [" + json::fmt(-limit) + ", " + json::fmt(limit) + "], got " + json::fmt(x));
+                    pl.*member = x;
+                },
+                [member](JsonWriter& w, const sky::SunPlace& pl, const KeyPath& p) { w.number(pl.*member, p); })
+                .doc("number", rule);
+        };
+        placeNumber("timezone", &sky::SunPlace::timeZoneHours, 14.0, "hours of local time ahead of UTC (east +: 1 for CET, 2 for CEST), -14 .. 14; with `date`");
+        placeNumber("latitude", &sky::SunPlace::latitudeDeg, 90.0, "degrees north (south negative), -90 .. 90; with `date`");
+        placeNumber("longitude", &sky::SunPlace::longitudeDeg, 180.0, "degrees east (west negative), -180 .. 180; with `date`");
+        b.table.fields.back().then = [](JsonReader& r, const QJsonObject&, const KeyPath& path, SunDesc& sun) {
+            if (!sun.place) return;
+            try {
+                sun.direction = sky::placeSunDirection(*sun.place);
+            } catch (const Error& e) {
+                r.fail(path, e.what());
+            }
+        };
         b.number("temperature", &SunDesc::temperature, Bounds{.lo = 1000.0, .hi = 40000.0, .unit = " kelvin"})
             .doc("number", "blackbody colour temperature, 1000 .. 40000 K")
             .summarized([](const SunDesc& s) {
@@ -280,6 +340,15 @@ const Table<SunDesc>& sunTable()
             const bool hasElevation = o.contains(QLatin1String("elevation")), hasAzimuth = o.contains(QLatin1String("azimuth"));
             if (hasDirection && (hasElevation || hasAzimuth))
                 r.fail(path, "give either \"direction\" or \"elevation\" and \"azimuth\", not both");
+            static const char* const kPlace[] = {"date", "time", "timezone", "latitude", "longitude"};
+            int placeKeys = 0;
+            for (const char* k : kPlace) placeKeys += o.contains(QLatin1String(k)) ? 1 : 0;
+            if (placeKeys > 0 && (hasDirection || hasElevation || hasAzimuth))
+                r.fail(path, "give one of \"direction\", \"elevation\" and \"azimuth\", or \"date\", \"time\", \"timezone\", \"latitude\" and \"longitude\"");
+            if (placeKeys > 0)
+                for (const char* k : kPlace)
+                    if (!o.contains(QLatin1String(k)))
+                        r.fail(path.field(k), "missing (the sun by date and place needs date, time, timezone, latitude and longitude)");
             if (hasElevation && !hasAzimuth) r.fail(path.field("azimuth"), "missing (required with \"elevation\")");
             if (hasAzimuth && !hasElevation) r.fail(path.field("elevation"), "missing (required with \"azimuth\")");
         };
@@ -520,7 +589,7 @@ const Table<Scene>& sceneTable()
                 .summarized(sectionLine("terrain", [](const Scene& sc) -> const TerrainDesc& { return sc.terrain; }, terrainTable()));
         }
         b.object("sun", &Scene::sun, sunTable())
-            .doc("object", "`direction`, or `elevation` with `azimuth`; not both")
+            .doc("object", "`direction`, or `elevation` with `azimuth`, or `date`, `time`, `timezone`, `latitude` and `longitude`; one of the three")
             .summarized(sectionLine("sun", [](const Scene& s) -> const SunDesc& { return s.sun; }, sunTable()));
         b.object("sky", [](auto& s) -> auto& { return s; }, skyTable())
             .doc("object", "")

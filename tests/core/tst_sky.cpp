@@ -569,6 +569,34 @@ private Q_SLOTS:
         const SunPosition noon = noaaSunPosition({.year = 2024, .month = 3, .day = 20, .hour = 12.0, .timeZoneHours = 0.0, .latitudeDeg = 45.0, .longitudeDeg = 0.0});
         QVERIFY(noon.direction.z > 0.7f && std::abs(noon.direction.x) < 0.05f);
         QVERIFY(std::abs(noon.elevationDeg - 45.0) < 1.0);   // equinox: 90 - latitude (declination ~0, refraction)
+        // The almanac's June solstice of 2024 (USNO: June 20, 20:51 UT): the sun's apparent longitude is 90
+        // degrees, so its apparent declination is the true obliquity of the ecliptic, computed here by Meeus
+        // (22.2: mean obliquity; chapter 22's nutation in obliquity, its four leading terms); a day either
+        // side it is lower by the second-order fall (under 0.01 degrees).
+        const SunPosition solstice = noaaSunPosition({.year = 2024, .month = 6, .day = 20, .hour = 20.0 + 51.0 / 60.0});
+        const double tc = (solstice.julianDay - 2451545.0) / 36525.0, rad = kPiD / 180.0;
+        const double omega = (125.04452 - 1934.136261 * tc) * rad, lSun = (280.4665 + 36000.7698 * tc) * rad,
+                     lMoon = (218.3165 + 481267.8813 * tc) * rad;
+        const double obliquity = 23.0 + 26.0 / 60.0 + (21.448 - tc * (46.8150 + tc * (0.00059 - tc * 0.001813))) / 3600.0 +
+                                 (9.20 * std::cos(omega) + 0.57 * std::cos(2.0 * lSun) + 0.10 * std::cos(2.0 * lMoon) - 0.09 * std::cos(2.0 * omega)) / 3600.0;
+        qInfo("June solstice 2024: declination %.5f (true obliquity %.5f)", solstice.declinationDeg, obliquity);
+        QVERIFY(std::abs(solstice.declinationDeg - obliquity) < 0.002);
+        for (int day : {19, 21}) {
+            const double d = noaaSunPosition({.year = 2024, .month = 6, .day = day, .hour = 20.0 + 51.0 / 60.0}).declinationDeg;
+            QVERIFY(d < solstice.declinationDeg && d > solstice.declinationDeg - 0.01);
+        }
+        // The text forms read back.
+        int y = 0, mo = 0, d = 0;
+        double h = 0.0;
+        QVERIFY(parseSunDate("2024-02-29", &y, &mo, &d) && y == 2024 && mo == 2 && d == 29);
+        QVERIFY(parseSunTime("08:30", &h) && h == 8.5);
+        QVERIFY(parseSunTime("12:30:30", &h) && std::abs(h - (12.0 + 30.5 / 60.0)) < 1e-12);
+        QCOMPARE(formatSunTime(12.0 + 30.5 / 60.0), std::string("12:30:30"));
+        QCOMPARE(formatSunTime(8.5), std::string("08:30"));
+        QVERIFY(parseSunTime(formatSunTime(7.123456), &h) && std::abs(h - 7.123456) < 1e-6);
+        QCOMPARE(formatSunDate({.year = 987 + 1000, .month = 3, .day = 4}), std::string("1987-03-04"));
+        for (const char* bad : {"2024-6-1x", "24-06-21", "2024/06/21", ""}) QVERIFY(!parseSunDate(bad, &y, &mo, &d));
+        for (const char* bad : {"8:30", "08:60", "08:30:60", "08h30", "08:30x", ""}) QVERIFY(!parseSunTime(bad, &h));
         // Bad input names the field.
         for (SunPlace bad : {SunPlace{.month = 13}, SunPlace{.year = 2023, .month = 2, .day = 29}, SunPlace{.hour = 25.0},
                              SunPlace{.timeZoneHours = 15.0}, SunPlace{.latitudeDeg = 91.0}, SunPlace{.longitudeDeg = std::nan("")}})

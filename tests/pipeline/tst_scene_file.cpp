@@ -112,6 +112,16 @@ void compareScenes(const Scene& a, const Scene& b)
     QCOMPARE(a.sun.direction, b.sun.direction);
     QCOMPARE(a.sun.temperature, b.sun.temperature);
     QCOMPARE(a.sun.intensity, b.sun.intensity);
+    QCOMPARE(a.sun.place.has_value(), b.sun.place.has_value());
+    if (a.sun.place) {
+        QCOMPARE(a.sun.place->year, b.sun.place->year);
+        QCOMPARE(a.sun.place->month, b.sun.place->month);
+        QCOMPARE(a.sun.place->day, b.sun.place->day);
+        QCOMPARE(a.sun.place->hour, b.sun.place->hour);
+        QCOMPARE(a.sun.place->timeZoneHours, b.sun.place->timeZoneHours);
+        QCOMPARE(a.sun.place->latitudeDeg, b.sun.place->latitudeDeg);
+        QCOMPARE(a.sun.place->longitudeDeg, b.sun.place->longitudeDeg);
+    }
     QCOMPARE(a.sky, b.sky);
     QCOMPARE(a.camera.position, b.camera.position);
     QCOMPARE(a.camera.target, b.camera.target);
@@ -232,7 +242,7 @@ Scene fullScene(const QString& sceneDir)
         s.instances.push_back(inst);
     }
     s.ground = {false, -1.25, {0.3f, 0.2f, 0.1f}};
-    s.sun = {{-0.2f, 0.9f, 0.1f}, 5200.5, 3.25f};
+    s.sun = {{-0.2f, 0.9f, 0.1f}, 5200.5, 3.25f, {}};
     s.sky = {0.1f, 0.2f, 1.7f};
     s.camera = {{10.5, 3.25, -40.0}, {1.0, 4.0, 2.0}, {0.0f, 1.0f, 0.1f}, 33.3f};
     s.render = {1920, 1080, 64, RenderMode::Lb, AccelKind::KdTree, false, 0.75f, 0.3f, 87.5f, 33.25f};
@@ -456,6 +466,40 @@ private Q_SLOTS:
         QCOMPARE(s.sun.intensity, 2.0f);
     }
 
+    void sunByDateAndPlace()
+    {
+        // The sun by date, time and place: the direction is NOAA's for that instant (core/sky/sun_position,
+        // checked there against NREL SPA and Meeus), the file keeps the place (not the direction) and reads
+        // back to the same scene and text.
+        QJsonObject o = validScene();
+        o.insert("sun", QJsonObject{{"date", "2003-10-17"}, {"time", "12:30:30"}, {"timezone", -7}, {"latitude", 39.742476},
+                                    {"longitude", -105.1786}, {"temperature", 5800}});
+        const Scene s = parseScene(compact(o).toStdString(), dir().toStdString(), kName);
+        QVERIFY(s.sun.place.has_value());
+        QCOMPARE(s.sun.place->hour, 12.0 + 30.5 / 60.0);
+        const sky::SunPosition pos = sky::noaaSunPosition(*s.sun.place);
+        QCOMPARE(s.sun.direction, pos.direction);
+        // NREL SPA's example (Reda & Andreas 2004, Table A4-1): elevation 90 - 50.11162, bearing 194.34024.
+        const double elevation = std::asin(double(s.sun.direction.y)) * 180.0 / M_PI;
+        const double bearing = 180.0 - std::atan2(double(s.sun.direction.x), double(s.sun.direction.z)) * 180.0 / M_PI;
+        QVERIFY2(std::abs(elevation - (90.0 - 50.11162)) < 0.02, qPrintable(QString::number(elevation)));
+        QVERIFY2(std::abs(bearing - 194.34024) < 0.02, qPrintable(QString::number(bearing)));
+        QCOMPARE(s.sun.temperature, 5800.0);
+        const std::string text = sceneToJson(s, dir().toStdString());
+        QVERIFY(text.find("\"date\": \"2003-10-17\"") != std::string::npos);
+        QVERIFY(text.find("\"time\": \"12:30:30\"") != std::string::npos);
+        const size_t sunAt = text.find("\"sun\"");
+        QVERIFY(sunAt != std::string::npos && text.find("\"direction\"", sunAt) > text.find('}', sunAt));   // no direction in sun
+        const Scene back = parseScene(text, dir().toStdString(), kName);
+        compareScenes(back, s);
+        QCOMPARE(sceneToJson(back, dir().toStdString()), text);
+        // Another hour moves the sun: the morning sun stands east (+X) of the afternoon one.
+        o.insert("sun", QJsonObject{{"date", "2003-10-17"}, {"time", "08:00"}, {"timezone", -7}, {"latitude", 39.74}, {"longitude", -105.18}});
+        const Scene morning = parseScene(compact(o).toStdString(), dir().toStdString(), kName);
+        QVERIFY(morning.sun.direction.x > 0.5f && s.sun.direction.x < 0.0f);
+        QVERIFY(describeScene(morning).find("on 2003-10-17 at 08:00 UTC-7") != std::string::npos);
+    }
+
     void malformed_data()
     {
         QTest::addColumn<QByteArray>("json");
@@ -506,6 +550,20 @@ private Q_SLOTS:
                                              << "sun.elevation: must lie in [-90, 90]";
         QTest::newRow("sun temperature") << with({"sun", "temperature"}, 500) << "sun.temperature: must lie in [1000, 40000] kelvin, got 500";
         QTest::newRow("sun intensity") << with({"sun", "intensity"}, -1) << "sun.intensity: must be >= 0";
+        const QJsonObject place{{"date", "2024-06-21"}, {"time", "08:30"}, {"timezone", 2}, {"latitude", 48.1}, {"longitude", 11.6}};
+        auto placeWith = [&](const char* key, const QJsonValue& v) {
+            QJsonObject p = place;
+            if (v.isUndefined()) p.remove(key);
+            else p.insert(key, v);
+            return with({"sun"}, p);
+        };
+        QTest::newRow("sun place and direction") << placeWith("direction", QJsonArray{0, 1, 0}) << "sun: give one of \"direction\"";
+        QTest::newRow("sun place missing") << placeWith("longitude", QJsonValue::Undefined) << "sun.longitude: missing";
+        QTest::newRow("sun date form") << placeWith("date", "21.06.2024") << "sun.date: expected a date \"YYYY-MM-DD\"";
+        QTest::newRow("sun date exists") << placeWith("date", "2023-02-29") << "sun: sun position: day must be in 1 .. 28";
+        QTest::newRow("sun time form") << placeWith("time", "8h30") << "sun.time: expected a local clock time";
+        QTest::newRow("sun latitude") << placeWith("latitude", 91) << "sun.latitude: must lie in [-90, 90], got 91";
+        QTest::newRow("sun timezone") << placeWith("timezone", 15) << "sun.timezone: must lie in [-14, 14]";
         QTest::newRow("version 2") << with({"version"}, 2) << "version: unsupported version 2";
         QTest::newRow("version missing") << without({"version"}) << "version: missing";
         QTest::newRow("version string") << with({"version"}, "1") << "version: expected a number, got a string";

@@ -231,6 +231,13 @@ private Q_SLOTS:
         for (const char* bad : {"2003-10-17,12:30,-7,39.7", "2003-13-17,12:30,-7,39.7,-105", "2003-10-17,12h30,-7,39.7,-105", "2003-10-17,12:30,-7,95,-105"})
             QCOMPARE(runSylva({"sky", "--sun-at", bad, "-o", QString::fromStdString(out)}).code, 2);
         QCOMPARE(runSylva({"sky", "--sun", "0,1,0", "--sun-at", "2003-10-17,12:30,-7,39.7,-105", "-o", QString::fromStdString(out)}).code, 2);
+        // render takes the same option (so do light and reference), checked before any work.
+        {
+            const Run bad = runSylva({"render", "--sun-at", "2003-02-29,12:30,-7,39.7,-105", "-o", QString::fromStdString(outPath("x.png"))});
+            QCOMPARE(bad.code, 2);
+            QVERIFY2(bad.err.contains("--sun-at") && bad.err.contains("day"), qPrintable(bad.err));
+        }
+        QCOMPARE(runSylva({"render", "--sun", "0,1,0", "--sun-at", "2003-10-17,12:30,-7,39.7,-105"}).code, 2);
         // The sun from a scene file.
         const std::string scene = outPath("sun.sylva.json");
         {
