@@ -1,0 +1,66 @@
+// The forest-level LB grid (seed 000 section 3, issue 18 item 1): a coarse lattice over the whole scene whose
+// node density comes from the plants in its cells, solved with the scene's boundary (sun, and sky when
+// asked), giving each instance a per-channel factor that scales its species' (per-species, unchanged)
+// lighting grid.
+//
+// Density: each instance spreads its species' biomass B (sum of the species grid's densities x its
+// cell volume, x scale^3) evenly over its crown box (the species grid's occupied bounds, scaled and
+// moved); a coarse node gets the overlap of that box with its cell, as mean density over the cell x
+// (coarse spacing / the species grid's spacing): a coarse step crosses that many fine cells, so the
+// extinction per step matches the fine grid's on average (capped at 1). Continuous in the instance's
+// position and scale.
+// Factor: the forest grid's light at the instance's crown centre divided by the light there on the same
+// lattice with that instance alone (its own shading is already in its species grid): exactly 1 for an
+// isolated plant, < 1 where other plants shade it (> 1 where they scatter more light in than they take).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/grid/grid.h"
+#include "core/lb/lb_params.h"
+
+namespace sylva::lb {
+
+// A species as the forest grid sees it, in its own frame (scale 1, origin at the plant's position).
+struct ForestSpecies {
+    glm::dvec3 boxMin{0.0}, boxMax{0.0};   // occupied bounds of its density grid (node cells with density > 0)
+    double biomass = 0.0;                  // sum of density x cell volume (m^3)
+    double spacing = 1.0;                  // its density grid's spacing (m)
+};
+ForestSpecies forestSpecies(const DensityGrid& density);
+
+struct ForestPlant {
+    glm::dvec3 position{0.0};   // of the species' origin, world metres
+    float scale = 1.0f;
+    int species = 0;
+};
+
+struct ForestGridSettings {
+    int resolution = 32;            // nodes along the longest horizontal extent (>= 4)
+    float uniformSpread = 0.02f;    // auto: factors within this (max - min) / max count as uniform exposure
+};
+
+struct ForestGridResult {
+    GridGeometry geometry;
+    std::vector<float> density;     // coarse node density, z fastest
+    LightingGrid lighting;          // the forest grid's solve (unit intensity boundary)
+    std::vector<glm::vec3> factors; // per plant, per channel
+    float minFactor = 1.0f, maxFactor = 1.0f;   // over plants and channels
+    bool uniform = true;            // (max - min) / max < settings.uniformSpread
+    int steps = 0;
+    double seconds = 0.0;           // build + solve (forest grid and the per-plant solves)
+};
+
+// Throws Error for bad settings, a species index out of range or a non-positive scale. `params` gives the
+// optics, boundary (sun or params.boundary) and storage; steps are 2 x the forest grid's longest edge for
+// the forest grid and every plant's own solve (both converge: the factor of an isolated plant is 1).
+ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const std::vector<ForestSpecies>& species,
+                                 const LbParams& params, const ForestGridSettings& settings = {});
+
+// One line for stats: resolution, dims, time, factor range, and whether exposure is uniform.
+std::string forestGridSummary(const ForestGridResult& r);
+
+} // namespace sylva::lb
