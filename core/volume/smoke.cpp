@@ -536,7 +536,9 @@ void SmokeSim::advectScalars(float dt)
                 }
                 const glm::vec3 x = glm::vec3(i, j, k) + 0.5f;
                 auto vel = [&](const glm::vec3& q) { return glm::vec3(sampleLinear(fu, q), sampleLinear(fv, q), sampleLinear(fw, q)); };
-                const glm::vec3 mid = glm::clamp(x - 0.5f * scale * vel(x), glm::vec3(0.0f), hi);
+                const glm::vec3 v0(0.5f * (m_u[d.uIdx(i, j, k)] + m_u[d.uIdx(i + 1, j, k)]), 0.5f * (m_v[d.vIdx(i, j, k)] + m_v[d.vIdx(i, j + 1, k)]),
+                                   0.5f * (m_w[d.wIdx(i, j, k)] + m_w[d.wIdx(i, j, k + 1)]));
+                const glm::vec3 mid = glm::clamp(x - 0.5f * scale * v0, glm::vec3(0.0f), hi);
                 const glm::vec3 back = glm::clamp(x - scale * vel(mid), glm::vec3(0.0f), hi);
                 m_density[c] = std::clamp(sample(fd, back, interp), 0.0f, 1.0f);
                 m_temperature[c] = std::max(0.0f, sample(ft, back, interp));
@@ -656,18 +658,42 @@ void SmokeSim::step(Progress* progress)
         const glm::vec3 hi = glm::vec3(n);
         const SmokeInterp interp = m_s.interp;
         auto vel = [&](const glm::vec3& q) { return glm::vec3(sampleLinear(fu, q), sampleLinear(fv, q), sampleLinear(fw, q)); };
-        auto trace = [&](const glm::vec3& x) {
-            const glm::vec3 mid = glm::clamp(x - 0.5f * scale * vel(x), glm::vec3(0.0f), hi);
+        // RK2 from the velocity at the face itself (its own component and the 4-face averages of the
+        // others: what trilinear sampling gives there, without the gathers).
+        auto trace = [&](const glm::vec3& x, const glm::vec3& v0) {
+            const glm::vec3 mid = glm::clamp(x - 0.5f * scale * v0, glm::vec3(0.0f), hi);
             return glm::clamp(x - scale * vel(mid), glm::vec3(0.0f), hi);
         };
+        const auto& U = u1;
+        const auto& V = v1;
+        const auto& W = w1;
         forSlabs(n.x + 1, [&](int i) {
+            const int ia = std::max(i - 1, 0), ib = std::min(i, n.x - 1);
             for (int j = 0; j < n.y; ++j)
-                for (int k = 0; k < n.z; ++k) m_u[d.uIdx(i, j, k)] = sample(fu, trace(glm::vec3(float(i), j + 0.5f, k + 0.5f)), interp);
+                for (int k = 0; k < n.z; ++k) {
+                    const glm::vec3 v0(U[d.uIdx(i, j, k)],
+                                       0.25f * (V[d.vIdx(ia, j, k)] + V[d.vIdx(ib, j, k)] + V[d.vIdx(ia, j + 1, k)] + V[d.vIdx(ib, j + 1, k)]),
+                                       0.25f * (W[d.wIdx(ia, j, k)] + W[d.wIdx(ib, j, k)] + W[d.wIdx(ia, j, k + 1)] + W[d.wIdx(ib, j, k + 1)]));
+                    m_u[d.uIdx(i, j, k)] = sample(fu, trace(glm::vec3(float(i), j + 0.5f, k + 0.5f), v0), interp);
+                }
             if (i == n.x) return;
-            for (int j = 0; j <= n.y; ++j)
-                for (int k = 0; k < n.z; ++k) m_v[d.vIdx(i, j, k)] = sample(fv, trace(glm::vec3(i + 0.5f, float(j), k + 0.5f)), interp);
+            for (int j = 0; j <= n.y; ++j) {
+                const int ja = std::max(j - 1, 0), jb = std::min(j, n.y - 1);
+                for (int k = 0; k < n.z; ++k) {
+                    const glm::vec3 v0(0.25f * (U[d.uIdx(i, ja, k)] + U[d.uIdx(i + 1, ja, k)] + U[d.uIdx(i, jb, k)] + U[d.uIdx(i + 1, jb, k)]),
+                                       V[d.vIdx(i, j, k)],
+                                       0.25f * (W[d.wIdx(i, ja, k)] + W[d.wIdx(i, ja, k + 1)] + W[d.wIdx(i, jb, k)] + W[d.wIdx(i, jb, k + 1)]));
+                    m_v[d.vIdx(i, j, k)] = sample(fv, trace(glm::vec3(i + 0.5f, float(j), k + 0.5f), v0), interp);
+                }
+            }
             for (int j = 0; j < n.y; ++j)
-                for (int k = 0; k <= n.z; ++k) m_w[d.wIdx(i, j, k)] = sample(fw, trace(glm::vec3(i + 0.5f, j + 0.5f, float(k))), interp);
+                for (int k = 0; k <= n.z; ++k) {
+                    const int ka = std::max(k - 1, 0), kb = std::min(k, n.z - 1);
+                    const glm::vec3 v0(0.25f * (U[d.uIdx(i, j, ka)] + U[d.uIdx(i + 1, j, ka)] + U[d.uIdx(i, j, kb)] + U[d.uIdx(i + 1, j, kb)]),
+                                       0.25f * (V[d.vIdx(i, j, ka)] + V[d.vIdx(i, j + 1, ka)] + V[d.vIdx(i, j, kb)] + V[d.vIdx(i, j + 1, kb)]),
+                                       W[d.wIdx(i, j, k)]);
+                    m_w[d.wIdx(i, j, k)] = sample(fw, trace(glm::vec3(i + 0.5f, j + 0.5f, float(k)), v0), interp);
+                }
         });
     }
     if (progress) progress->throwIfCancelled();
