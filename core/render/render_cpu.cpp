@@ -1,6 +1,7 @@
 // CPU render loop: oneTBB over 8x8 tiles calling the shared per-pixel kernel; mode composition.
 #include "core/render/render_cpu.h"
 
+#include <algorithm>
 #include <atomic>
 #include <string>
 
@@ -62,6 +63,28 @@ void renderFilmRect(const RenderView& v, int x0, int y0, int x1, int y1, SampleP
 }
 
 // Mean luminance of full = mean of local + a * albedo  =>  a = mean(lum(indirect)) / mean(lum(albedo)).
+void accumulateFilm(Film& sum, int sumSamples, const Film& part, int partSamples)
+{
+    if (sumSamples <= 0 || sum.pixels.empty()) {
+        sum = part;
+        return;
+    }
+    if (sum.width != part.width || sum.height != part.height || sum.pixels.size() != part.pixels.size())
+        throw Error("accumulateFilm: the films differ in size");
+    const float a = float(sumSamples) / float(sumSamples + partSamples), b = 1.0f - a;
+    for (size_t i = 0; i < sum.pixels.size(); ++i) {
+        SampleParts& s = sum.pixels[i];
+        const SampleParts& p = part.pixels[i];
+        s.local = s.local * a + p.local * b;
+        s.indirect = s.indirect * a + p.indirect * b;
+        s.albedo = s.albedo * a + p.albedo * b;
+        s.skyCover = s.skyCover * a + p.skyCover * b;
+        s.normal = s.normal * a + p.normal * b;
+        s.depth = std::min(s.depth, p.depth);
+        s.background = s.background * a + p.background * b;
+    }
+}
+
 void addAmbientSums(const Film& film, double* indirect, double* albedo)
 {
     for (const SampleParts& p : film.pixels) {

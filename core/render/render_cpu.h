@@ -29,6 +29,13 @@ Film renderFilmRows(const RenderView& v, int y0, int y1, Progress* progress = nu
 // for a rectangle outside the frame.
 void renderFilmRect(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts* out);
 
+// Progressive refinement (the studio viewport once the camera stops; the same samples `sylva render
+// --spp` traces at once): `sum` holds the mean of sumSamples samples per pixel, `part` the mean of
+// partSamples further ones (a frame of RenderView::sampleBegin .. sampleEnd); sum becomes the mean of
+// all of them (depth: the nearest). An empty sum (sumSamples 0) becomes part. Throws Error for films of
+// different sizes.
+void accumulateFilm(Film& sum, int sumSamples, const Film& part, int partSamples);
+
 // The sums ambient mode matches (luminance of indirect and of albedo over the film's pixels, in pixel
 // order), added to *indirect and *albedo so a frame in bands sums exactly as the whole film does.
 void addAmbientSums(const Film& film, double* indirect, double* albedo);

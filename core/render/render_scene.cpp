@@ -1,6 +1,7 @@
 // Flattens species, pruned levels, instance groups, textures and lighting grids into the RenderView arrays;
 // builds every level's acceleration structure. The one builder of the levels, for every front end.
 #include "core/render/render_scene.h"
+#include "core/render/render_volumes.h"
 
 #include <array>
 #include <algorithm>
@@ -185,6 +186,7 @@ RenderView RenderScene::view() const
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
     v.instanceCount = uint32_t(instances.size());
+    v.volumeCount = uint32_t(volumeInstances.size());
     return v;
 }
 
@@ -586,6 +588,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
     }
     rs.m_stats.groups = scene.groups.size();
     rs.m_stats.groupInstances = rs.groupInstances.size();
+    buildVolumeGrids(rs, scene);   // volumes (core/render/render_volumes.h)
     countBytes(rs);
     return rs;
 }
@@ -689,6 +692,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     b.shadows = scene.render.shadows;
     b.indirectScale = scene.render.indirectScale;
     b.alphaDistance = scene.render.alphaDistance;
+    placeVolumes(rs, scene, scene.camera.position);
     countBytes(rs);
 }
 

@@ -11,6 +11,7 @@
 #include "core/scene/scene.h"
 #include "core/sky/sky.h"
 #include "core/sky/virtual_lights.h"
+#include "core/render/volume_trace.h"
 #include "core/terrain/height_field.h"
 
 namespace sylva {
@@ -172,7 +173,14 @@ struct CameraRecord {
     X(Scene, Both, float, terrainHeights, Terrain)         /* the terrain's samples (core/terrain) */          \
     X(Scene, Both, glm::vec2, terrainRanges, Terrain)      /* its min/max pyramid */                           \
     X(Scene, Both, float, skyMap, None)                    /* the sky's map pixels (RGB, skyModel.map's) */    \
-    X(Scene, Both, sky::VirtualLight, skyLights, None)     /* the sky's virtual directional lights */
+    X(Scene, Both, sky::VirtualLight, skyLights, None)     /* the sky's virtual directional lights */ \
+    X(Top, Both, VolumeInstanceRecord, volumeInstances, None) /* placed volumes (camera-relative) */        \
+    X(Scene, Both, VolumeGridRecord, volumeGrids, None)    /* per volume grid: dims, optics, offsets */        \
+    X(Scene, Both, float, volumeDensity, None)             /* volume densities (core/render/volume_trace.h) */ \
+    X(Scene, Both, float, volumeBricks, None)              /* their bricks' max density (empty-space skip) */ \
+    X(Scene, Both, float, volumeLight, None)               /* their LB photon density, 3 per node, normalized */ \
+    X(Scene, Both, float, volumeTemperature, None)         /* their temperatures (kelvin; emission) */         \
+    X(Scene, Both, glm::vec3, volumeBlackbody, None)       /* blackbody colour table (kVolumeBlackbodySize) */
 
 enum class ArrayPart { Top, Scene };
 enum class ArrayWhere { Both, Host };
@@ -184,6 +192,7 @@ struct RenderView {
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
     uint32_t instanceCount;          // of the top level
+    uint32_t volumeCount;            // volumeInstances (0: no volume, every stage as before)
 
     // environment
     bool groundEnabled;

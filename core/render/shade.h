@@ -208,9 +208,56 @@ SYLVA_HD inline SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, c
 
 // Stage 3, volume: what participating media along the camera ray's segment [ray.tmin, tEnd] add to
 // and take from the parts behind them (no volume kind yet: the parts pass unchanged).
-SYLVA_HD SYLVA_INLINE void volumeStage(const RenderView& v, const Ray& ray, float tEnd, SampleParts& parts)
+SYLVA_HD SYLVA_INLINE VolumeView volumeViewOf(const RenderView& v)
 {
-    (void)v, (void)ray, (void)tEnd, (void)parts;
+    return VolumeView{v.volumeGrids, v.volumeInstances, v.volumeDensity, v.volumeBricks, v.volumeLight, v.volumeTemperature,
+                      v.volumeBlackbody, v.volumeCount};
+}
+
+// The volumes the segment crosses are composed back to front (each one's entry point orders them):
+// what lies behind is multiplied by the volume's transmittance (the constant sky through skyCover x its
+// mean, the colour difference into background) and the volume's own light is added (core/render/
+// volume_trace.h marchVolume: sun single scattering and emission into local, LB into indirect, the
+// scattered share of a uniform ambient into albedo, so every render mode keeps its meaning). Without
+// volumes the parts pass unchanged.
+SYLVA_HD inline void volumeStage(const RenderView& v, const Ray& ray, float tEnd, SampleParts& parts)
+{
+    if (v.volumeCount == 0) return;
+    const VolumeView vv = volumeViewOf(v);
+    uint32_t order[kMaxRayVolumes];
+    float entry[kMaxRayVolumes];
+    int n = 0;
+    for (uint32_t i = 0; i < v.volumeCount; ++i) {
+        const VolumeInstanceRecord& in = v.volumeInstances[i];
+        float t0 = ray.tmin, t1 = tEnd;
+        if (!volumeClip(v.volumeGrids[in.grid].dims, volumeToGrid(in, ray.org), volumeDirToGrid(in, ray.dir), t0, t1)) continue;
+        if (n == kMaxRayVolumes && !(t0 < entry[n - 1])) continue;   // full: keep the nearest
+        int k = n < kMaxRayVolumes ? n++ : n - 1;
+        while (k > 0 && entry[k - 1] > t0) {        // nearest entry first
+            order[k] = order[k - 1];
+            entry[k] = entry[k - 1];
+            --k;
+        }
+        order[k] = i;
+        entry[k] = t0;
+    }
+    for (int k = n - 1; k >= 0; --k) {
+        const VolumeSegment s = marchVolume(vv, v.volumeInstances[order[k]], ray.org, ray.dir, ray.tmin, tEnd, v.sunDir, v.sunRadiance,
+                                            v.indirectScale);
+        const glm::vec3& T = s.transmittance;
+        const float mean = (T.x + T.y + T.z) * (1.0f / 3.0f);
+        parts.local = parts.local * T + s.local;
+        parts.indirect = parts.indirect * T + s.indirect;
+        parts.albedo = parts.albedo * T + s.albedo;
+        parts.background = parts.background * T + parts.skyCover * (T - mean) * v.sky;
+        parts.skyCover *= mean;
+    }
+}
+
+// The sun's light at camera-relative point p that gets through the volumes (1 without volumes).
+SYLVA_HD SYLVA_INLINE glm::vec3 sunThroughVolumes(const RenderView& v, const glm::vec3& p)
+{
+    return v.volumeCount == 0 ? glm::vec3(1.0f) : volumeTransmittance(volumeViewOf(v), p, v.sunDir);
 }
 
 // Stage 4, background and lights: a ray that hit nothing sees the sky (the constant one through
@@ -229,7 +276,10 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
     SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
     const float nl = glm::dot(s.ng, v.sunDir);
     if (s.ground) {   // the plane or the terrain: Lambertian, lit by the sun and the uniform sky
-        if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng))) out.local = s.albedo * v.sunRadiance * nl;
+        if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng))) {
+            out.local = s.albedo * v.sunRadiance * nl;
+            if (v.volumeCount > 0) out.local *= sunThroughVolumes(v, s.p);   // cloud shadows
+        }
         if (v.skyLightCount > 0) out.local += s.albedo * skyLightIrradiance(v, offsetPoint(s.p, s.ng), s.ng, px, py, sample);
         out.indirect = s.albedo * v.sky;
         return out;
@@ -242,6 +292,7 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
             if (vr > 0.0f) c += s.specular * powf(vr, s.shininess);
         }
         out.local = c * v.sunRadiance;
+        if (v.volumeCount > 0) out.local *= sunThroughVolumes(v, s.p);
     }
     if (v.skyLightCount > 0) out.local += s.albedo * skyLightIrradiance(v, offsetPoint(s.p, s.ng, s.extent), s.ng, px, py, sample);
     out.indirect = s.albedo * s.lighting * v.sunRadiance * v.indirectScale;

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "core/lb/lb_params.h"
+#include "core/scene/volume.h"
 #include "core/sky/sky.h"
 #include "core/sky/sun_position.h"
 
@@ -157,6 +158,7 @@ struct Scene {
     std::vector<GroupDesc> groups;       // instance groups (built in code today; scene files hold none yet)
     GroundDesc ground;
     TerrainDesc terrain;                 // with a DEM, the terrain is the ground (the plane is not traced)
+    std::vector<VolumeDesc> volumes;     // participating media (clouds, smoke), beside plants and ground
     SunDesc sun;
     glm::vec3 sky{0.55f, 0.70f, 0.95f};  // linear RGB radiance of the background (the constant sky: sky.color)
     SkyDesc skyModel;                    // the rest of the sky block (Preetham, HDR map, virtual lights)

@@ -22,6 +22,7 @@
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/scene/scene_file.h"
+#include "pipeline/render/volume_job.h"
 
 namespace sylva {
 
@@ -207,7 +208,9 @@ RenderScene prepareRenderScene(const Scene& scene, GridCache* cache, Progress* p
     t0 = std::chrono::steady_clock::now();
     SubProgress buildPart(progress, 0.6, 0.7);
     Progress buildProgress([&](double f, const std::string& m) { buildPart.report(f, m); });
-    RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun), &buildProgress);
+    // Volumes: their LB lighting through the cache, like a species' (pipeline/render/volume_job.h).
+    const Scene lit = scene.volumes.empty() ? Scene{} : lightSceneVolumes(scene, cache, modeNeedsLighting(scene.render.mode), nullptr, log, backend);
+    RenderScene rs = buildRenderScene(scene.volumes.empty() ? scene : lit, assets, sunRadiance(scene.sun), &buildProgress);
     if (log) log->stages.push_back("build");
     timings.build = secondsSince(t0);
     return rs;

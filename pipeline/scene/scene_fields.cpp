@@ -14,6 +14,7 @@
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/scene/scene_species.h"
+#include "pipeline/scene/scene_volumes.h"
 #include "pipeline/scene/summary_text.h"
 
 namespace sylva {
@@ -588,6 +589,12 @@ const Table<Scene>& sceneTable()
                 .shown("")
                 .summarized(sectionLine("terrain", [](const Scene& sc) -> const TerrainDesc& { return sc.terrain; }, terrainTable()));
         }
+        b.array("volumes", &Scene::volumes, volumeTable(), nullptr, 4096, "too many volumes (at most 4096)")
+            .required(nullptr)
+            .writtenIf([](const Scene& sc) { return !sc.volumes.empty(); })
+            .doc("object", "participating media (clouds, smoke): a density grid, optics, tracer, placements; optional")
+            .shown("[]")
+            .summarized(describeVolumes);
         b.object("sun", &Scene::sun, sunTable())
             .doc("object", "`direction`, or `elevation` with `azimuth`, or `date`, `time`, `timezone`, `latitude` and `longitude`; one of the three")
             .summarized(sectionLine("sun", [](const Scene& s) -> const SunDesc& { return s.sun; }, sunTable()));

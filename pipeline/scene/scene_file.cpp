@@ -15,6 +15,7 @@
 #include "pipeline/io/output_path.h"
 #include "pipeline/scene/scene_fields.h"
 #include "pipeline/scene/scene_species.h"
+#include "pipeline/scene/scene_volumes.h"
 
 namespace sylva {
 
@@ -53,6 +54,7 @@ Scene readSceneFile(const std::string& path)
     } catch (const Error& e) {
         throw Error(path + ": terrain.dem: " + e.what());
     }
+    loadSceneVolumes(scene);   // the volumes' density and temperature grids, read and checked with the file
     try {
         const std::string cleaned = loadSceneSky(scene);   // the sky's map read and cleaned, or its Preetham model built
         if (cleaned.find("cleaned:") != std::string::npos) std::fprintf(stderr, "sylva: sky.path: %s\n", cleaned.c_str());

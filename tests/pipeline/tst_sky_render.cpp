@@ -233,6 +233,53 @@ private Q_SLOTS:
         QVERIFY2(previous < 0.04, qPrintable(QString("64 spp: %1").arg(previous)));
     }
 
+    // Progressive refinement (item 5): frames of samples [0, 8), [8, 16), ... of a 64-spp frame (new pixel
+    // positions and sky-light subsets each), averaged by accumulateFilm, are the 64-spp frame `sylva render
+    // --spp 64` traces at once, to float rounding; the running mean after each frame converges to the
+    // N-light, 64-sample reference of an uninterleaved frame (all N lights in every sample), its error at
+    // least halving per 8x the samples.
+    void progressiveAccumulationIsTheFullFrame()
+    {
+        const QString file = hdriPath("forest.exr");
+        if (!QFile::exists(file)) QSKIP("../shared/data/hdri is absent");
+        Scene patch = shrubPatch();
+        useMap(patch, file.toStdString(), 64, 8, false);
+        patch.render.spp = 64;
+        const RenderScene rs = buildRenderScene(patch, m_shrub, glm::vec3(0.0f));
+        const Film whole = renderFilm(rs.view());
+        Scene allLights = patch;
+        allLights.skyModel.interleave = 1;
+        const std::vector<glm::vec3> reference = picture(allLights, m_shrub);
+        Film sum;
+        int done = 0;
+        double previous = 1e30;
+        for (int chunk : {1, 7, 8, 16, 32}) {
+            RenderView v = rs.view();
+            v.sampleBegin = done;
+            v.sampleEnd = done + chunk;
+            accumulateFilm(sum, done, renderFilm(v), chunk);
+            done += chunk;
+            const double e = relativeError(composeMode(sum, RenderMode::Full, composeSky(patch)), reference);
+            qInfo("progressive, %d of 64 samples: mean pixel error %.4f against 64 lights x 64 spp, all lights per sample", done, e);
+            if (done == 8 || done == 64) {
+                QVERIFY2(e < 0.5 * previous, qPrintable(QString("%1 samples: %2, not below half of %3").arg(done).arg(e).arg(previous)));
+                previous = e;
+            }
+        }
+        QCOMPARE(done, 64);
+        QVERIFY2(previous < 0.04, qPrintable(QString("64 samples: %1").arg(previous)));
+        double worst = 0.0;
+        for (size_t i = 0; i < whole.pixels.size(); ++i) {
+            const SampleParts &a = sum.pixels[i], &b = whole.pixels[i];
+            worst = std::max({worst, double(glm::length(a.local - b.local)) / (1e-6 + glm::length(b.local)),
+                              double(glm::length(a.background - b.background)) / (1e-6 + glm::length(b.background)),
+                              double(std::abs(a.skyCover - b.skyCover))});
+            QCOMPARE(a.depth, b.depth);
+        }
+        QVERIFY2(worst < 1e-4, qPrintable(QString("accumulated frames off the 64-spp frame by %1").arg(worst)));
+        QVERIFY_THROWS_EXCEPTION(Error, accumulateFilm(sum, 64, Film{3, 1, std::vector<SampleParts>(3)}, 1));
+    }
+
     // Sky light on the floor through the same lights, occluded by plants: the floor between the shrubs is
     // darker than open ground (the same lights, no plants), and never brighter.
     void floorDarkerUnderPlants()
