@@ -214,6 +214,10 @@ struct RenderView {
 
     // settings
     int width, height, spp;
+    // Progressive refinement: this frame traces samples [sampleBegin, sampleEnd) of the spp (their positions
+    // and sky-light subsets are the full frame's); sampleEnd 0: all of them. accumulateFilm (render_cpu.h)
+    // averages such frames into exactly the spp frame, up to float rounding.
+    int sampleBegin = 0, sampleEnd = 0;
     AccelKind accel;
     bool shadows;
     float indirectScale;

@@ -349,11 +349,12 @@ SYLVA_HD SYLVA_INLINE glm::vec2 samplePosition(int px, int py, int s, int spp)
     return glm::vec2(float(px) + jx, float(py) + jy);
 }
 
-// All samples of one pixel, box-filtered.
+// All samples of one pixel (or those of v.sampleBegin .. sampleEnd), box-filtered.
 SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
 {
     SampleParts sum{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, glm::vec3(0.0f), kSkyDepth, glm::vec3(0.0f)};
-    for (int s = 0; s < v.spp; ++s) {
+    const int sBegin = v.sampleBegin, sEnd = v.sampleEnd > 0 ? v.sampleEnd : v.spp;
+    for (int s = sBegin; s < sEnd; ++s) {
         const glm::vec2 pos = samplePosition(px, py, s, v.spp);
         const SampleParts p = shadeRay(v, cameraRay(v, pos.x, pos.y), px, py, s);
         sum.local += p.local;
@@ -364,7 +365,7 @@ SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
         sum.depth = fminf(sum.depth, p.depth);
         sum.background += p.background;
     }
-    const float inv = 1.0f / float(v.spp);
+    const float inv = 1.0f / float(sEnd > sBegin ? sEnd - sBegin : 1);
     sum.local *= inv;
     sum.indirect *= inv;
     sum.albedo *= inv;
