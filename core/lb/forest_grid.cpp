@@ -161,7 +161,11 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
                 for (int c = 0; c < lg.dims.z; ++c)
                     if (a == 0 || bb == 0 || c == 0 || a == lg.dims.x - 1 || bb == lg.dims.y - 1 || c == lg.dims.z - 1)
                         rho[lg.index(a, bb, c)] = 0.0f;
-        const LightingGrid alone = solveLighting(densityOn(lg, rho), p);
+        // Its window is small: 4 x its longest edge converges it (light crosses it four times), capped by the
+        // forest grid's steps; an isolated plant still gets 1 (tst_forest_grid).
+        LbParams pa = p;
+        pa.steps = std::min(p.steps, 4 * lg.longestEdge());
+        const LightingGrid alone = solveLighting(densityOn(lg, rho), pa);
         const glm::dvec3 centre = 0.5 * (b.lo + b.hi);
         const glm::vec3 la = sample(alone, centre), lf = sample(r.lighting, centre);
         for (int c = 0; c < 3; ++c) r.factors[i][c] = la[c] > 0.0f ? lf[c] / la[c] : 1.0f;   // > 1 where neighbours scatter light in

@@ -56,7 +56,7 @@ struct ForestGridResult {
 
 // Throws Error for bad settings, a species index out of range or a non-positive scale. `params` gives the
 // optics, boundary (sun or params.boundary) and storage; steps are 2 x the forest grid's longest edge for
-// the forest grid and every plant's own solve (both converge: the factor of an isolated plant is 1).
+// the forest grid and 4 x its window's for each plant's own solve (both converge: an isolated plant gets 1).
 ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const std::vector<ForestSpecies>& species,
                                  const LbParams& params, const ForestGridSettings& settings = {});
 
