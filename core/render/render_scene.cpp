@@ -118,6 +118,7 @@ void countBytes(RenderScene& rs)
     st.wideBlasBytes = bytes[size_t(ArrayStat::WideBlas)];
     st.triangleBytes = bytes[size_t(kd ? ArrayStat::KdTriangles : ArrayStat::BvhTriangles)];
     st.terrainBytes = bytes[size_t(ArrayStat::Terrain)];
+    st.landscapeBytes = bytes[size_t(ArrayStat::Landscape)];
 }
 
 void addCutout(const ImageRgba& img, RenderScene& rs, MaterialRecord& m)
@@ -588,6 +589,21 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
     }
     rs.m_stats.groups = scene.groups.size();
     rs.m_stats.groupInstances = rs.groupInstances.size();
+
+    // The landscape (seed 002): Wang tiles of the species' full meshes on the terrain's cells.
+    if (scene.terrain.enabled() && scene.terrain.cells > 0) {
+        const TerrainDesc& t = scene.terrain;
+        std::vector<LandscapeSpecies> ls(ns);
+        for (size_t s = 0; s < ns; ++s) ls[s] = LandscapeSpecies{uint32_t(s), rs.geometryBounds[s].lo, rs.geometryBounds[s].hi, rs.geometryTriangles[s]};
+        LandscapeBuild lb = buildLandscape(*t.field, uint32_t(t.cells), t.tiles, t.tiling, t.density, t.origin.y, 0.0f, 0.0f, ls);
+        rs.landNodes = std::move(lb.nodes);
+        rs.landCells = std::move(lb.cells);
+        rs.tileRecords = std::move(lb.tiles);
+        rs.tileNodes = std::move(lb.tileNodes);
+        rs.tilePlants = std::move(lb.plants);
+        rs.base.land = lb.layout;
+        rs.m_stats.landscape = lb.stats;
+    }
     buildVolumeGrids(rs, scene);   // volumes (core/render/render_volumes.h)
     countBytes(rs);
     return rs;
@@ -669,6 +685,20 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
         b.terrainSnow = t.snow;
         b.terrainRockCos = float(std::cos(double(t.rockSlope) * 3.14159265358979323846 / 180.0));
         b.terrainSnowY = t.snowLine > 0.0f ? float(double(t.snowLine) - t.origin.y) : 3.0e38f;
+        // The height field's and the landscape's frames are rebased under the camera, in double (seed 002 at
+        // UTM coordinates: millions of metres from the world origin, centimetres near the camera).
+        const HeightFieldLayout& L = rs.base.terrain;
+        const glm::dvec3 camLocal = origin - t.origin;   // the camera in the DEM's frame
+        const auto nearest = [](double x, double step, uint32_t n) { return int32_t(std::clamp(std::floor(x / step), 0.0, double(n))); };
+        b.terrainBaseI = nearest(camLocal.x, double(L.dx), L.nx - 1);
+        b.terrainBaseJ = nearest(camLocal.z, double(L.dz), L.nz - 1);
+        b.terrainBase = glm::vec3(t.origin + glm::dvec3(double(b.terrainBaseI) * double(L.dx), 0.0, double(b.terrainBaseJ) * double(L.dz)) - origin);
+        b.landscapeEnabled = !rs.landCells.empty();
+        if (b.landscapeEnabled) {
+            const double C = double(b.land.cellSize);
+            b.landBaseCell = glm::ivec2(nearest(camLocal.x, C, b.land.cellsX), nearest(camLocal.z, C, b.land.cellsZ));
+            b.landBase = glm::vec3(t.origin + glm::dvec3(double(b.landBaseCell.x) * C, 0.0, double(b.landBaseCell.y) * C) - origin);
+        }
     }
     const glm::vec3 sd = scene.sun.direction;
     if (!(glm::length(sd) > 0.0f)) throw Error("sun: direction must not be zero");

@@ -37,6 +37,8 @@ struct AccelStats {
     size_t groups = 0, groupInstances = 0;   // instance groups and the instances inside them
     size_t terrainBytes = 0;             // the terrain's heights and min/max pyramid
     size_t terrainSamplesX = 0, terrainSamplesZ = 0;
+    size_t landscapeBytes = 0;           // the landscape's cells, kd-tree, tiles' trees and plants
+    LandscapeStats landscape;            // cells, tiles, potentially visible instances and triangles, build time
 };
 
 // The pruned levels of detail a scene build makes meshes for: those the scene's camera gives some

@@ -13,6 +13,7 @@
 #include "core/sky/virtual_lights.h"
 #include "core/render/volume_trace.h"
 #include "core/terrain/height_field.h"
+#include "core/terrain/landscape.h"
 
 namespace sylva {
 
@@ -172,6 +173,11 @@ struct CameraRecord {
     X(Scene, Both, float, lighting, None)                  /* normalized LB photon density, 3 per node */     \
     X(Scene, Both, float, terrainHeights, Terrain)         /* the terrain's samples (core/terrain) */          \
     X(Scene, Both, glm::vec2, terrainRanges, Terrain)      /* its min/max pyramid */                           \
+    X(Scene, Both, LandNode, landNodes, Landscape)         /* the landscape's 2D kd-tree over cells */         \
+    X(Scene, Both, LandCell, landCells, Landscape)         /* per cell: ground range, tile */                  \
+    X(Scene, Both, TileRecord, tileRecords, Landscape)     /* per Wang tile */                                 \
+    X(Scene, Both, TileNode, tileNodes, Landscape)         /* the tiles' 2D trees */                           \
+    X(Scene, Both, TilePlant, tilePlants, Landscape)       /* the tiles' plants */                             \
     X(Scene, Both, float, skyMap, None)                    /* the sky's map pixels (RGB, skyModel.map's) */    \
     X(Scene, Both, sky::VirtualLight, skyLights, None)     /* the sky's virtual directional lights */ \
     X(Top, Both, VolumeInstanceRecord, volumeInstances, None) /* placed volumes (camera-relative) */        \
@@ -184,7 +190,7 @@ struct CameraRecord {
 
 enum class ArrayPart { Top, Scene };
 enum class ArrayWhere { Both, Host };
-enum class ArrayStat { Tlas, WideTlas, Instances, Blas, BvhBlas, KdBlas, WideBlas, KdTriangles, BvhTriangles, Terrain, None };
+enum class ArrayStat { Tlas, WideTlas, Instances, Blas, BvhBlas, KdBlas, WideBlas, KdTriangles, BvhTriangles, Terrain, Landscape, None };
 
 // Everything a frame needs, as pointers into flat arrays (host or device memory).
 struct RenderView {
@@ -204,6 +210,12 @@ struct RenderView {
     glm::vec3 terrainRock, terrainSnow;
     float terrainRockCos;            // normals with a y below this are rock
     float terrainSnowY;              // terrain-frame height above which the ground is snow (> max height: none)
+    glm::vec3 terrainBase;           // camera-relative position of sample (terrainBaseI, terrainBaseJ), placed in double: the
+    int32_t terrainBaseI, terrainBaseJ;   // height field is traced relative to it (precise near the camera anywhere)
+    bool landscapeEnabled;           // cells carrying Wang tiles of plants (landNodes ... tilePlants)
+    LandscapeLayout land;
+    glm::ivec2 landBaseCell;         // the cell under the camera (clamped to the grid)
+    glm::vec3 landBase;              // camera-relative corner of landBaseCell at the terrain frame's y = 0, placed in double
     glm::vec3 sunDir;                // toward the sun, normalized
     glm::vec3 sunRadiance;           // blackbody colour (luminance 1) x intensity
     glm::vec3 sky;                   // the constant sky (skyModel.kind Constant), else 0

@@ -179,6 +179,9 @@ SYLVA_HD inline SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, c
         s.ng = glm::dot(n, s.viewDir) < 0.0f ? -n : n;
         const float y = (s.p - v.terrainOrigin).y;
         s.albedo = y > v.terrainSnowY ? v.terrainSnow : (n.y < v.terrainRockCos ? v.terrainRock : v.groundColor);
+        // The hit was computed in the height field's rebased frame, whose heights keep their magnitude.
+        const glm::vec3 lp = s.p - v.terrainBase;
+        s.extent = fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));
         return s;
     }
     const InstanceRecord in = hitInstance(v, hit);
@@ -276,11 +279,11 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
     SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
     const float nl = glm::dot(s.ng, v.sunDir);
     if (s.ground) {   // the plane or the terrain: Lambertian, lit by the sun and the uniform sky
-        if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng))) {
+        if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng, s.extent))) {
             out.local = s.albedo * v.sunRadiance * nl;
             if (v.volumeCount > 0) out.local *= sunThroughVolumes(v, s.p);   // cloud shadows
         }
-        if (v.skyLightCount > 0) out.local += s.albedo * skyLightIrradiance(v, offsetPoint(s.p, s.ng), s.ng, px, py, sample);
+        if (v.skyLightCount > 0) out.local += s.albedo * skyLightIrradiance(v, offsetPoint(s.p, s.ng, s.extent), s.ng, px, py, sample);
         out.indirect = s.albedo * v.sky;
         return out;
     }

@@ -10,6 +10,7 @@ namespace sylva {
 
 inline constexpr uint32_t kGroundPrim = 0xfffffffeu;   // Hit::prim of the ground plane
 inline constexpr uint32_t kTerrainInst = 0xfffffffdu;  // Hit::inst of the terrain (Hit::prim: its triangle)
+inline constexpr uint32_t kLandscapeInst = 0xfffffffcu; // Hit::inst of a landscape plant (nested[0]: cell, nested[1]: plant)
 
 // Texel lookup in a 1-bit cut-out, uv wrapped (OBJ convention: v = 0 is the image's bottom row).
 SYLVA_HD SYLVA_INLINE bool alphaOpaque(const RenderView& v, uint32_t maskIndex, glm::vec2 uv)
@@ -159,8 +160,13 @@ SYLVA_HD SYLVA_INLINE InstanceRecord composeInstances(const InstanceRecord& inne
 
 // The hit instance as one map from the camera-relative world frame to the hit mesh's frame (the
 // instances along the hit's path composed) with its mesh geometry and the total scale.
+namespace trace_detail {
+SYLVA_HD inline InstanceRecord landPlantInstance(const RenderView& v, uint32_t cell, uint32_t plant);
+}
+
 SYLVA_HD inline InstanceRecord hitInstance(const RenderView& v, const Hit& hit)
 {
+    if (hit.inst == kLandscapeInst) return trace_detail::landPlantInstance(v, hit.nested[0], hit.nested[1]);
     InstanceRecord m = v.instances[hit.inst];
     for (uint32_t k = 0; k < hit.depth && k < uint32_t(kMaxNested); ++k) m = composeInstances(v.groupInstances[hit.nested[k]], m);
     return m;
@@ -265,6 +271,12 @@ SYLVA_HD inline bool traceLevel(Query& q, const BvhNode* nodes, const BvhNode8* 
 
 } // namespace trace_detail
 
+} // namespace sylva
+
+#include "core/render/trace_landscape.h"
+
+namespace sylva {
+
 // Closest hit along the ray (camera-relative world frame) over the ground plane, the terrain and the top level's instances,
 // descending through instance groups to meshes traced through their BVHs (Kd = false) or kd-trees
 // (Kd = true; groups and the top level always use BVHs). AnyHit stops at the first accepted hit (shadow
@@ -288,10 +300,11 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
     }
     // The terrain next (seed 002 section 4.1): its hit shortens the ray before the plants are traversed.
     if (v.terrainEnabled) {
-        const Ray local{ray.org - v.terrainOrigin, ray.tmin, ray.dir, tmax};
+        const Ray local{ray.org - v.terrainBase, ray.tmin, ray.dir, tmax};
         uint32_t tri = kNoHit;
         float u = 0.0f, w = 0.0f;
-        if (intersectHeightField<AnyHit>(HeightFieldView{v.terrain, v.terrainHeights, v.terrainRanges}, local, tmax, tri, u, w)) {
+        if (intersectHeightField<AnyHit>(HeightFieldView{v.terrain, v.terrainHeights, v.terrainRanges, v.terrainBaseI, v.terrainBaseJ}, local, tmax,
+                                         tri, u, w)) {
             if (AnyHit) return true;
             hit.prim = tri;
             hit.inst = kTerrainInst;
@@ -299,6 +312,11 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
             hit.u = u;
             hit.v = w;
         }
+    }
+    // The landscape's cells and tiles (seed 002 sections 4.1, 4.2), below the ground's hit.
+    if (v.landscapeEnabled) {
+        trace_detail::Query lq{v, ray.tmin, alphaTestLimit(v, ray), hit, {}};
+        if (trace_detail::traceLandscape<AnyHit, Kd>(lq, ray.org, ray.dir, tmax) && AnyHit) return true;
     }
     if (v.instanceCount == 0) return AnyHit ? false : hit.prim != kNoHit;
     trace_detail::Query q{v, ray.tmin, alphaTestLimit(v, ray), hit, {}};

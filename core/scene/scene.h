@@ -13,6 +13,7 @@
 #include "core/scene/volume.h"
 #include "core/sky/sky.h"
 #include "core/sky/sun_position.h"
+#include "core/terrain/landscape.h"
 
 namespace sylva {
 
@@ -87,6 +88,12 @@ struct TerrainDesc {
     glm::vec3 snow{0.80f, 0.82f, 0.86f}; // albedo above snowLine
     float rockSlope = 35.0f;             // degrees
     float snowLine = 0.0f;               // world y, metres; 0 = no snow
+    // Plants (seed 002): the terrain cut into `cells` x `cells` cells along its longer side (0 = no plant
+    // tiles), each carrying a Wang tile of `tiles`' population chosen by `tiling`, thinned by `density`.
+    int cells = 0;
+    TileSetDesc tiles;
+    TilingDesc tiling;
+    DensityDesc density;
     // The loaded heights (pipeline/io/dem_io: loadSceneTerrain), shared by the scene's copies; not in the file.
     std::shared_ptr<const HeightField> field;
     bool enabled() const { return !dem.empty(); }

@@ -33,10 +33,14 @@ struct HeightFieldLayout {
 
 // A height field to trace: its layout, nx * nz heights and the pyramid's (min, max) heights (level 0
 // first, rows of blocks).
+// The traversal's frame is the terrain frame moved to sample (baseI, baseJ): sample (i, j) lies at
+// ((i - baseI) dx, height, (j - baseJ) dz), so points near the base (the camera) keep float precision however
+// far the terrain extends (the renderer places the base under the camera; 0, 0: the terrain frame itself).
 struct HeightFieldView {
     const HeightFieldLayout& layout;
     const float* heights;
     const glm::vec2* ranges;
+    int32_t baseI = 0, baseJ = 0;
 };
 
 // Host storage of a height field and its pyramid; view() points into it.
@@ -67,7 +71,8 @@ SYLVA_HD SYLVA_INLINE float sampleAt(const HeightFieldView& h, uint32_t i, uint3
 SYLVA_HD SYLVA_INLINE bool intersectCell(const HeightFieldView& h, uint32_t i, uint32_t j, const glm::vec3& org, const glm::vec3& dir,
                                          float tmin, float& tmax, uint32_t& prim, float& u, float& v)
 {
-    const float x0 = float(i) * h.layout.dx, x1 = float(i + 1) * h.layout.dx, z0 = float(j) * h.layout.dz, z1 = float(j + 1) * h.layout.dz;
+    const float x0 = float(int(i) - h.baseI) * h.layout.dx, x1 = float(int(i) + 1 - h.baseI) * h.layout.dx;
+    const float z0 = float(int(j) - h.baseJ) * h.layout.dz, z1 = float(int(j) + 1 - h.baseJ) * h.layout.dz;
     const glm::vec3 p00(x0, sampleAt(h, i, j), z0), p10(x1, sampleAt(h, i + 1, j), z0);
     const glm::vec3 p01(x0, sampleAt(h, i, j + 1), z1), p11(x1, sampleAt(h, i + 1, j + 1), z1);
     const uint32_t c = j * (h.layout.nx - 1) + i;
@@ -92,15 +97,15 @@ SYLVA_HD SYLVA_INLINE bool intersectBlock(const HeightFieldView& h, uint32_t bi,
     const int ci1 = int(minf(float((bi + 1) * kHeightBlock), float(h.layout.nx - 1))) - 1;
     const int cj1 = int(minf(float((bj + 1) * kHeightBlock), float(h.layout.nz - 1))) - 1;
     const glm::vec3 p = org + t0 * dir;   // where the ray enters the block's box
-    int ci = int(floorf(p.x / h.layout.dx)), cj = int(floorf(p.z / h.layout.dz));
+    int ci = int(floorf(p.x / h.layout.dx)) + h.baseI, cj = int(floorf(p.z / h.layout.dz)) + h.baseJ;
     ci = ci < ci0 ? ci0 : (ci > ci1 ? ci1 : ci);
     cj = cj < cj0 ? cj0 : (cj > cj1 ? cj1 : cj);
     const int si = dir.x > 0.0f ? 1 : (dir.x < 0.0f ? -1 : 0), sj = dir.z > 0.0f ? 1 : (dir.z < 0.0f ? -1 : 0);
     // Distance to the next column boundary on each axis, and between boundaries.
     const float big = 3.0e38f;
     const float ddx = si != 0 ? h.layout.dx / fabsf(dir.x) : big, ddz = sj != 0 ? h.layout.dz / fabsf(dir.z) : big;
-    float nextX = si > 0 ? (float(ci + 1) * h.layout.dx - org.x) / dir.x : (si < 0 ? (float(ci) * h.layout.dx - org.x) / dir.x : big);
-    float nextZ = sj > 0 ? (float(cj + 1) * h.layout.dz - org.z) / dir.z : (sj < 0 ? (float(cj) * h.layout.dz - org.z) / dir.z : big);
+    float nextX = si > 0 ? (float(ci + 1 - h.baseI) * h.layout.dx - org.x) / dir.x : (si < 0 ? (float(ci - h.baseI) * h.layout.dx - org.x) / dir.x : big);
+    float nextZ = sj > 0 ? (float(cj + 1 - h.baseJ) * h.layout.dz - org.z) / dir.z : (sj < 0 ? (float(cj - h.baseJ) * h.layout.dz - org.z) / dir.z : big);
     float tIn = t0;
     for (;;) {
         const float tExit = minf(nextX, nextZ);
@@ -150,8 +155,9 @@ SYLVA_HD SYLVA_INLINE bool intersectHeightField(const HeightFieldView& h, const 
         const Entry e = stack[--top];
         const float span = float(kHeightBlock << e.level);
         const glm::vec2 r = h.ranges[h.layout.levelOffset[e.level] + e.bj * h.layout.levelWidth[e.level] + e.bi];
-        const glm::vec3 lo(float(e.bi) * span * h.layout.dx, r.x, float(e.bj) * span * h.layout.dz);
-        const glm::vec3 hi(minf(float(e.bi + 1) * span, cellsX) * h.layout.dx, r.y, minf(float(e.bj + 1) * span, cellsZ) * h.layout.dz);
+        const float bx = float(h.baseI), bz = float(h.baseJ);
+        const glm::vec3 lo((float(e.bi) * span - bx) * h.layout.dx, r.x, (float(e.bj) * span - bz) * h.layout.dz);
+        const glm::vec3 hi((minf(float(e.bi + 1) * span, cellsX) - bx) * h.layout.dx, r.y, (minf(float(e.bj + 1) * span, cellsZ) - bz) * h.layout.dz);
         const float tNear = rayBoxEntry(lo, hi, ray.org, inv, ray.tmin, tmax);
         if (!(tNear <= tmax)) continue;
         if (e.level == 0) {

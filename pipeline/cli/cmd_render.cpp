@@ -51,6 +51,11 @@ Scene sceneForArgs(const Args& args, std::string* stem)
     if (args.has("--accel") && !parseAccel(args.get("--accel"), &r.accel))
         throw UsageError("option --accel: expected bvh or kdtree, got '" + args.get("--accel") + "'");
     if (args.has("--no-shadows")) r.shadows = false;
+    if (args.has("--cells")) {
+        if (!scene.terrain.enabled()) throw UsageError("option --cells: the scene has no terrain");
+        scene.terrain.cells = int(parseInteger("--cells", args.get("--cells"), 1, 65536));
+        if (scene.terrain.tiles.plants.empty()) throw UsageError("option --cells: the scene's terrain has no tiles (terrain.tiles)");
+    }
     if (args.has("--sun") && args.has("--sun-at")) throw UsageError("give either --sun or --sun-at, not both");
     if (args.has("--sun")) {
         if (args.get("--sun").find(',') == std::string::npos) throw UsageError("option --sun: expected X,Y,Z");
@@ -93,6 +98,10 @@ void printStats(const AccelStats& st, const RenderTimings& timings, const Render
     if (st.terrainBytes > 0)
         std::printf("terrain: %zu x %zu samples, %.0f triangles implied, %.1f MB of heights and min/max pyramid\n", st.terrainSamplesX,
                     st.terrainSamplesZ, double(st.terrainSamplesX - 1) * double(st.terrainSamplesZ - 1) * 2.0, double(st.terrainBytes) / 1e6);
+    if (st.landscapeBytes > 0)
+        std::printf("landscape: %zu cells, %zu tiles of %zu-%zu plants, %.3g potentially visible instances, %.3g triangles, %.1f MB, built in %.2f s\n",
+                    st.landscape.cells, st.landscape.tiles, st.landscape.plantsPerTileMin, st.landscape.plantsPerTileMax, st.landscape.instances,
+                    st.landscape.triangles, double(st.landscapeBytes) / 1e6, st.landscape.buildSeconds);
     if (r.mode == RenderMode::Ambient) std::printf("ambient constant %.4f\n", ambient);
 }
 
@@ -215,6 +224,7 @@ Command renderCommand()
              {"--mode", "M", "full (LB indirect + sun), local (sun only), ambient (sun + matched constant), lb"},
              {"--accel", "bvh|kdtree", "acceleration structure (default: the scene's, bvh)"},
              {"--no-shadows", "", "no shadow rays"},
+             {"--cells", "N", "plant cells along the terrain's longer side (terrain.cells; the scene needs terrain.tiles)"},
              {"--sun", "X,Y,Z", "direction toward the sun (+Y up, any length), replacing the scene's"},
              kSunAt,
              {"--alpha-distance", "M", "skip leaf cut-out tests beyond M metres from the camera (0: off, default)"},

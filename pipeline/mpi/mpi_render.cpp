@@ -49,6 +49,14 @@ void check(int rc, const char* what)
     throw Error(std::string("MPI ") + what + " failed: " + std::string(text, size_t(n)));
 }
 
+// "rank N" (built without string concatenation, which GCC 12 warns about falsely).
+std::string rankName(int r)
+{
+    char t[32];
+    std::snprintf(t, sizeof t, "rank %d", r);
+    return t;
+}
+
 std::string hostName()
 {
     char h[256] = {};
@@ -215,12 +223,14 @@ public:
             std::lock_guard<std::mutex> lock(m_mutex);
             if (!m_film) return;   // the band was abandoned (cancelled)
             if (id < m_base || id >= m_base + int(m_tiles.size()))
-                throw Error("a rank sent back tile " + std::to_string(id) + ", which is not one of the frame's tiles now");
+                throw Error(std::string("a rank sent back a tile that is not one of the frame's tiles now: ") + std::to_string(id));
             const TileMsg& t = m_tiles[size_t(id - m_base)];
             const size_t w = size_t(t.x1 - t.x0);
-            if (count != w * size_t(t.y1 - t.y0))
-                throw Error("a rank sent back tile " + std::to_string(id) + " with " + std::to_string(count) + " pixels, not " +
-                            std::to_string(w * size_t(t.y1 - t.y0)));
+            if (count != w * size_t(t.y1 - t.y0)) {
+                char msg[160];
+                std::snprintf(msg, sizeof msg, "a rank sent back tile %d with %zu pixels, not %zu", id, count, w * size_t(t.y1 - t.y0));
+                throw Error(msg);
+            }
             for (int y = t.y0; y < t.y1; ++y)
                 std::memcpy(&m_film->pixels[size_t(y - m_y0) * size_t(m_film->width) + size_t(t.x0)], parts + size_t(y - t.y0) * w,
                             w * sizeof(SampleParts));
@@ -277,9 +287,9 @@ int lead(const RenderJob& job, int size, const std::vector<std::string>& hosts)
                 const int src = st.MPI_SOURCE;
                 Peer& p = peers[size_t(src)];
                 p.seen = Clock::now();
-                if (st.MPI_TAG == kFailed) abortJob("rank " + std::to_string(src) + " on " + std::string(buf.data(), size_t(n)));
+                if (st.MPI_TAG == kFailed) abortJob(rankName(src) + " on " + std::string(buf.data(), size_t(n)));
                 if (st.MPI_TAG != kRequest) continue;
-                if (n < int(sizeof(int32_t))) throw Error("rank " + std::to_string(src) + " sent a malformed request");
+                if (n < int(sizeof(int32_t))) throw Error(rankName(src) + " sent a malformed request");
                 int32_t id = -1;
                 std::memcpy(&id, buf.data(), sizeof id);
                 if (id >= 0)
@@ -331,7 +341,13 @@ int lead(const RenderJob& job, int size, const std::vector<std::string>& hosts)
             }
         }
         if (rendered && allDone) break;
-        if (Progress::cancelAllRequested() && rendered) throw Cancelled();
+        if (Progress::cancelAllRequested()) {
+            // mpirun sends SIGTERM to every rank when one dies or fails (and on Ctrl-C); the render may be
+            // in a step that does not look at the cancel flag, so say it here and leave at once.
+            std::fprintf(stderr, "sylva render: stopped by a signal (mpirun ends the job when a rank dies or fails); no picture was written\n");
+            std::fflush(stderr);
+            std::_Exit(128 + 15);
+        }
         if (!busy) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     return code;
@@ -377,6 +393,7 @@ public:
     // The next message of rank 0 other than a heartbeat: kTile (t filled) or kDone.
     int await(TileMsg* t)
     {
+        m_heard = Clock::now();   // the wait starts now (rank 0 owes nothing while this rank works)
         for (;;) {
             int flag = 0;
             MPI_Status st;
@@ -407,13 +424,13 @@ public:
         // Rank 0 aborts the job on this message; should it not, stop after the timeout.
         const Clock::time_point t0 = Clock::now();
         while (since(t0) < m_timeout) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-        abortJob("rank " + std::to_string(m_rank) + ": " + text);
+        abortJob(rankName(m_rank) + " on " + text);
     }
 
 private:
     void beat()
     {
-        if (Progress::cancelAllRequested()) throw Cancelled();
+        if (Progress::cancelAllRequested()) std::_Exit(128 + 15);   // SIGTERM from mpirun: rank 0 says why
         if (since(m_beat) < kHeartbeatSeconds) return;
         check(MPI_Send(nullptr, 0, MPI_BYTE, 0, kHeartbeat, MPI_COMM_WORLD), "Send");
         m_beat = Clock::now();
@@ -458,7 +475,7 @@ int work(const RenderJob& job, int rank)
     } catch (const Cancelled&) {
         throw;
     } catch (const Error& e) {
-        abortJob("rank " + std::to_string(rank) + ": " + e.what());
+        abortJob(rankName(rank) + " on " + hostName() + ": " + e.what());
     }
     return 0;
 }

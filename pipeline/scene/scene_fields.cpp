@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <limits>
 
+#include "core/base/error.h"
 #include "core/sky/preetham.h"
 #include "core/sky/sun_position.h"
 #include "core/sky/virtual_lights.h"
@@ -205,6 +206,149 @@ const Table<GroundDesc>& groundTable()
     return table;
 }
 
+const Table<TilePlantDesc>& tilePlantTable()
+{
+    static const Table<TilePlantDesc> table = [] {
+        TableBuilder<TilePlantDesc> b(Layout::Inline);
+        b.custom(
+             "species",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, TilePlantDesc& t) {
+                 InstanceDesc probe;
+                 readInstanceSpecies(in(r), v, p, probe);   // unknown names refused with the declared ones
+                 t.species = probe.species;
+                 t.speciesName = r.string(v, p).toStdString();
+             },
+             [](JsonWriter& w, const TilePlantDesc& t, const KeyPath& p, int) {
+                 InstanceDesc probe;
+                 probe.species = t.species;
+                 writeInstanceSpecies(out(w), probe, p);
+             })
+            .doc("string", "name of a declared species")
+            .required("missing (required: the name of a species)")
+            .shown("required");
+        b.number("spacing", &TilePlantDesc::spacing, above(0.0))
+            .doc("number", "metres between roots of this species (Poisson disk; between two species the mean of their spacings), > 0");
+        b.number("scale_min", &TilePlantDesc::scaleMin, above(0.0)).doc("number", "uniform scale drawn in [scale_min, scale_max], > 0");
+        b.number("scale_max", &TilePlantDesc::scaleMax, above(0.0)).doc("number", ">= scale_min");
+        b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& p, TilePlantDesc& t) {
+            if (t.scaleMax < t.scaleMin) r.fail(p.field("scale_max"), "must be >= scale_min (" + json::fmt(t.scaleMin) + ")");
+        };
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<TileSetDesc>& tileSetTable()
+{
+    static const Table<TileSetDesc> table = [] {
+        TableBuilder<TileSetDesc> b(Layout::Block);
+        b.number("size", &TileSetDesc::size, above(0.0)).doc("number", "metres, the side of a tile (its frame; mapped onto a cell scaled by cell / size), > 0");
+        b.integer("seed", &TileSetDesc::seed, 0, kMaxSeed).doc("integer", "0 .. 2^62; the populations (splitmix64, as the scatter tool)");
+        b.array("plants", &TileSetDesc::plants, tilePlantTable(), "a tile set needs at least one species")
+            .doc("object", "the species of every tile's population, drawn in this order");
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<TilingDesc>& tilingTable()
+{
+    static const Table<TilingDesc> table = [] {
+        TableBuilder<TilingDesc> b(Layout::Inline);
+        b.custom(
+             "colors",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, TilingDesc& t) {
+                 const QJsonArray a = r.array(v, p);
+                 if (a.size() != 2) r.fail(p, "must be [horizontal, vertical] (two integers)");
+                 t.horizontal = int(r.integer(a.at(0), p.at(0), 1, 16));
+                 t.vertical = int(r.integer(a.at(1), p.at(1), 1, 16));
+             },
+             [](JsonWriter& w, const TilingDesc& t, const KeyPath&, int) {
+                 w.raw("[");
+                 w.integer((long long)t.horizontal);
+                 w.raw(", ");
+                 w.integer((long long)t.vertical);
+                 w.raw("]");
+             })
+            .doc("`[h, v]`", "edge colours: h for south/north edges, v for east/west edges, 1 .. 16 each");
+        b.custom(
+             "set",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, TilingDesc& t) {
+                 const QJsonArray a = r.array(v, p);
+                 t.setGiven = true;
+                 t.set.clear();
+                 for (qsizetype i = 0; i < a.size(); ++i) {
+                     const QJsonArray e = r.array(a.at(i), p.at(i));
+                     if (e.size() != 4) r.fail(p.at(i), "must be [south, east, north, west] (four colours)");
+                     WangTile w;
+                     w.s = int(r.integer(e.at(0), p.at(i).at(0), 0, 15));
+                     w.e = int(r.integer(e.at(1), p.at(i).at(1), 0, 15));
+                     w.n = int(r.integer(e.at(2), p.at(i).at(2), 0, 15));
+                     w.w = int(r.integer(e.at(3), p.at(i).at(3), 0, 15));
+                     t.set.push_back(w);
+                 }
+             },
+             [](JsonWriter& w, const TilingDesc& t, const KeyPath&, int) {
+                 w.raw("[");
+                 for (size_t i = 0; i < t.set.size(); ++i) {
+                     const WangTile& x = t.set[i];
+                     w.raw(i ? ", [" : "[");
+                     w.raw(std::to_string(x.s) + ", " + std::to_string(x.e) + ", " + std::to_string(x.n) + ", " + std::to_string(x.w) + "]");
+                 }
+                 w.raw("]");
+             })
+            .doc("array of `[s, e, n, w]`",
+                 "the Wang tiles' edge colours (south, east, north, west); absent: every combination (h^2 v^2 tiles). Refused when "
+                 "empty or when it cannot tile (a south/west pair its tiles' north/east colours meet has no tile)")
+            .shown("every combination")
+            .writtenIf([](const TilingDesc& t) { return t.setGiven; });
+        b.integer("seed", &TilingDesc::seed, 0, kMaxSeed).doc("integer", "0 .. 2^62; which matching tile each cell takes (a hash of seed and cell)");
+        b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& p, TilingDesc& t) {
+            try {
+                (void)wangTileSet(t);
+            } catch (const Error& e) {
+                r.fail(p.field("set"), e.what());
+            }
+        };
+        return b.table;
+    }();
+    return table;
+}
+
+const Table<DensityDesc>& densityTable()
+{
+    static const Table<DensityDesc> table = [] {
+        TableBuilder<DensityDesc> b(Layout::Inline);
+        b.boolean("enabled", &DensityDesc::enabled).doc("bool", "thin the plants by altitude (seed 002 eq. 2, 3) and the ground's colour");
+        b.number("lower", &DensityDesc::lower).doc("number", "world y of the lower tree line, metres");
+        b.number("upper", &DensityDesc::upper).doc("number", "world y of the upper tree line, metres (>= lower)");
+        b.number("at_lower", &DensityDesc::atLower, Bounds{.lo = 0.0, .hi = 1.0}).doc("number", "d_min: density threshold at and below the lower line, [0, 1]");
+        b.number("at_upper", &DensityDesc::atUpper, Bounds{.lo = 0.0, .hi = 1.0}).doc("number", "d_max: at and above the upper line, [0, 1]");
+        b.integer("a", &DensityDesc::a, 1, 1 << 20).doc("integer", "eq. 2's multiplier (p = (a (id_inst + id_tile) mod m) / (m - 1))");
+        b.integer("m", &DensityDesc::m, 2, 1 << 20).doc("integer", "eq. 2's modulus, >= 2");
+        b.boolean("no_snow", &DensityDesc::noSnow).doc("bool", "no plants where the ground is snow (above `snow_line`)");
+        b.boolean("no_rock", &DensityDesc::noRock).doc("bool", "no plants where the ground is rock (steeper than `rock_slope`)");
+        b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& p, DensityDesc& d) {
+            if (d.upper < d.lower) r.fail(p.field("upper"), "must be >= lower (" + json::fmt(d.lower) + ")");
+        };
+        return b.table;
+    }();
+    return table;
+}
+
+// An optional nested object of the terrain, read when present, written when `when` holds.
+template <class U, class Get>
+void terrainObject(TableBuilder<TerrainDesc>& b, const char* key, Get get, const Table<U>& sub, bool (*when)(const TerrainDesc&), const char* rule)
+{
+    json::Field<TerrainDesc>& f = b.custom(
+        key, [get, &sub](JsonReader& r, const QJsonValue& v, const KeyPath& p, TerrainDesc& t) { readObject(r, r.object(v, p), p, get(t), sub); },
+        [get, &sub](JsonWriter& w, const TerrainDesc& t, const KeyPath& p, int indent) { writeObject(w, get(const_cast<TerrainDesc&>(t)), p, sub, indent); });
+    f.writeIf = when;
+    f.nested = true;
+    f.children = [&sub](std::vector<json::FieldDoc>& o, const std::string& path) { documentFields(sub, path, o); };
+    f.doc("object", rule).shown("");
+}
+
 const Table<TerrainDesc>& terrainTable()
 {
     static const Table<TerrainDesc> table = [] {
@@ -233,6 +377,21 @@ const Table<TerrainDesc>& terrainTable()
             .doc("number", "degrees from horizontal, [0, 90]; gentler slopes take `ground.color`");
         b.number("snow_line", &TerrainDesc::snowLine, atLeast(0.0, " (metres; 0 = no snow)"))
             .doc("number", "world y above which the ground is snow, metres; 0 = no snow");
+        b.integer("cells", &TerrainDesc::cells, 0, 65536)
+            .doc("integer",
+                 "plant cells along the terrain's longer side (seed 002: 64 .. 512), each carrying a Wang tile of `tiles`; 0 = no plant "
+                 "tiles; `sylva render --cells` overrides it")
+            .writtenIf([](const TerrainDesc& t) { return t.cells > 0; })
+            .summarized([](const TerrainDesc& t) { return t.cells > 0 ? std::to_string(t.cells) + " cells a side" : std::string(); });
+        terrainObject(b, "tiles", [](TerrainDesc& t) -> TileSetDesc& { return t.tiles; }, tileSetTable(),
+                      [](const TerrainDesc& t) { return t.cells > 0; }, "the tiles' plant population (required with `cells` > 0)");
+        terrainObject(b, "tiling", [](TerrainDesc& t) -> TilingDesc& { return t.tiling; }, tilingTable(),
+                      [](const TerrainDesc& t) { return t.cells > 0; }, "the Wang tile set and the tiling of the cells");
+        terrainObject(b, "density", [](TerrainDesc& t) -> DensityDesc& { return t.density; }, densityTable(),
+                      [](const TerrainDesc& t) { return t.density.enabled; }, "adaptive plant density while tracing (seed 002 section 4.3)");
+        b.table.after = [](JsonReader& r, const QJsonObject& o, const KeyPath& p, TerrainDesc& t) {
+            if (t.cells > 0 && !o.contains(QLatin1String("tiles"))) r.fail(p.field("tiles"), "missing (required with cells > 0: the tiles' plants)");
+        };
         return b.table;
     }();
     return table;
