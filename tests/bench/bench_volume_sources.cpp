@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <cstring>
 #include <string>
+#include <ctime>
 #include <vector>
 
 #include <tbb/blocked_range.h>
@@ -61,6 +62,14 @@ DensityGrid cloud256()
     return g;
 }
 
+// Processor seconds of this process (all threads): what a step costs independent of other load.
+double cpuSeconds()
+{
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -92,11 +101,13 @@ int main(int argc, char** argv)
             volume::SmokeSim smoke(s);
             for (int w = 0; w < 5; ++w) smoke.step();   // a rising plume, a warm pressure start
             double iterations = 0.0;
+            const double cpu0 = cpuSeconds();
             const bench::Timing t = bench::timeReps(reps, [&] {
                 smoke.step();
                 iterations += smoke.lastStats().pressureIterations;
             });
             iterations /= std::max(1, reps);
+            const double cpuPerStep = (cpuSeconds() - cpu0) / std::max(1, reps);
             // Bytes a step must move at least (each array read or written once per pass): forces and
             // vorticity ~ 120 B/cell, the two advections ~ 64 B/cell, each CG iteration ~ 200 B/cell (operator,
             // V-cycle of 4 Jacobi sweeps with residual and transfers on the finest level, 2 dots, 3 updates).
@@ -104,9 +115,10 @@ int main(int argc, char** argv)
             const double bytes = cells * (184.0 + 200.0 * iterations);
             const double floor = copySeconds(size_t(bytes));
             const char* name = interp == volume::SmokeInterp::Linear ? "linear" : "cubic";
-            std::printf("smoke step %d^3 (%s): %.3f s median of %d (min %.3f), %.1f pressure iterations; streaming floor of %.0f MB "
-                        "%.3f s (%.1fx the floor)\n",
-                        n, name, t.median, reps, t.min, iterations, bytes / 1e6, floor, t.median / floor);
+            std::printf("smoke step %d^3 (%s): %.3f s median of %d (min %.3f), %.2f processor s per step, %.1f pressure iterations; "
+                        "streaming floor of %.0f MB %.3f s (%.1fx the floor)\n",
+                        n, name, t.median, reps, t.min, cpuPerStep, iterations, bytes / 1e6, floor, t.median / floor);
+            std::printf("smoke_step_%s_cpu_s=%.3f\n", name, cpuPerStep);
             std::printf("smoke_step_%s_s=%.4f\nsmoke_step_%s_iterations=%.1f\nsmoke_step_%s_floor_s=%.4f\nsmoke_step_%s_vs_floor=%.2f\n", name,
                         t.median, name, iterations, name, floor, name, t.median / floor);
             std::fflush(stdout);
