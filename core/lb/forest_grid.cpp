@@ -9,7 +9,9 @@
 #include <tbb/parallel_for.h>
 
 #include "core/base/error.h"
+#include "core/lb/lb_node.h"
 #include "core/lb/lb_solver.h"
+#include "core/lb/omega.h"
 
 namespace sylva::lb {
 
@@ -81,6 +83,57 @@ glm::vec3 sample(const LightingGrid& l, const glm::dvec3& p)
         const double w = (o.x ? f.x : 1.0 - f.x) * (o.y ? f.y : 1.0 - f.y) * (o.z ? f.z : 1.0 - f.z);
         const size_t n = g.index(i0.x + o.x, i0.y + o.y, i0.z + o.z);
         for (int ch = 0; ch < 3; ++ch) out[ch] += float(w * double(l.rgb[n * 3 + size_t(ch)]));
+    }
+    return out;
+}
+
+// The LB of LB_MODEL.md on a small grid without wood, single-threaded and scalar through the same node
+// collision as the solvers (collideNode): for the hundreds of few-hundred-node windows of a forest, where a
+// full solver's setup (page-aligned copies, thread pool per step) costs far more than the steps.
+LightingGrid solveSmall(const GridGeometry& g, const std::vector<float>& rho, const LbParams& p, int steps)
+{
+    const std::vector<float> bc = boundaryOf(p);
+    const size_t nodes = g.nodeCount();
+    LightingGrid out;
+    out.geometry = g;
+    out.rgb.assign(nodes * 3, 0.0f);
+    auto boundary = [&](int i, int j, int k) {
+        return i == 0 || j == 0 || k == 0 || i == g.dims.x - 1 || j == g.dims.y - 1 || k == g.dims.z - 1;
+    };
+    std::vector<float> a(nodes * kDirections), b(nodes * kDirections);
+    for (int c = 0; c < 3; ++c) {
+        const ChannelParams& cp = p.channels[size_t(c)];
+        const SymmetricOmega om = symmetricOmega(cp);
+        for (int i = 0; i < g.dims.x; ++i)
+            for (int j = 0; j < g.dims.y; ++j)
+                for (int k = 0; k < g.dims.z; ++k) {
+                    const bool onB = boundary(i, j, k) || p.warmStart;
+                    float* f = &a[g.index(i, j, k) * kDirections];
+                    for (int m = 0; m < kDirections; ++m) f[m] = onB ? bc[size_t(m)] : 0.0f;
+                }
+        b = a;
+        for (int t = 0; t < steps; ++t) {
+            for (int i = 0; i < g.dims.x; ++i)
+                for (int j = 0; j < g.dims.y; ++j)
+                    for (int k = 0; k < g.dims.z; ++k) {
+                        const size_t n = g.index(i, j, k);
+                        float f[kDirections];
+                        for (int m = 0; m < kDirections; ++m) f[m] = a[n * kDirections + size_t(m)];
+                        if (rho[n] > 0.0f) collideNode(f, rho[n], om, p.zeroF0);
+                        else if (p.zeroF0) f[0] = 0.0f;
+                        for (int m = 0; m < kDirections; ++m) {
+                            const int ti = i + kC[m][0], tj = j + kC[m][1], tk = k + kC[m][2];
+                            if (ti < 1 || tj < 1 || tk < 1 || ti > g.dims.x - 2 || tj > g.dims.y - 2 || tk > g.dims.z - 2) continue;
+                            b[g.index(ti, tj, tk) * kDirections + size_t(m)] = f[m];
+                        }
+                    }
+            std::swap(a, b);
+        }
+        for (size_t n = 0; n < nodes; ++n) {
+            double sum = 0.0;
+            for (int m = 0; m < kDirections; ++m) sum += double(a[n * kDirections + size_t(m)]);
+            out.rgb[n * 3 + size_t(c)] = float(sum) * p.intensity[c];
+        }
     }
     return out;
 }
@@ -165,7 +218,9 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
         // forest grid's steps; an isolated plant still gets 1 (tst_forest_grid).
         LbParams pa = p;
         pa.steps = std::min(p.steps, 4 * lg.longestEdge());
-        const LightingGrid alone = solveLighting(densityOn(lg, rho), pa);
+        // Small windows (most, at forest resolutions) through the scalar loop, large ones through the solver.
+        const DensityGrid ld = densityOn(lg, rho);
+        const LightingGrid alone = lg.nodeCount() <= 4096 ? solveSmall(lg, ld.density, pa, pa.steps) : solveLighting(ld, pa);
         const glm::dvec3 centre = 0.5 * (b.lo + b.hi);
         const glm::vec3 la = sample(alone, centre), lf = sample(r.lighting, centre);
         for (int c = 0; c < 3; ++c) r.factors[i][c] = la[c] > 0.0f ? lf[c] / la[c] : 1.0f;   // > 1 where neighbours scatter light in
