@@ -211,8 +211,11 @@ private Q_SLOTS:
         const glm::vec2 range = s.terrain.field->ranges.back();
         QVERIFY2(std::fabs(range.x - 567.5f) < 0.05f && std::fabs(range.y - 2538.2f) < 0.05f, qPrintable(QString("%1 .. %2").arg(range.x).arg(range.y)));
         QCOMPARE(s.species.size(), size_t(5));
-        QVERIFY(s.instances.size() > 500);
-        for (const InstanceDesc& d : s.instances) QVERIFY(d.onTerrain);
+        // Its plants are Wang tiles of the five species on 125 x 125 cells (160 m, the seed's cell size), thinned by altitude.
+        QVERIFY(s.instances.empty());
+        QCOMPARE(s.terrain.cells, 125);
+        QCOMPARE(s.terrain.tiles.plants.size(), size_t(5));
+        QVERIFY(s.terrain.density.enabled);
     }
 
     // An instance standing on the terrain is lifted onto its surface; one off the terrain or in a scene
