@@ -348,7 +348,7 @@ int lead(const RenderJob& job, int size, const std::vector<std::string>& hosts)
             std::fflush(stderr);
             std::_Exit(128 + 15);
         }
-        if (!busy) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        if (!busy) std::this_thread::sleep_for(std::chrono::microseconds(200));
     }
     return code;
 }
