@@ -13,6 +13,7 @@ bool parsePart(const std::string& name, Part* out)
     if (name == "lb") *out = Part::Lb;
     else if (name == "voxel") *out = Part::Voxel;
     else if (name == "render") *out = Part::Render;
+    else if (name == "truth") *out = Part::Truth;
     else return false;
     return true;
 }
@@ -54,6 +55,7 @@ Result run(const Options& options)
     } else if (loadRender(renderPath, &render)) {
         input.render = &render;
     }
+    if (wants(Part::Truth)) measureTruth(options);   // writes accuracy/truth.md, which the report includes
     Result result;
     writeReport(options, input, result);
     result.seconds = secondsNow() - t0;

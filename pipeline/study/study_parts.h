@@ -24,6 +24,9 @@ void markDefaults(LbData& data);
 LbData measureLb(const Options& options);
 VoxelData measureVoxel(const Options& options);
 RenderData measureRender(const Options& options);
+// Sylva against Cycles (study_truth.cpp): writes outDir/accuracy/truth.md, truth/*.png and truth_time.svg;
+// false (and a log line) when skipped: no `blender` (SYLVA_BLENDER overrides the program) or --quick.
+bool measureTruth(const Options& options);
 
 // What the report is written from: whichever parts have stored results.
 struct ReportInput {

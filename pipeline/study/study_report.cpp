@@ -585,6 +585,11 @@ void writeReport(const Options& options, const ReportInput& in, Result& result)
     if (in.render) md << renderSections(*in.render, pl);
     else md << "## Rendering\n\nNot measured yet: `sylva study render`.\n\n";
     md << presetSection(in.lb, in.render);
+    {   // the ground truth against Cycles, written by `sylva study truth` (measureTruth) and kept until rerun
+        std::ifstream truth(dir + "/accuracy/truth.md");
+        if (truth) md << truth.rdbuf();
+        else md << "## Ground truth: Sylva against Cycles\n\nNot measured yet: `sylva study truth` (needs `blender`).\n\n";
+    }
     if (pl.program.empty() || !pl.note.empty()) md << "Plots: skipped (" << pl.note << ").\n";
 
     AtomicFile file(mdPath);
