@@ -244,7 +244,7 @@ private Q_SLOTS:
         if (!QFile::exists(teapotPath())) QSKIP("../shared/data/models/teapot.obj is absent");
         const TriangleMesh mesh = importMesh(teapotPath().toStdString());
         VoxelizeSettings s;
-        s.longestAxisNodes = 64;
+        s.longestAxisNodes = 48;
         s.solid = true;
         const DensityGrid g = voxelize(mesh, s);
         const GridGeometry& geo = g.geometry;
@@ -284,7 +284,7 @@ private Q_SLOTS:
         const WindingNumber w(mesh);
         std::mt19937 rng(9);
         std::uniform_real_distribution<double> ux(b.lo.x, b.hi.x), uy(b.lo.y, b.hi.y), uz(b.lo.z, b.hi.z);
-        const int samples = 1500;
+        const int samples = 1000;
         int inside = 0;
         for (int i = 0; i < samples; ++i)
             if (std::fabs(w.exact({ux(rng), uy(rng), uz(rng)})) >= 0.5) ++inside;
