@@ -204,6 +204,17 @@ int runRender(const Args& args)
         return prepareRenderScene(scene, cache.get(), progress, nullptr, compute.get(), t);
     };
     job.lead = renderAndWrite;
+    // Species lighting across the ranks: species s is solved by rank s mod N into the shared cache.
+    if (cache && modeNeedsLighting(r.mode))
+        job.lightShare = [&](int rank, int ranks, Progress* progress) {
+            int solves = 0;
+            for (size_t s = size_t(rank); s < scene.species.size(); s += size_t(ranks)) {
+                JobLog lit;
+                loadSpeciesGrids(scene, s, cache.get(), progress, &lit, nullptr, compute.get());
+                for (const std::string& stage : lit.stages) solves += stage == "light" ? 1 : 0;
+            }
+            return solves;
+        };
     if (args.has("--mpi-timeout")) job.timeoutSeconds = double(parseInteger("--mpi-timeout", args.get("--mpi-timeout"), 1, 86400));
     return mpi::runRender(job);
 #else

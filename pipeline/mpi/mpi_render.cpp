@@ -34,7 +34,7 @@ using Clock = std::chrono::steady_clock;
 
 // Message tags. Workers send kHeartbeat, kRequest (the tile they finished, if any, and a request for
 // the next) and kFailed (an error text); rank 0 sends kTile, kDone and kHeartbeat (to waiting ranks).
-enum Tag : int { kFailed = 11, kHeartbeat = 12, kRequest = 13, kTile = 14, kDone = 15 };
+enum Tag : int { kFailed = 11, kHeartbeat = 12, kRequest = 13, kTile = 14, kDone = 15, kLit = 16 };
 
 constexpr double kHeartbeatSeconds = 0.5;
 
@@ -260,7 +260,37 @@ int lead(const RenderJob& job, int size, const std::vector<std::string>& hosts)
 {
     TileQueue queue(size, job.tile);
     const FilmRowsTracer tracer = [&queue](const RenderView& v, int y0, int y1, Progress* p) { return queue.trace(v, y0, y1, p); };
-    std::future<int> render = std::async(std::launch::async, [&job, &tracer, size] { return job.lead(tracer, size); });
+    // The species' lighting shared out (when asked): rank 0's share, then a wait for every rank's.
+    std::mutex litMutex;
+    int lit = 0;
+    std::vector<int> solves(static_cast<size_t>(size), 0);
+    std::future<int> render = std::async(std::launch::async, [&] {
+        if (job.lightShare) {
+            const int mine = job.lightShare(0, size, nullptr);
+            for (;;) {
+                {
+                    std::lock_guard<std::mutex> lock(litMutex);
+                    if (lit == size - 1) {
+                        solves[0] = mine;
+                        std::string line;
+                        int total = 0;
+                        for (int r = 0; r < size; ++r) {
+                            total += solves[size_t(r)];
+                            line += r ? " + " : "";
+                            line += std::to_string(solves[size_t(r)]);
+                        }
+                        std::printf("species lighting on %d %s: %d LB %s (%s by rank), the rest from the cache\n", size,
+                                    size == 1 ? "rank" : "ranks", total, total == 1 ? "solve" : "solves", line.c_str());
+                        std::fflush(stdout);
+                        break;
+                    }
+                }
+                if (Progress::cancelAllRequested()) throw Cancelled();
+                std::this_thread::sleep_for(std::chrono::milliseconds(5));
+            }
+        }
+        return job.lead(tracer, size);
+    });
 
     struct Peer {
         Clock::time_point seen, pinged;
@@ -288,6 +318,14 @@ int lead(const RenderJob& job, int size, const std::vector<std::string>& hosts)
                 Peer& p = peers[size_t(src)];
                 p.seen = Clock::now();
                 if (st.MPI_TAG == kFailed) abortJob(rankName(src) + " on " + std::string(buf.data(), size_t(n)));
+                if (st.MPI_TAG == kLit) {
+                    int32_t count = 0;
+                    if (n == int(sizeof count)) std::memcpy(&count, buf.data(), sizeof count);
+                    std::lock_guard<std::mutex> lock(litMutex);
+                    solves[size_t(src)] = count;
+                    ++lit;
+                    continue;
+                }
                 if (st.MPI_TAG != kRequest) continue;
                 if (n < int(sizeof(int32_t))) throw Error(rankName(src) + " sent a malformed request");
                 int32_t id = -1;
@@ -448,11 +486,15 @@ private:
     Clock::time_point m_beat, m_heard;
 };
 
-int work(const RenderJob& job, int rank)
+int work(const RenderJob& job, int rank, int size)
 {
     Worker w(rank, job.timeoutSeconds);
     try {
         Progress quiet([](double, const std::string&) {});
+        if (job.lightShare) {
+            const int32_t solved = w.busy([&] { return job.lightShare(rank, size, &quiet); });
+            w.send(&solved, sizeof solved, kLit);
+        }
         const RenderScene rs = w.busy([&] { return job.prepare(&quiet); });
         const RenderView view = rs.view();
         std::vector<char> msg(sizeof(int32_t));
@@ -534,7 +576,7 @@ int runRender(const RenderJob& job)
         MPI_Finalize();
         return 1;
     }
-    const int code = rank == 0 ? lead(job, size, hosts) : work(job, rank);
+    const int code = rank == 0 ? lead(job, size, hosts) : work(job, rank, size);
     MPI_Finalize();
     return code;
 }

@@ -31,6 +31,10 @@ bool launchedByMpi();
 int launchRank();
 
 struct RenderJob {
+    // Every rank first (when set): the LB solves of the species the rank shares out (species s on rank
+    // s mod N) into the shared grid cache, so that loading them afterwards is a cache hit everywhere.
+    // Returns the number of LB solves it ran (0 for species the cache held).
+    std::function<int(int rank, int ranks, Progress* progress)> lightShare;
     // Ranks other than 0: the frame's scene (prepareRenderScene), the same call as rank 0's.
     std::function<RenderScene(Progress* progress)> prepare;
     // Rank 0: the whole render and its output, with the tracing through `tracer`. Returns the exit

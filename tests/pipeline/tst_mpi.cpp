@@ -177,6 +177,26 @@ private Q_SLOTS:
         }
     }
 
+    // Species lighting across the ranks: with an empty cache, 2 ranks share the 5 species' LB solves
+    // (rank 0 species 0, 2 and 4, rank 1 species 1 and 3), each solved once, and the picture equals a
+    // single process's from that cache; a second run solves none.
+    void speciesLitAcrossRanks()
+    {
+        QTemporaryDir fresh;
+        const QString out = m_dir.filePath("shared_lit.png"), ref = m_dir.filePath("shared_lit_single.png");
+        const QStringList common{m_scene, "--cache", fresh.path(), "--width", "48", "--height", "24", "--quiet"};
+        Run r = mpirun(2, QStringList(common) << "-o" << out);
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QVERIFY2(r.out.contains("species lighting on 2 ranks: 5 LB solves (3 + 2 by rank)"), qPrintable(r.out));
+        r = mpirun(2, QStringList(common) << "-o" << out);
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QVERIFY2(r.out.contains("species lighting on 2 ranks: 0 LB solves (0 + 0 by rank)"), qPrintable(r.out));
+        r = single(QStringList(common) << "-o" << ref);
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QVERIFY(!fileBytes(ref).isEmpty());
+        QCOMPARE(fileBytes(out), fileBytes(ref));
+    }
+
     // A rank killed (SIGKILL) or stopped (SIGSTOP: it hangs) while the frame is traced: mpirun exits
     // non-zero within 30 s, rank 0 says what happened, and neither the picture nor a temporary file is left.
     void deadOrHungRankEndsTheJob_data()
