@@ -94,6 +94,11 @@ SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, 
         }
         for (uint32_t k = n.first; k < n.first + n.count; ++k) {
             const TilePlant& p = v.tilePlants[k];
+            // The plant's box raised anywhere in the cell's ground range first (tile frame): most plants of a
+            // leaf are rejected before the height field is read.
+            if (!(rayBoxEntry(glm::vec3(p.x + p.lo.x, c.ground.x * ik + p.lo.y, p.z + p.lo.z), glm::vec3(p.x + p.hi.x, c.ground.y * ik + p.hi.y, p.z + p.hi.z),
+                              ot, inv, q.tmin, tmax) <= tmax))
+                continue;
             glm::vec3 root;
             if (!landPlantRoot(v, cell, p, root)) continue;
             const glm::vec3 op = (o - root) * ik;   // the plant-centred tile frame
