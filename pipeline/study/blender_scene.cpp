@@ -431,15 +431,18 @@ def place(coll, name, matrix):
         py << "bg.inputs['Color'].default_value = (" << num(scene.sky.x) << ", " << num(scene.sky.y) << ", " << num(scene.sky.z)
            << ", 1.0)\n";
     } else {
-        // Sylva's map: u = 1/2 - atan2(x, z) / (2 pi) (Sylva frame), v = acos(y) / pi from the top row. Blender's
-        // equirectangular lookup of the direction with its X and Y swapped gives the same texel.
+        // Sylva's map: u = 1/2 - atan2(x, z) / (2 pi) (Sylva frame), v = acos(y) / pi from the top row. Cycles':
+        // u = 1/2 - atan2(Y, X) / (2 pi) of the Blender direction (X, Y, Z) = (x, -z, y), so it is looked up
+        // at (-Y, X, Z) = (z, x, y): the same texel.
         py << "et = node(wn, 'ShaderNodeTexEnvironment', interpolation='Closest', projection='EQUIRECTANGULAR')\n"
               "et.image = bpy.data.images.load("
            << pyString(fs::absolute(skyExr).string())
            << ")\net.image.colorspace_settings.name = 'Linear'\n"
               "tc = node(wn, 'ShaderNodeTexCoord')\nsx = node(wn, 'ShaderNodeSeparateXYZ')\ncx = node(wn, 'ShaderNodeCombineXYZ')\n"
+              "neg = node(wn, 'ShaderNodeMath', operation='MULTIPLY')\nneg.inputs[1].default_value = -1.0\n"
               "wn.links.new(tc.outputs['Generated'], sx.inputs[0])\nwn.links.new(sx.outputs['X'], cx.inputs['Y'])\n"
-              "wn.links.new(sx.outputs['Y'], cx.inputs['X'])\nwn.links.new(sx.outputs['Z'], cx.inputs['Z'])\n"
+              "wn.links.new(sx.outputs['Y'], neg.inputs[0])\nwn.links.new(neg.outputs[0], cx.inputs['X'])\n"
+              "wn.links.new(sx.outputs['Z'], cx.inputs['Z'])\n"
               "wn.links.new(cx.outputs[0], et.inputs['Vector'])\nwn.links.new(et.outputs['Color'], bg.inputs['Color'])\n";
     }
     py << "try:\n    w.lightgroup = 'sky'\nexcept Exception:\n    pass\n";

@@ -456,7 +456,7 @@ bool measureTruth(const Options& o)
           "| constant sky `sky.color`: background radiance; the ground's indirect light albedo x sky (an unoccluded uniform sky) | "
           "world Background of that colour, strength 1 (lights everything, with occlusion) |\n"
           "| Preetham or map sky | world Environment Texture of the equirectangular EXR `sylva sky` writes (nearest pixel, Sylva's "
-          "orientation: the lookup direction's X and Y swapped) |\n"
+          "orientation: the lookup direction (X, Y, Z) turned to (-Y, X, Z)) |\n"
           "| ground plane: Lambertian albedo `ground.color` | an 80 km plane, Diffuse BSDF of that colour |\n"
           "| bark: diffuse kd = Kd x texture (sRGB decoded, bilinear) | Diffuse BSDF (roughness 0) of the same kd (image sRGB, "
           "linear interpolation) |\n"

@@ -14,6 +14,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "pipeline/io/image_io.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/study/blender_scene.h"
 #include "tests/common/run_program.h"
@@ -113,6 +114,57 @@ private Q_SLOTS:
             mean /= double(spec.width * spec.height);
             const double expected = double(s.ground.color[k]) * (double(rad[k]) * cosSun + double(s.sky[k]));
             QVERIFY2(std::fabs(mean / expected - 1.0) < 0.015, qPrintable(QString("channel %1: Cycles %2, closed form %3").arg(k).arg(mean).arg(expected)));
+        }
+    }
+
+    // A map sky as the world texture: looking along +X and +Z (Sylva's frame), Cycles' background shows the
+    // map's texel that Sylva's equirectUv gives for that direction (u = 1/2 - atan2(x, z) / 2pi, v = acos(y) / pi).
+    void cyclesSkyMapOrientation()
+    {
+        QTemporaryDir tmp;
+        const std::string dir = tmp.path().toStdString();
+        const int mw = 16, mh = 8;
+        ImageRgba map(mw, mh);
+        for (int y = 0; y < mh; ++y)
+            for (int x = 0; x < mw; ++x) {
+                float* p = &map.pixels[size_t(y * mw + x) * 4];
+                p[0] = 0.05f * float(x + 1);
+                p[1] = 0.1f * float(y + 1);
+                p[2] = 0.5f;
+                p[3] = 1.0f;
+            }
+        writeImage(dir + "/map.exr", map);
+        for (glm::dvec3 d : {glm::dvec3(1, 0.2, 0.1), glm::dvec3(0.1, 0.2, 1), glm::dvec3(-0.6, 0.5, -0.7), glm::dvec3(0.3, -0.4, -1)}) {
+            Scene s;
+            s.render.width = 4;
+            s.render.height = 4;
+            s.skyModel.kind = sky::SkyKind::Map;
+            s.ground.enabled = false;
+            s.camera.position = {0.0, 0.0, 0.0};
+            s.camera.target = d;
+            s.camera.fovY = 1.0f;
+            study::BlenderOptions o;
+            o.samples = 4;
+            const std::string script = study::writeBlenderScene(s, {}, dir, o, dir + "/map.exr");
+            const std::string exr = dir + "/sky.exr";
+            const std::string out = runBlender(m_blender, script, "--out '" + exr + "' --sun 0");
+            QVERIFY2(out.find("SYLVA_CYCLES_SECONDS=") != std::string::npos, out.c_str());
+            auto in = OIIO::ImageInput::open(exr);
+            QVERIFY(in);
+            const OIIO::ImageSpec& spec = in->spec();
+            std::vector<float> px(size_t(spec.width * spec.height * spec.nchannels));
+            QVERIFY(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, px.data()));
+            int ch[3] = {-1, -1, -1};
+            for (int c = 0; c < spec.nchannels; ++c)
+                for (int k = 0; k < 3; ++k)
+                    if (spec.channelnames[size_t(c)] == std::string("ViewLayer.Combined.") + "RGB"[k]) ch[k] = c;
+            const glm::dvec3 n = glm::normalize(d);
+            const double u = 0.5 - std::atan2(n.x, n.z) / (2.0 * M_PI), v = std::acos(n.y) / M_PI;
+            const int tx = int((u - std::floor(u)) * mw), ty = int(v * mh);
+            const size_t centre = size_t((1 * spec.width + 1) * spec.nchannels);   // pixel (1, 1), next to the axis
+            const float r = px[centre + size_t(ch[0])], g = px[centre + size_t(ch[1])];
+            QVERIFY2(std::fabs(r - 0.05f * float(tx + 1)) < 2e-3f && std::fabs(g - 0.1f * float(ty + 1)) < 2e-3f,
+                     qPrintable(QString("direction (%1, %2, %3): Cycles (%4, %5), map texel (%6, %7)").arg(d.x).arg(d.y).arg(d.z).arg(r).arg(g).arg(tx).arg(ty)));
         }
     }
 
