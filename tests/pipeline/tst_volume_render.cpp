@@ -340,6 +340,28 @@ private Q_SLOTS:
         }
     }
 
+    // The bundled example (resources/cloud.sylva.json, read as `sylva render` reads it, LB solved without a
+    // cache): a finite picture; the cloud brightens the sky where it stands and its shadow darkens ground.
+    void bundledCloudExample()
+    {
+        Scene s = readSceneFile(std::string(SYLVA_SOURCE_DIR) + "/resources/cloud.sylva.json");
+        s.render.width = 80;
+        s.render.height = 60;
+        const std::vector<glm::vec3> with = composeMode(renderScene(s, nullptr).film, RenderMode::Full, s.sky);
+        Scene bare = s;
+        bare.volumes.clear();
+        const std::vector<glm::vec3> without = composeMode(renderScene(bare, nullptr).film, RenderMode::Full, s.sky);
+        int darker = 0, changed = 0;
+        for (size_t i = 0; i < with.size(); ++i) {
+            for (int c = 0; c < 3; ++c) QVERIFY(std::isfinite(with[i][c]) && with[i][c] >= 0.0f);
+            changed += with[i] != without[i];
+            darker += with[i].y < 0.8f * without[i].y && i >= with.size() / 2;   // the lower half: ground and trees
+        }
+        std::printf("cloud example: %d of %zu pixels changed, %d in the lower half darker by 20%% or more\n", changed, with.size(), darker);
+        QVERIFY(changed > 100);
+        QVERIFY(darker > 20);
+    }
+
     // The scene file: volumes read (relative grid path, preset with overrides, tracer, placements) and
     // written back; files without volumes are written without the key; bad input refused by name.
     void sceneFile()
