@@ -256,42 +256,42 @@ struct SmokeSim::Solver {
         });
     }
 
-    // Damped Jacobi sweeps (omega 6/7, the 3D 7-point smoother); `fromZero`: x starts at 0.
-    static void jacobi(Level& l, int sweeps, bool fromZero)
+    // One Gauss-Seidel sweep over the cells of one colour ((i + j + k) % 2 == colour), in place: the
+    // cells of a colour depend only on the other colour, so the slabs run in parallel and the result
+    // does not depend on the thread count.
+    static void colourSweep(Level& l, int colour)
     {
-        constexpr double omega = 6.0 / 7.0;
-        for (int s = 0; s < sweeps; ++s) {
-            if (fromZero && s == 0) {
-                forSlabs(l.n.x, [&](int i) {
-                    for (int j = 0; j < l.n.y; ++j)
-                        for (int k = 0; k < l.n.z; ++k) {
-                            const size_t c = l.index(i, j, k);
-                            l.x[c] = l.fluid[c] ? omega * l.b[c] / double(l.diag[c]) : 0.0;
-                        }
-                });
-                continue;
-            }
-            forSlabs(l.n.x, [&](int i) {
-                for (int j = 0; j < l.n.y; ++j)
-                    for (int k = 0; k < l.n.z; ++k) {
-                        const size_t c = l.index(i, j, k);
-                        l.tmp[c] = l.fluid[c] ? l.x[c] + omega * (l.b[c] - applyAt(l, l.x.data(), i, j, k)) / double(l.diag[c]) : 0.0;
-                    }
-            });
-            std::swap(l.x, l.tmp);
-        }
+        forSlabs(l.n.x, [&](int i) {
+            for (int j = 0; j < l.n.y; ++j)
+                for (int k = (i + j + colour) & 1; k < l.n.z; k += 2) {
+                    const size_t c = l.index(i, j, k);
+                    if (!l.fluid[c]) continue;
+                    const double off = double(l.diag[c]) * l.x[c] - applyAt(l, l.x.data(), i, j, k);   // sum of the neighbours
+                    l.x[c] = (l.b[c] + off) / double(l.diag[c]);
+                }
+        });
     }
 
-    // x_l = V-cycle applied to b_l (a symmetric linear operator: equal Jacobi sweeps before and after,
-    // restriction = prolongation^T / 2, a fixed sweep count on the coarsest level).
+    // x_l = V-cycle applied to b_l, a symmetric linear operator: red-black Gauss-Seidel before the
+    // coarse correction and black-red after (the adjoint), restriction = prolongation^T / 2, and a
+    // palindromic sweep sequence on the coarsest level.
     void vcycle(size_t li)
     {
         Level& l = levels[li];
+        std::fill(l.x.begin(), l.x.end(), 0.0);
         if (li + 1 == levels.size()) {
-            jacobi(l, 30, true);
+            for (int sweep = 0; sweep < 8; ++sweep) {
+                colourSweep(l, 0);
+                colourSweep(l, 1);
+            }
+            for (int sweep = 0; sweep < 8; ++sweep) {
+                colourSweep(l, 1);
+                colourSweep(l, 0);
+            }
             return;
         }
-        jacobi(l, 2, true);
+        colourSweep(l, 0);
+        colourSweep(l, 1);
         Level& c = levels[li + 1];
         forSlabs(l.n.x, [&](int i) {
             for (int j = 0; j < l.n.y; ++j)
@@ -319,7 +319,8 @@ struct SmokeSim::Solver {
                     if (l.fluid[f]) l.x[f] += c.x[c.index(i / 2, j / 2, k / 2)];
                 }
         });
-        jacobi(l, 2, false);
+        colourSweep(l, 1);
+        colourSweep(l, 0);
     }
 
     static double dot(const std::vector<double>& a, const std::vector<double>& b)
