@@ -195,18 +195,57 @@ void RenderWorker::process(const Request& req, Progress& progress)
         if (interrupted()) throw Cancelled();
     }
     const glm::vec3 sun = sunRadiance(scene.sun);
+    // Progressive refinement (issue 16 item 5): the schedule's frames (while the camera moves every request
+    // restarts them) light with the sun's one shadow ray alone; then, at full size, frames of new sample
+    // positions and sky-light subsets are accumulated up to the samples `sylva render` traces.
+    const Refinement refine = refinementFor(m_frame->rs.view(),   // the sky's lights are the frame's (built, not placed)
+                                             scene.render.spp, passes.empty() ? 0 : passes.back().spp);
     for (size_t p = 0; p < passes.size(); ++p) {
         const int pw = std::max(1, w / passes[p].divisor), ph = std::max(1, h / passes[p].divisor);
         placeViewFrame(*m_frame, scene, sun, pw, ph, passes[p].spp);
-        Film film = renderFilm(m_frame->rs.view(), &progress);
+        RenderView view = m_frame->rs.view();
+        if (refine.frames > 0) view.skyLightCount = 0;   // moving: the sun alone
+        Film film = renderFilm(view, &progress);
         if (interrupted()) throw Cancelled();
         const QImage img = picture(film, scene, req.compare);
+        const bool last = p + 1 == passes.size() && refine.frames == 0;
         m_lastFilm = std::move(film);
         m_lastScene = scene;
         m_lastSize = req.size;
-        m_lastPass = int(p);
-        Q_EMIT imageReady(img, int(p), p + 1 == passes.size(), elapsed());
+        m_lastPass = last ? int(passes.size()) - 1 : -1;
+        Q_EMIT imageReady(img, int(p), last, elapsed());
     }
+    if (refine.frames == 0) return;
+    placeViewFrame(*m_frame, scene, sun, w, h, refine.samples);
+    Film sum;
+    int done = 0;
+    for (int f = 0; f < refine.frames; ++f) {
+        RenderView view = m_frame->rs.view();
+        view.sampleBegin = done;
+        view.sampleEnd = std::min(refine.samples, done + refine.perFrame);
+        const Film part = renderFilm(view, &progress);
+        if (interrupted()) throw Cancelled();
+        accumulateFilm(sum, done, part, view.sampleEnd - view.sampleBegin);
+        done = view.sampleEnd;
+        const bool last = done >= refine.samples;
+        const QImage img = picture(sum, scene, req.compare);
+        m_lastFilm = sum;
+        m_lastScene = scene;
+        m_lastSize = req.size;
+        m_lastPass = last ? int(passes.size()) - 1 : -1;
+        Q_EMIT imageReady(img, int(passes.size()) + f, last, elapsed());
+    }
+}
+
+Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp)
+{
+    Refinement r;
+    if (view.skyLightCount == 0 && sceneSpp <= lastPassSpp) return r;   // the constant sky: the schedule as before
+    const int subsets = std::max(1, view.skyInterleave.subsets);
+    r.samples = std::max(sceneSpp, subsets);
+    r.perFrame = subsets;
+    r.frames = (r.samples + r.perFrame - 1) / r.perFrame;
+    return r;
 }
 
 } // namespace sylva

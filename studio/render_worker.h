@@ -30,6 +30,15 @@ struct RenderPass {
     int spp;
 };
 
+// The viewport's refinement once the schedule is done (issue 16 item 5): `frames` full-size frames of
+// `perFrame` samples each (one cycle of the K sky-light subsets), accumulated (accumulateFilm) into the
+// frame of `samples` samples per pixel, the scene's spp (at least K), which is `sylva render`'s picture.
+// None (frames 0) for a constant sky whose spp the schedule's last pass already reaches.
+struct Refinement {
+    int samples = 0, perFrame = 0, frames = 0;
+};
+Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp);
+
 // Tone-mapped sRGB picture of a film in a render mode (composeMode + toneMapped), as a QImage.
 QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float exposureKey);
 
@@ -53,7 +62,9 @@ public:
     explicit RenderWorker(QObject* parent = nullptr);
     ~RenderWorker() override;
 
-    // The default schedule: 1/4 size at 1 spp, full size at 1 spp, full size at 4 spp.
+    // The default schedule: 1/4 size at 1 spp, full size at 1 spp, full size at 4 spp. A sky with virtual
+    // lights (or a scene spp above the last pass's) is then refined (refinementFor); the schedule's frames
+    // then light with the sun alone.
     static std::vector<RenderPass> defaultPasses();
     void setPasses(std::vector<RenderPass> passes);
     std::vector<RenderPass> passes() const;

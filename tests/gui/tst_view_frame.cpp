@@ -11,6 +11,7 @@
 #include "core/render/render_cpu.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/grow/tree_grower.h"
+#include "pipeline/io/env_map_io.h"
 #include "pipeline/render/render_job.h"
 #include "studio/asset_store.h"
 #include "studio/render_worker.h"
@@ -198,6 +199,62 @@ private Q_SLOTS:
         images.clear();
         worker.request(s, assets, QSize(64, 36));
         QTRY_VERIFY_WITH_TIMEOUT(!images.isEmpty() && images.last().at(2).toBool(), 20000);
+    }
+
+    // Progressive refinement (issue 16 item 5) under a Preetham sky with 16 virtual lights in 4 subsets:
+    // while the camera moves (every request restarts the schedule) the schedule's frames light with the
+    // sun alone; once it stops, frames of 4 samples (one cycle of the subsets) are accumulated until the
+    // scene's 8 spp, and that last picture equals the frame `sylva render` traces (buildRenderScene at the
+    // scene's spp, all samples at once) within one 8-bit step.
+    void refinementAccumulatesToTheRenderFrame()
+    {
+        Scene s = treeScene();
+        s.skyModel.kind = sky::SkyKind::Preetham;
+        s.skyModel.lights = 16;
+        s.skyModel.interleave = 4;
+        s.render.spp = 8;
+        s.render.mode = RenderMode::Local;
+        loadSceneSky(s);
+        const QSize size(64, 36);
+        std::vector<AssetsPtr> assets{std::make_shared<const SpeciesAssets>(m_assets[0])};
+        RenderWorker worker;
+        worker.setPasses({{4, 1}, {1, 1}});
+        QSignalSpy images(&worker, &RenderWorker::imageReady);
+        worker.request(s, assets, size);
+        QTRY_VERIFY_WITH_TIMEOUT(!images.isEmpty() && images.last().at(2).toBool(), 60000);
+        QCOMPARE(images.count(), 2 + 2);   // the schedule, then 8 spp in 2 frames of 4
+        for (int i = 0; i + 1 < images.count(); ++i) QVERIFY(!images.at(i).at(2).toBool());
+        QCOMPARE(images.at(3).at(1).toInt(), 3);
+        const QImage moving = images.at(1).at(0).value<QImage>(), settled = images.last().at(0).value<QImage>();
+
+        Scene cli = s;
+        cli.render.width = size.width();
+        cli.render.height = size.height();
+        const RenderScene rs = buildRenderScene(cli, m_assets, sunRadiance(cli.sun));
+        QVERIFY(rs.view().skyLightCount == 16);
+        const QImage reference = filmImage(renderFilm(rs.view()), cli.render.mode, composeSky(cli), cli.render.exposureKey);
+        auto maxStep = [](const QImage& p, const QImage& q) {
+            if (p.size() != q.size()) return 256;
+            int m = 0;
+            for (int y = 0; y < q.height(); ++y)
+                for (int x = 0; x < q.width(); ++x) {
+                    const QRgb a = p.pixel(x, y), b = q.pixel(x, y);
+                    m = std::max({m, std::abs(qRed(a) - qRed(b)), std::abs(qGreen(a) - qGreen(b)), std::abs(qBlue(a) - qBlue(b))});
+                }
+            return m;
+        };
+        const int worst = maxStep(settled, reference);
+        QVERIFY2(worst <= 1, qPrintable(QString("the settled viewport is %1 steps off sylva render's frame").arg(worst)));
+        // The moving frame is the sun's alone: darker than the settled one (no sky light), and the same
+        // picture as a 1-spp frame with the sky lights off.
+        Scene oneSample = cli;
+        oneSample.render.spp = 1;
+        const RenderScene rs1 = buildRenderScene(oneSample, m_assets, sunRadiance(cli.sun));
+        RenderView sunOnly = rs1.view();
+        sunOnly.skyLightCount = 0;
+        const QImage sunPicture = filmImage(renderFilm(sunOnly), cli.render.mode, composeSky(cli), cli.render.exposureKey);
+        QVERIFY2(maxStep(moving, sunPicture) <= 1, qPrintable(QString("moving frame %1 steps off the sun-only frame").arg(maxStep(moving, sunPicture))));
+        QVERIFY2(maxStep(moving, settled) > 8, qPrintable(QString("moving frame only %1 steps off the settled one").arg(maxStep(moving, settled))));
     }
 
     // Side-by-side compare (seed 000 Figure 2): both halves come from one trace. Turning compare on
