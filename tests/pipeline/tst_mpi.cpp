@@ -197,7 +197,8 @@ private Q_SLOTS:
         QCOMPARE(fileBytes(out), fileBytes(ref));
     }
 
-    // A rank killed (SIGKILL) or stopped (SIGSTOP: it hangs) while the frame is traced: mpirun exits
+    // A rank killed (SIGKILL) or stopped (SIGSTOP: it hangs) while the frame is traced (512 spp: tens of
+    // seconds of tracing even on idle cores, so the signal lands mid-frame; the job ends first): mpirun exits
     // non-zero within 30 s, rank 0 says what happened, and neither the picture nor a temporary file is left.
     void deadOrHungRankEndsTheJob_data()
     {
@@ -216,7 +217,7 @@ private Q_SLOTS:
         p.setProcessEnvironment(mpiEnv(m_cache));
         p.setProcessChannelMode(QProcess::SeparateChannels);
         p.start(SYLVA_MPIEXEC, mpirunArgs(2) << SYLVA_CLI_PATH << "render" << "--mpi" << "--mpi-timeout" << "3" << m_scene << "--width"
-                                              << "320" << "--height" << "160" << "--spp" << "64" << "-o" << out);
+                                              << "320" << "--height" << "160" << "--spp" << "512" << "-o" << out);
         QVERIFY(p.waitForStarted());
         // Wait until rank 0 reports tracing (its progress lines on stderr).
         QByteArray err;
