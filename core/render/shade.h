@@ -211,9 +211,9 @@ SYLVA_HD inline SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, c
 
 // Stage 3, volume: what participating media along the camera ray's segment [ray.tmin, tEnd] add to
 // and take from the parts behind them (no volume kind yet: the parts pass unchanged).
-SYLVA_HD SYLVA_INLINE VolumeView volumeViewOf(const RenderView& v)
+SYLVA_HD SYLVA_INLINE VolumeArrays volumeViewOf(const RenderView& v)
 {
-    return VolumeView{v.volumeGrids, v.volumeInstances, v.volumeDensity, v.volumeBricks, v.volumeLight, v.volumeTemperature,
+    return VolumeArrays{v.volumeGrids, v.volumeInstances, v.volumeDensity, v.volumeBricks, v.volumeLight, v.volumeTemperature,
                       v.volumeBlackbody, v.volumeCount};
 }
 
@@ -226,7 +226,7 @@ SYLVA_HD SYLVA_INLINE VolumeView volumeViewOf(const RenderView& v)
 SYLVA_HD inline void volumeStage(const RenderView& v, const Ray& ray, float tEnd, SampleParts& parts)
 {
     if (v.volumeCount == 0) return;
-    const VolumeView vv = volumeViewOf(v);
+    const VolumeArrays vv = volumeViewOf(v);
     uint32_t order[kMaxRayVolumes];
     float entry[kMaxRayVolumes];
     int n = 0;

@@ -62,7 +62,7 @@ struct VolumeInstanceRecord {
 };
 
 // What a volume view needs of RenderView (filled from it by volumeViewOf in shade.h).
-struct VolumeView {
+struct VolumeArrays {
     const VolumeGridRecord* grids;
     const VolumeInstanceRecord* instances;
     const float* density;
@@ -157,7 +157,7 @@ SYLVA_HD SYLVA_INLINE bool volumeClip(const glm::ivec3& dims, const glm::vec3& o
 // Walks the bricks that ray o + t d (grid coordinates) crosses in [t0, t1], nearest first (3D DDA),
 // calling f(brickMax, ta, tb) for each; f returns false to stop.
 template <class F>
-SYLVA_HD inline void walkBricks(const VolumeView& vv, const VolumeGridRecord& g, const glm::vec3& o, const glm::vec3& d, float t0, float t1,
+SYLVA_HD inline void walkBricks(const VolumeArrays& vv, const VolumeGridRecord& g, const glm::vec3& o, const glm::vec3& d, float t0, float t1,
                                 F&& f)
 {
     const float B = float(kVolumeBrick);
@@ -200,7 +200,7 @@ SYLVA_HD inline void walkBricks(const VolumeView& vv, const VolumeGridRecord& g,
 
 // Optical depth per channel of volume instance `in` along camera-relative ray org + t dir, t in [tmin, tmax]
 // (shadow-march step; bricks without medium skipped).
-SYLVA_HD inline glm::vec3 volumeOpticalDepth(const VolumeView& vv, const VolumeInstanceRecord& in, const glm::vec3& org, const glm::vec3& dir,
+SYLVA_HD inline glm::vec3 volumeOpticalDepth(const VolumeArrays& vv, const VolumeInstanceRecord& in, const glm::vec3& org, const glm::vec3& dir,
                                              float tmin, float tmax)
 {
     const VolumeGridRecord g = vv.grids[in.grid];
@@ -224,7 +224,7 @@ SYLVA_HD inline glm::vec3 volumeOpticalDepth(const VolumeView& vv, const VolumeI
 }
 
 // Transmittance of every volume along camera-relative ray org + t dir for t in [0, tmax] (shadow rays).
-SYLVA_HD inline glm::vec3 volumeTransmittance(const VolumeView& vv, const glm::vec3& org, const glm::vec3& dir, float tmax = 1e30f)
+SYLVA_HD inline glm::vec3 volumeTransmittance(const VolumeArrays& vv, const glm::vec3& org, const glm::vec3& dir, float tmax = 1e30f)
 {
     glm::vec3 tau(0.0f);
     for (uint32_t i = 0; i < vv.count; ++i) tau += volumeOpticalDepth(vv, vv.instances[i], org, dir, 0.0f, tmax);
@@ -232,7 +232,7 @@ SYLVA_HD inline glm::vec3 volumeTransmittance(const VolumeView& vv, const glm::v
 }
 
 // Linear RGB of a blackbody at `kelvin` from the table (luminance 1 at 6500 K); 0 below the table.
-SYLVA_HD SYLVA_INLINE glm::vec3 blackbodyRadiance(const VolumeView& vv, float kelvin)
+SYLVA_HD SYLVA_INLINE glm::vec3 blackbodyRadiance(const VolumeArrays& vv, float kelvin)
 {
     if (!(kelvin >= kVolumeBlackbodyLo)) return glm::vec3(0.0f);
     const float x = fminf((kelvin - kVolumeBlackbodyLo) / (kVolumeBlackbodyHi - kVolumeBlackbodyLo), 1.0f) * float(kVolumeBlackbodySize - 1);
@@ -255,7 +255,7 @@ struct VolumeSegment {
 // the exact exponential over the step (the source held constant: T (1 - e^-sigma_t dt) S / sigma_t).
 // sunDir: toward the sun (unit); sunRadiance: the renderer's sun (surfaces show albedo x it x cos, so its
 // irradiance is pi x it); indirectScale: the LB's weight, as on surfaces.
-SYLVA_HD inline VolumeSegment marchVolume(const VolumeView& vv, const VolumeInstanceRecord& in, const glm::vec3& org, const glm::vec3& dir,
+SYLVA_HD inline VolumeSegment marchVolume(const VolumeArrays& vv, const VolumeInstanceRecord& in, const glm::vec3& org, const glm::vec3& dir,
                                           float tmin, float tmax, const glm::vec3& sunDir, const glm::vec3& sunRadiance, float indirectScale)
 {
     VolumeSegment s{glm::vec3(1.0f), glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
