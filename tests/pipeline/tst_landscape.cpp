@@ -222,8 +222,10 @@ private Q_SLOTS:
         TileSetDesc d;
         d.size = 30.0;
         TilePlantDesc a, b;
-        a.species = 0, a.speciesName = "a", a.spacing = 3.0;
-        b.species = 1, b.speciesName = "b", b.spacing = 2.0;
+        a.species = 0, a.spacing = 3.0;
+        a.speciesName.push_back('a');   // not = "a": GCC 12 warns falsely (-Wrestrict) about that assignment
+        b.species = 1, b.spacing = 2.0;
+        b.speciesName.push_back('b');
         d.plants = {a, b};
         const std::vector<LandscapeSpecies> sp = {{0, glm::vec3(-1.0f, 0.0f, -1.0f), glm::vec3(1.0f, 4.0f, 1.0f), 100.0},
                                                   {1, glm::vec3(-0.5f, 0.0f, -0.6f), glm::vec3(0.5f, 2.0f, 0.4f), 50.0}};
