@@ -26,6 +26,7 @@
 #include "core/base/error.h"
 #include "core/base/version.h"
 #include "core/render/render_cpu.h"
+#include "pipeline/mpi/mpi_tiles.h"
 
 namespace sylva::mpi {
 namespace {
@@ -147,18 +148,13 @@ public:
         film.width = v.width;
         film.height = y1 - y0;
         film.pixels.resize(size_t(film.width) * size_t(film.height));
-        int edge = std::max(1, m_edge);
-        auto tilesAt = [&](int e) { return ((film.width + e - 1) / e) * ((film.height + e - 1) / e); };
-        while (edge > 8 && tilesAt(edge) < 4 * m_ranks) edge /= 2;
         {
             std::lock_guard<std::mutex> lock(m_mutex);
             m_film = &film;
             m_y0 = y0;
             m_base = m_next;
             m_tiles.clear();
-            for (int ty = y0; ty < y1; ty += edge)
-                for (int tx = 0; tx < film.width; tx += edge)
-                    m_tiles.push_back({m_next++, tx, ty, std::min(tx + edge, film.width), std::min(ty + edge, y1)});
+            for (const TileRect& t : frameTiles(film.width, y0, y1, m_ranks, m_edge)) m_tiles.push_back({m_next++, t.x0, t.y0, t.x1, t.y1});
             m_pending.assign(m_tiles.begin(), m_tiles.end());
             m_done = 0;
         }

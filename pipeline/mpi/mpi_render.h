@@ -3,8 +3,8 @@
 //
 // Every rank loads the scene and builds its frame (species assets through the shared grid cache).
 // Rank 0 runs the render exactly as the single-process path does, except that its tracing goes
-// through a FilmRowsTracer that cuts the rows into tiles (32 x 32, smaller when a frame has few per
-// rank) and hands them from a work queue to the ranks that ask; rank 0 traces tiles too between its
+// through a FilmRowsTracer that cuts the rows into tiles (mpi_tiles.h: 32 x 32, smaller when a frame
+// has few per rank, quarters at the end of the queue) and hands them from a work queue to the ranks that ask; rank 0 traces tiles too between its
 // messages. A tile is renderFilmRect, shadePixel per pixel, so the picture is bit-identical to a
 // single-process CPU render at any rank count. Rank 0 gathers, composes and writes with the
 // single-process writer.
