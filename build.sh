@@ -20,7 +20,7 @@ PACKAGES=(cmake ninja-build ccache g++ pkg-config
   qt6-qpa-plugins xvfb xauth libgl1-mesa-dri
   # sylva study draws the plots of docs/ACCURACY.md
   gnuplot-nox
-  # sylva render --mpi and its tests (docs/DISTRIBUTED.md)
+  # sylva render --mpi and its tests, see docs/DISTRIBUTED.md
   libopenmpi-dev openmpi-bin)
 
 install_missing() {

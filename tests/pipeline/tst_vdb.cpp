@@ -280,6 +280,7 @@ private Q_SLOTS:
                                 "cpu", "--no-cache", "--quiet", "-o", QString::fromStdString(lit)});
         QVERIFY2(r.code == 0, qPrintable(r.err));
         lb::LbParams p = lb::paramsFromPreset(*lb::findPreset("leaf"));
+        lb::useFrontDefaults(p);   // sylva light's default storage (fp16; --steps sets the count)
         p.sun = {0.0f, 1.0f, 0.0f};
         p.steps = 40;
         const LightingGrid want = lightingFor(d, p, nullptr);
