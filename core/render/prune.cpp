@@ -1,6 +1,8 @@
 // Stochastic pruning: leaf elements by shared vertices, a fixed shuffled order, area-preserving levels.
 #include "core/render/prune.h"
 
+#include "core/base/splitmix.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -17,13 +19,6 @@ uint32_t findRoot(std::vector<uint32_t>& parent, uint32_t a)
     return a;
 }
 
-uint64_t splitmix64(uint64_t& state)
-{
-    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
 
 // ceil(n / 2^level)
 size_t keptElements(size_t n, int level) { return (n + (size_t(1) << level) - 1) >> level; }
@@ -91,10 +86,10 @@ std::vector<uint32_t> pruneOrder(size_t n, uint64_t seed)
 {
     std::vector<uint32_t> order(n);
     std::iota(order.begin(), order.end(), 0u);
-    uint64_t state = seed;
+    SplitMix64 state{seed};
     for (size_t i = n; i > 1; --i) {
         // Unbiased enough for the purpose (bias < i / 2^64), and exactly reproducible.
-        const size_t j = size_t((unsigned __int128)splitmix64(state) * i >> 64);
+        const size_t j = size_t((unsigned __int128)state.next() * i >> 64);
         std::swap(order[i - 1], order[j]);
     }
     return order;

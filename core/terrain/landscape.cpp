@@ -11,22 +11,10 @@
 #include <tbb/parallel_for.h>
 
 #include "core/base/error.h"
+#include "core/base/splitmix.h"
 
 namespace sylva {
 namespace {
-
-// splitmix64 (as the scatter tool): the same sequence on every platform.
-struct SplitMix64 {
-    uint64_t state;
-    uint64_t next()
-    {
-        uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
-    double unit() { return double(next() >> 11) * 0x1.0p-53; }
-};
 
 uint64_t mix(uint64_t a, uint64_t b)
 {

@@ -5,24 +5,9 @@
 #include <string>
 
 #include "core/base/error.h"
+#include "core/base/splitmix.h"
 
 namespace sylva {
-namespace {
-
-// splitmix64 (Steele, Lea, Flood 2014): a fixed sequence on every platform.
-struct SplitMix64 {
-    uint64_t state;
-    uint64_t next()
-    {
-        uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
-    double unit() { return double(next() >> 11) * 0x1.0p-53; }   // [0, 1)
-};
-
-} // namespace
 
 std::vector<InstanceDesc> scatterInstances(const ScatterSpec& spec)
 {
