@@ -16,8 +16,6 @@
 #include "core/terrain/height_field.h"
 
 namespace sylva {
-namespace {
-
 glm::dmat3 rotationDeg(const glm::vec3& deg)
 {
     const glm::dvec3 r = glm::dvec3(deg) * (M_PI / 180.0);
@@ -29,6 +27,8 @@ glm::dmat3 rotationDeg(const glm::vec3& deg)
     const glm::dmat3 rz(cz, sz, 0, -sz, cz, 0, 0, 0, 1);
     return rz * ry * rx;
 }
+
+namespace {
 
 // The parent-frame box of an instance of a geometry whose own-frame bounds are `b`, from the instance's
 // description in double, grown by a relative epsilon so float rounding of the transform never clips geometry.

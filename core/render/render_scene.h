@@ -101,6 +101,9 @@ RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets
                              Progress* progress = nullptr);
 
 // Camera basis and image extents for a camera and image size (throws Error on a degenerate camera).
+// The rotation of an instance from its degrees about x, y, z: R = Rz Ry Rx (column-major glm).
+glm::dmat3 rotationDeg(const glm::vec3& deg);
+
 CameraRecord makeCamera(const CameraDesc& camera, int width, int height);
 
 // The instance's parent -> geometry map in the frame whose origin is `frameOrigin` (parent-frame metres).

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/base/error.h"
+#include "core/render/render_scene.h"
 #include "pipeline/io/atomic_file.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/render/render_job.h"
@@ -43,17 +44,6 @@ LeafOptics leafOptics(const lb::LbParams& params)
 glm::dvec3 toBlender(const glm::dvec3& p) { return {p.x, -p.z, p.y}; }
 
 namespace {
-
-glm::dmat3 rotationFromDeg(const glm::vec3& deg)   // R = Rz Ry Rx, as the renderer (render_scene.cpp)
-{
-    const glm::dvec3 r = glm::dvec3(deg) * (M_PI / 180.0);
-    const double cx = std::cos(r.x), sx = std::sin(r.x), cy = std::cos(r.y), sy = std::sin(r.y);
-    const double cz = std::cos(r.z), sz = std::sin(r.z);
-    const glm::dmat3 rx(1, 0, 0, 0, cx, sx, 0, -sx, cx);
-    const glm::dmat3 ry(cy, 0, -sy, 0, 1, 0, sy, 0, cy);
-    const glm::dmat3 rz(cz, sz, 0, -sz, cz, 0, 0, 0, 1);
-    return rz * ry * rx;
-}
 
 // Row-major 4x4 from Blender-frame columns (x, y, z axes) and origin.
 std::array<double, 16> fromColumns(const glm::dvec3& x, const glm::dvec3& y, const glm::dvec3& z, const glm::dvec3& o)
@@ -135,7 +125,7 @@ std::array<double, 16> blenderCameraMatrix(const CameraDesc& c)
 
 std::array<double, 16> blenderInstanceMatrix(const InstanceDesc& d)
 {
-    const glm::dmat3 r = rotationFromDeg(d.rotationDeg) * double(d.scale);
+    const glm::dmat3 r = rotationDeg(d.rotationDeg) * double(d.scale);
     return fromColumns(toBlender(r[0]), toBlender(r[1]), toBlender(r[2]), toBlender(d.position));
 }
 
