@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/terrain/height_field.h"
+
 namespace sylva {
 namespace {
 
@@ -85,6 +87,17 @@ CameraDesc flyMove(const CameraDesc& camera, double right, double up, double for
     c.position += move;
     c.target += move;
     return c;
+}
+
+double flyStepFor(const Scene& scene)
+{
+    const TerrainDesc& t = scene.terrain;
+    if (t.enabled() && t.field) {
+        const HeightFieldLayout& L = t.field->layout;
+        const double side = std::max(double(L.nx - 1) * double(L.dx), double(L.nz - 1) * double(L.dz));
+        return std::max(0.05, 0.005 * side);
+    }
+    return std::max(0.05, 0.05 * glm::length(scene.camera.target - scene.camera.position));
 }
 
 void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg)

@@ -27,6 +27,11 @@ CameraDesc flyLook(const CameraDesc& camera, double yawDeg, double pitchDeg);
 // (horizontal), `up` metres along world +Y and `forward` metres along the view direction.
 CameraDesc flyMove(const CameraDesc& camera, double right, double up, double forward);
 
+// Metres a fly key press moves in `scene`: over a terrain 0.5% of its longer side (100 m over a 20 km DEM,
+// so crossing it takes a couple of hundred presses, or a fifth with Shift's 5x), else 5% of the eye-target
+// distance; at least 5 cm.
+double flyStepFor(const Scene& scene);
+
 // A camera that shows world box b whole, from the front-left and a little above (current's field of
 // view; up is world +Y): what the studio frames the first instances of a scene with.
 CameraDesc framingCamera(const CameraDesc& current, const Bounds3& b);

@@ -55,8 +55,11 @@ void LightingScheduler::updateViewport()
     const Scene& s = m_doc->scene();
     const bool lit = viewNeedsLighting();
     std::vector<AssetsPtr> assets = m_assets->forScene(s, lit);
-    if (s.instances.empty() || !assets.empty()) {
-        m_viewport->setScene(s, std::move(assets));
+    const bool content = !s.instances.empty() || s.terrain.enabled();   // a landscape may have no instances
+    Scene shown;
+    const bool volumesReady = m_volumes.litScene(s, lit, &shown);   // the volumes with their lighting
+    if (!content || (!assets.empty() && volumesReady)) {
+        m_viewport->setScene(volumesReady ? shown : s, std::move(assets));
         return;
     }
     m_viewport->setScene(s, {});
@@ -76,6 +79,7 @@ Job* LightingScheduler::computeLighting(bool reload)
     const bool lit = viewNeedsLighting();
     std::vector<std::string> target;
     for (const SpeciesDesc& sp : scene.species) target.push_back(assetKey(sp, scene.sun, lit));
+    for (const VolumeDesc& v : scene.volumes) target.push_back(VolumeLightStore::key(scene, v, lit));
     if (m_job) {
         // One lighting job at a time. One that already makes what the scene needs (the camera or an
         // instance moved meanwhile) runs on; otherwise stop it and run again for the scene as it is now.
@@ -99,22 +103,32 @@ Job* LightingScheduler::computeLighting(bool reload)
         }
         if (m_assets->size() > 4 * keep.size() + 8) m_assets->retainOnly(keep);
     }
-    if (m_assets->missingSpecies(scene, lit).empty()) {
+    if (m_assets->missingSpecies(scene, lit).empty() && m_volumes.missing(scene, lit).empty()) {
         updateViewport();
         Q_EMIT settled();
         return nullptr;
     }
     GridCache* cache = m_cache;
     AssetStore* store = m_assets;
+    VolumeLightStore* volumes = &m_volumes;
     Backend* backend = m_backend;
     log(lit ? tr("lighting %n species", nullptr, int(m_assets->missingSpecies(scene, lit).size()))
             : tr("loading %n species", nullptr, int(m_assets->missingSpecies(scene, lit).size())));
     m_target = target;
     m_job = m_jobs->start(lit ? tr("Lighting") : tr("Loading"),
-                          [scene, lit, store, cache, backend](Job& job, Progress& progress) {
-                              ensureAssets(
-                                  scene, lit, *store, cache, &progress,
-                                  [&job](const std::string& line) { job.log(QString::fromStdString(line)); }, backend);
+                          [scene, lit, store, volumes, cache, backend](Job& job, Progress& progress) {
+                              const auto log = [&job](const std::string& line) { job.log(QString::fromStdString(line)); };
+                              const bool anyVolume = !volumes->missing(scene, lit).empty();
+                              SubProgress speciesPart(&progress, 0.0, anyVolume ? 0.8 : 1.0);
+                              Progress sp([&](double f, const std::string& msg) { speciesPart.report(f, msg); });
+                              if (progress.isCancelled()) sp.cancel();
+                              ensureAssets(scene, lit, *store, cache, &sp, log, backend);
+                              if (!anyVolume) return;
+                              // The volumes' LB lighting (lightSceneVolumes), through the same cache.
+                              SubProgress volumePart(&progress, 0.8, 1.0);
+                              Progress vp([&](double f, const std::string& msg) { volumePart.report(f, msg); });
+                              if (progress.isCancelled()) vp.cancel();
+                              volumes->ensure(scene, lit, cache, &vp, log, backend);
                           },
                           [this](Job* job) {
                               m_job = nullptr;

@@ -10,6 +10,7 @@
 #include <QTimer>
 
 #include "studio/studio_controller.h"
+#include "studio/volume_lighting.h"
 
 namespace sylva {
 
@@ -48,6 +49,8 @@ public:
     bool isPending() const { return m_job || m_timer.isActive(); }
     // Cancels the running lighting job (New: the old scene's grids are not needed).
     void cancel();
+    // The volumes' lit data the lighting jobs made (the viewport's scene carries it).
+    VolumeLightStore* volumeLights() { return &m_volumes; }
 
 Q_SIGNALS:
     void autoLightingChanged(bool on);
@@ -66,7 +69,8 @@ private:
     bool m_autoLighting = true;
     QTimer m_timer;
     QPointer<Job> m_job;
-    std::vector<std::string> m_target;   // asset keys the running lighting job produces
+    std::vector<std::string> m_target;   // asset keys (then volume keys) the running lighting job produces
+    VolumeLightStore m_volumes;
     bool m_again = false;
 };
 

@@ -3,6 +3,8 @@
 
 #include <QFileInfo>
 
+#include "core/terrain/height_field.h"
+
 namespace sylva {
 namespace {
 
@@ -11,23 +13,30 @@ QString vec3Text(double x, double y, double z)
     return QStringLiteral("(%1, %2, %3)").arg(x, 0, 'g', 4).arg(y, 0, 'g', 4).arg(z, 0, 'g', 4);
 }
 
+// Rows under Terrain: Tiles, Tiling, Density for a landscape (a terrain with cells), none otherwise.
+int terrainRows(const Scene& s) { return s.terrain.enabled() && s.terrain.cells > 0 ? 3 : 0; }
+
 } // namespace
 
 OutlinerModel::OutlinerModel(SceneDocument* doc, QObject* parent) : QAbstractItemModel(parent), m_doc(doc)
 {
     m_species = int(doc->scene().species.size());
     m_instances = int(doc->scene().instances.size());
+    m_terrainRows = terrainRows(doc->scene());
+    m_volumes = int(doc->scene().volumes.size());
     connect(doc, &SceneDocument::changed, this, &OutlinerModel::onChanged);
 }
 
 void OutlinerModel::onChanged(ScenePart)
 {
     const Scene& s = m_doc->scene();
-    const int ns = int(s.species.size()), ni = int(s.instances.size());
-    if (ns != m_species || ni != m_instances) {
+    const int ns = int(s.species.size()), ni = int(s.instances.size()), nt = terrainRows(s), nv = int(s.volumes.size());
+    if (ns != m_species || ni != m_instances || nt != m_terrainRows || nv != m_volumes) {
         beginResetModel();
         m_species = ns;
         m_instances = ni;
+        m_terrainRows = nt;
+        m_volumes = nv;
         endResetModel();
         return;
     }
@@ -59,6 +68,8 @@ int OutlinerModel::rowCount(const QModelIndex& parent) const
     if (parent.column() != 0 || parent.internalId() != 0) return 0;
     if (parent.row() == SpeciesGroup) return m_species;
     if (parent.row() == InstancesGroup) return m_instances;
+    if (parent.row() == TerrainGroup) return m_terrainRows;
+    if (parent.row() == VolumesGroup) return m_volumes;
     return 0;
 }
 
@@ -86,12 +97,19 @@ OutlinerItem OutlinerModel::itemAt(const QModelIndex& index) const
         case GroundGroup: return {OutlinerItem::Kind::Ground, -1};
         case SunGroup: return {OutlinerItem::Kind::Sun, -1};
         case CameraGroup: return {OutlinerItem::Kind::Camera, -1};
+        case TerrainGroup: return {OutlinerItem::Kind::Terrain, -1};
+        case VolumesGroup: return {OutlinerItem::Kind::VolumesGroup, -1};
         default: return {};
         }
     }
     const int group = int(index.internalId()) - 1;
     if (group == SpeciesGroup) return {OutlinerItem::Kind::Species, index.row()};
     if (group == InstancesGroup) return {OutlinerItem::Kind::Instance, index.row()};
+    if (group == TerrainGroup) {
+        constexpr OutlinerItem::Kind kRows[3] = {OutlinerItem::Kind::Tiles, OutlinerItem::Kind::Tiling, OutlinerItem::Kind::Density};
+        return index.row() < 3 ? OutlinerItem{kRows[index.row()], -1} : OutlinerItem{};
+    }
+    if (group == VolumesGroup) return {OutlinerItem::Kind::Volume, index.row()};
     return {};
 }
 
@@ -106,6 +124,12 @@ QModelIndex OutlinerModel::indexOf(const OutlinerItem& item, int column) const
     case K::Camera: return index(CameraGroup, column);
     case K::Species: return index(item.row, column, index(SpeciesGroup, 0));
     case K::Instance: return index(item.row, column, index(InstancesGroup, 0));
+    case K::Terrain: return index(TerrainGroup, column);
+    case K::Tiles: return index(0, column, index(TerrainGroup, 0));
+    case K::Tiling: return index(1, column, index(TerrainGroup, 0));
+    case K::Density: return index(2, column, index(TerrainGroup, 0));
+    case K::VolumesGroup: return index(VolumesGroup, column);
+    case K::Volume: return index(item.row, column, index(VolumesGroup, 0));
     case K::None: break;
     }
     return {};
@@ -146,6 +170,48 @@ QVariant OutlinerModel::data(const QModelIndex& index, int role) const
             return tr("%1 #%2").arg(sp).arg(it.row + 1);
         }
         return vec3Text(in.position.x, in.position.y, in.position.z);
+    }
+    case K::Terrain: {
+        if (name) return tr("Terrain");
+        const TerrainDesc& t = s.terrain;
+        if (!t.enabled()) return tr("none");
+        QString text = QFileInfo(QString::fromStdString(t.dem)).fileName();
+        if (t.field)
+            text += tr(", %1 x %2 samples, %3 m apart")
+                        .arg(t.field->layout.nx)
+                        .arg(t.field->layout.nz)
+                        .arg(t.spacing);
+        if (t.cells > 0) text += tr(", %1 cells a side").arg(t.cells);
+        return text;
+    }
+    case K::Tiles: {
+        if (name) return tr("Tiles");
+        const TileSetDesc& ts = s.terrain.tiles;
+        return tr("%1 m square, %n plant kind(s), seed %2", nullptr, int(ts.plants.size())).arg(ts.size).arg(ts.seed);
+    }
+    case K::Tiling: {
+        if (name) return tr("Tiling");
+        const TilingDesc& tl = s.terrain.tiling;
+        const int tiles = tl.setGiven ? int(tl.set.size()) : tl.horizontal * tl.horizontal * tl.vertical * tl.vertical;
+        return tr("Wang, %1 x %2 edge colours, %3 tiles, seed %4").arg(tl.horizontal).arg(tl.vertical).arg(tiles).arg(tl.seed);
+    }
+    case K::Density: {
+        if (name) return tr("Density");
+        const DensityDesc& d = s.terrain.density;
+        if (!d.enabled) return tr("off: every plant grows");
+        return tr("%1 at %2 m to %3 at %4 m").arg(double(d.atLower)).arg(d.lower).arg(double(d.atUpper)).arg(d.upper);
+    }
+    case K::VolumesGroup: return name ? tr("Volumes") : tr("%n volume(s)", nullptr, m_volumes);
+    case K::Volume: {
+        if (it.row >= int(s.volumes.size())) return {};
+        const VolumeDesc& v = s.volumes[size_t(it.row)];
+        if (name) return QString::fromStdString(v.name);
+        QString text = tr("%1, %2").arg(QFileInfo(QString::fromStdString(v.grid)).fileName(), QString::fromStdString(v.preset));
+        if (v.data) {
+            const glm::ivec3 d = v.data->density.geometry.dims;
+            text += tr(", %1 x %2 x %3 nodes").arg(d.x).arg(d.y).arg(d.z);
+        }
+        return text;
     }
     case K::None: break;
     }

@@ -1,5 +1,5 @@
 // The scene outliner: a two-level tree model over the document (groups: Species, Instances, Ground,
-// Sun, Camera; rows under Species and Instances), columns Name and Details.
+// Sun, Camera, Terrain, Volumes; rows under Species, Instances, Terrain and Volumes), columns Name and Details.
 #pragma once
 
 #include <QAbstractItemModel>
@@ -10,9 +10,10 @@ namespace sylva {
 
 // What an outliner row stands for.
 struct OutlinerItem {
-    enum class Kind { None, SpeciesGroup, InstancesGroup, Ground, Sun, Camera, Species, Instance };
+    enum class Kind { None, SpeciesGroup, InstancesGroup, Ground, Sun, Camera, Species, Instance,
+                      Terrain, Tiles, Tiling, Density, VolumesGroup, Volume };
     Kind kind = Kind::None;
-    int row = -1;   // index into Scene::species / Scene::instances for Species / Instance
+    int row = -1;   // index into Scene::species / Scene::instances / Scene::volumes for Species / Instance / Volume
     bool operator==(const OutlinerItem&) const = default;
 };
 
@@ -20,7 +21,9 @@ class OutlinerModel : public QAbstractItemModel {
     Q_OBJECT
 
 public:
-    enum Group { SpeciesGroup, InstancesGroup, GroundGroup, SunGroup, CameraGroup, GroupCount };
+    // Terrain: rows Tiles, Tiling, Density under it when the scene has a landscape (terrain cells); Volumes:
+    // one row per volume.
+    enum Group { SpeciesGroup, InstancesGroup, GroundGroup, SunGroup, CameraGroup, TerrainGroup, VolumesGroup, GroupCount };
 
     explicit OutlinerModel(SceneDocument* doc, QObject* parent = nullptr);
 
@@ -40,6 +43,7 @@ private:
 
     SceneDocument* m_doc;
     int m_species = 0, m_instances = 0;   // row counts the views know about
+    int m_terrainRows = 0, m_volumes = 0;
 };
 
 } // namespace sylva

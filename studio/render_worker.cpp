@@ -133,7 +133,8 @@ void RenderWorker::run()
 void RenderWorker::process(const Request& req, Progress& progress)
 {
     const Scene& scene = req.scene;
-    if (scene.instances.empty() || req.assets.size() != scene.species.size()) throw Error("the scene has no instances");
+    if ((scene.instances.empty() && !scene.terrain.enabled()) || req.assets.size() != scene.species.size())
+        throw Error("the scene has no instances and no terrain");
     const int w = std::max(1, req.size.width()), h = std::max(1, req.size.height());
     std::vector<RenderPass> passes;
     {
@@ -149,7 +150,9 @@ void RenderWorker::process(const Request& req, Progress& progress)
         if (m_gpuForget.exchange(false)) m_gpuAssets.clear();
         // The viewport has this frame and traces it itself (a frame built while the scene pruned has every
         // level of detail; one built without pruning is built again when pruning is turned on).
-        if (m_gpuAssets == req.assets && (!(scene.render.pruneDistance > 0.0f) || m_gpuPruned)) return;
+        if (m_gpuAssets == req.assets && !viewFrameUpdate(m_gpuScene, scene).any() &&
+            (!(scene.render.pruneDistance > 0.0f) || m_gpuPruned))
+            return;
         try {
             std::vector<SpeciesAssets> copies;
             copies.reserve(req.assets.size());
@@ -157,11 +160,14 @@ void RenderWorker::process(const Request& req, Progress& progress)
             const glm::vec3 sun = sunRadiance(scene.sun);
             auto g = std::make_shared<GpuFrame>();
             g->frame = buildViewFrame(scene, copies, sun);
+            ++m_frameBuilds;
             if (interrupted()) throw Cancelled();
             placeViewFrame(g->frame, scene, sun, w, h, 1);
             g->device = uploadDeviceFrame(g->frame.rs);
             g->assets = req.assets;
+            g->built = scene;
             m_gpuAssets = req.assets;
+            m_gpuScene = scene;
             m_gpuPruned = scene.render.pruneDistance > 0.0f;
             Q_EMIT gpuFrameReady(g);
             return;
@@ -185,13 +191,28 @@ void RenderWorker::process(const Request& req, Progress& progress)
         }
     }
 
-    if (!m_frame || m_frameAssets != req.assets || !viewFrameFits(*m_frame, scene)) {
+    // The species' structures are kept while the assets stay; an edit of the landscape or the volumes
+    // updates only its part (viewFrameUpdate), anything else the build reads builds the frame again.
+    const ViewFrameUpdate update = m_frame ? viewFrameUpdate(m_frameScene, scene) : ViewFrameUpdate{};
+    if (!m_frame || m_frameAssets != req.assets || !viewFrameFits(*m_frame, scene) || update.rebuild) {
         m_frame.reset();
         std::vector<SpeciesAssets> copies;
         copies.reserve(req.assets.size());
         for (const AssetsPtr& a : req.assets) copies.push_back(*a);
         m_frame = buildViewFrame(scene, copies, sunRadiance(scene.sun));
         m_frameAssets = req.assets;
+        m_frameScene = scene;
+        ++m_frameBuilds;
+        if (interrupted()) throw Cancelled();
+    } else if (update.any()) {
+        try {
+            updateViewFrame(*m_frame, scene, update);
+        } catch (...) {
+            m_frame.reset();   // half updated: build it whole next time
+            throw;
+        }
+        m_frameScene = scene;
+        ++m_frameUpdates;
         if (interrupted()) throw Cancelled();
     }
     const glm::vec3 sun = sunRadiance(scene.sun);

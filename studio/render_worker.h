@@ -52,6 +52,7 @@ struct GpuFrame {
     ViewFrame frame;
     std::unique_ptr<DeviceFrame> device;
     std::vector<AssetsPtr> assets;   // what it was built from
+    Scene built;                     // ... and for which scene (viewFrameUpdate says when it is stale)
 };
 using GpuFramePtr = std::shared_ptr<GpuFrame>;
 
@@ -84,6 +85,12 @@ public:
     // Switching (either way) forgets the last GPU frame.
     void setGpuMode(bool on);
     bool gpuMode() const { return m_gpu.load(); }
+
+    // How often the frame's camera-independent part was built whole (buildViewFrame), and how often an
+    // edit was taken in by updating it in place (viewFrameUpdate: a landscape density, tile or tiling edit,
+    // a volume edit) instead: what the studio's tests read to see that an edit rebuilt only its part.
+    int frameBuilds() const { return m_frameBuilds.load(); }
+    int frameUpdates() const { return m_frameUpdates.load(); }
 
 Q_SIGNALS:
     // pass: index into the schedule; last: the schedule is done; seconds: since the request.
@@ -119,11 +126,14 @@ private:
     // Worker-thread state.
     std::optional<ViewFrame> m_frame;
     std::vector<AssetsPtr> m_frameAssets;
+    Scene m_frameScene;                   // the scene m_frame's camera-independent part holds
+    std::atomic<int> m_frameBuilds{0}, m_frameUpdates{0};
     std::optional<Scene> m_lastScene;     // what m_lastFilm shows
     QSize m_lastSize;
     Film m_lastFilm;
     int m_lastPass = -1;
     std::vector<AssetsPtr> m_gpuAssets;   // what the last GPU frame was built from
+    Scene m_gpuScene;                     // ... and for which scene
     bool m_gpuPruned = false;             // ... and whether with every level of detail (the scene pruned)
 };
 

@@ -6,6 +6,7 @@
 #include <QFileInfo>
 
 #include "core/base/error.h"
+#include "pipeline/render/view_frame.h"
 #include "pipeline/scene/scene_file.h"
 
 namespace sylva {
@@ -22,6 +23,12 @@ bool sameSpecies(const std::vector<SpeciesDesc>& a, const std::vector<SpeciesDes
     for (size_t i = 0; i < a.size(); ++i)
         if (a[i].name != b[i].name || speciesFingerprint(a[i]) != speciesFingerprint(b[i])) return false;
     return true;
+}
+
+bool sameTerrain(const TerrainDesc& a, const TerrainDesc& b)
+{
+    return sameTerrainHeights(a, b) && sameLandscapeTiles(a, b) && sameLandscapeDensity(a, b) && a.rock == b.rock && a.snow == b.snow &&
+           a.rockSlope == b.rockSlope && a.snowLine == b.snowLine;
 }
 
 } // namespace
@@ -50,6 +57,8 @@ ScenePart changedParts(const Scene& a, const Scene& b)
     if (a.sun.direction != b.sun.direction || a.sun.temperature != b.sun.temperature || a.sun.intensity != b.sun.intensity)
         p = p | ScenePart::Sun;
     if (a.sky != b.sky) p = p | ScenePart::Sky;
+    if (!sameTerrain(a.terrain, b.terrain)) p = p | ScenePart::Terrain;
+    if (!sameVolumes(a.volumes, b.volumes)) p = p | ScenePart::Volumes;
     const CameraDesc &ca = a.camera, &cb = b.camera;
     if (ca.position != cb.position || ca.target != cb.target || ca.up != cb.up || ca.fovY != cb.fovY) p = p | ScenePart::Camera;
     const RenderSettings &ra = a.render, &rb = b.render;
@@ -115,8 +124,8 @@ void SceneDocument::open(const QString& path)
 
 void SceneDocument::saveAs(const QString& path)
 {
-    if (m_scene.species.empty() || m_scene.instances.empty())
-        throw Error(path.toStdString() + ": a scene file needs at least one species and one instance");
+    if (m_scene.species.empty() || (m_scene.instances.empty() && !m_scene.terrain.enabled()))
+        throw Error(path.toStdString() + ": a scene file needs at least one species and one instance (or a terrain)");
     writeSceneFile(m_scene, path.toStdString());
     const QString abs = QFileInfo(path).absoluteFilePath();
     if (m_filePath != abs) {

@@ -20,7 +20,9 @@ enum class ScenePart : unsigned {
     Sky = 1u << 4,
     Camera = 1u << 5,
     Render = 1u << 6,      // render settings (mode, size, spp, exposure)
-    All = 0x7fu,
+    Terrain = 1u << 7,     // the terrain: DEM, its colours, cells, tiles, tiling, density
+    Volumes = 1u << 8,     // the volume list or a volume's grid, optics or placements
+    All = 0x1ffu,
 };
 inline ScenePart operator|(ScenePart a, ScenePart b) { return ScenePart(unsigned(a) | unsigned(b)); }
 inline bool hasPart(ScenePart set, ScenePart part) { return (unsigned(set) & unsigned(part)) != 0; }

@@ -98,9 +98,10 @@ void Viewport::setStatus(const QString& status)
 
 void Viewport::requestRender()
 {
-    if (m_assets.empty() || m_assets.size() != m_scene.species.size() || m_scene.instances.empty()) {
+    const bool content = !m_scene.instances.empty() || m_scene.terrain.enabled();   // a landscape may have no instances
+    if (m_assets.empty() || m_assets.size() != m_scene.species.size() || !content) {
         m_worker->clear();
-        if (m_scene.instances.empty()) setStatus(tr("Empty scene: import a mesh or grow a species"));
+        if (!content) setStatus(tr("Empty scene: import a mesh or grow a species"));
         return;
     }
     setStatus(QString());
@@ -109,7 +110,8 @@ void Viewport::requestRender()
     if (m_interop) {
         // The device traces in paintGL; the worker only builds and uploads frames for new assets.
         m_gpuPass = 0;
-        if (!m_gpuFrame || m_gpuFrame->assets != m_assets || !viewFrameFits(m_gpuFrame->frame, m_scene))
+        if (!m_gpuFrame || m_gpuFrame->assets != m_assets || !viewFrameFits(m_gpuFrame->frame, m_scene) ||
+            viewFrameUpdate(m_gpuFrame->built, m_scene).any())
             m_worker->request(m_scene, m_assets, renderSize(), m_compare);
         update();
         return;
@@ -283,7 +285,8 @@ void Viewport::drawTexture()
 // on the GPU. Passes after the first follow while nothing changes.
 bool Viewport::paintGpu()
 {
-    if (!m_gpuFrame || m_gpuFrame->assets != m_assets || m_scene.instances.empty()) return false;
+    if (!m_gpuFrame || m_gpuFrame->assets != m_assets || (m_scene.instances.empty() && !m_scene.terrain.enabled())) return false;
+    if (viewFrameUpdate(m_gpuFrame->built, m_scene).any()) return false;   // a landscape or volume edit: the worker builds it
     if (!viewFrameFits(m_gpuFrame->frame, m_scene)) return false;   // pruning turned on: the worker builds the levels
     std::vector<int> spps;
     for (const RenderPass& p : m_worker->passes())
@@ -407,7 +410,7 @@ void Viewport::setCompare(std::optional<RenderMode> mode)
     requestRender();
 }
 
-double Viewport::flyStep() const { return std::max(0.05, 0.05 * glm::length(m_scene.camera.target - m_scene.camera.position)); }
+double Viewport::flyStep() const { return flyStepFor(m_scene); }
 
 void Viewport::keyPressEvent(QKeyEvent* event)
 {

@@ -61,7 +61,7 @@ public:
     // press flyStep() metres (Shift: 5x); left drag looks around the eye. Off: left drag orbits.
     bool flyMode() const { return m_fly; }
     void setFlyMode(bool on);
-    // Metres per key press: 5% of the eye-target distance, at least 5 cm.
+    // Metres per key press (flyStepFor): over a terrain 0.5% of its size, else 5% of the eye-target distance.
     double flyStep() const;
 
 Q_SIGNALS:

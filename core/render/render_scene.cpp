@@ -590,9 +590,28 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
     rs.m_stats.groups = scene.groups.size();
     rs.m_stats.groupInstances = rs.groupInstances.size();
 
+    buildLandscapeArrays(rs, scene);
+    buildVolumeGrids(rs, scene);   // volumes (core/render/render_volumes.h)
+    countBytes(rs);
+    return rs;
+}
+
+void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
+{
+    rs.landNodes.clear();
+    rs.landCells.clear();
+    rs.tileRecords.clear();
+    rs.tileNodes.clear();
+    rs.tilePlants.clear();
+    rs.base.land = LandscapeLayout{};
+    rs.m_stats.landscape = LandscapeStats{};
     // The landscape (seed 002): Wang tiles of the species' full meshes on the terrain's cells.
     if (scene.terrain.enabled() && scene.terrain.cells > 0) {
         const TerrainDesc& t = scene.terrain;
+        if (!t.field) throw Error("render: the terrain's heights were not loaded (" + t.dem + ")");
+        const size_t ns = scene.species.size();
+        if (rs.geometryBounds.size() < ns || rs.geometryTriangles.size() < ns)
+            throw Error("render: the scene's species differ from the ones the frame was built with");
         std::vector<LandscapeSpecies> ls(ns);
         for (size_t s = 0; s < ns; ++s) ls[s] = LandscapeSpecies{uint32_t(s), rs.geometryBounds[s].lo, rs.geometryBounds[s].hi, rs.geometryTriangles[s]};
         LandscapeBuild lb = buildLandscape(*t.field, uint32_t(t.cells), t.tiles, t.tiling, t.density, t.origin.y, 0.0f, 0.0f, ls);
@@ -604,9 +623,19 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
         rs.base.land = lb.layout;
         rs.m_stats.landscape = lb.stats;
     }
-    buildVolumeGrids(rs, scene);   // volumes (core/render/render_volumes.h)
     countBytes(rs);
-    return rs;
+}
+
+void setLandscapeDensity(RenderScene& rs, const Scene& scene)
+{
+    if (rs.landCells.empty()) return;
+    setLandscapeDensity(rs.base.land, scene.terrain.density, scene.terrain.origin.y);
+}
+
+void rebuildVolumeGrids(RenderScene& rs, const Scene& scene)
+{
+    buildVolumeGrids(rs, scene);
+    countBytes(rs);
 }
 
 bool hasLevelsFor(const RenderScene& rs, const Scene& sceneIn)

@@ -92,6 +92,16 @@ RenderScene buildSceneGeometry(const Scene& scene, const std::vector<SpeciesAsse
 // see hasLevelsFor).
 void placeTopLevel(RenderScene& rs, const Scene& scene, const glm::vec3& sunRadiance, int width, int height, int spp);
 
+// Parts of step 1 again, for a scene that differs from the one `rs` was built from only there (the studio's
+// viewport keeps the species' structures across such edits; the same species list is assumed):
+// buildLandscapeArrays: the landscape's tiling, tile populations and trees, cells and kd-tree (a tile, tiling
+// or cell edit); setLandscapeDensity: only the density rule's layout fields (core/terrain/landscape.h:
+// nothing is built, the rule thins plants while tracing); rebuildVolumeGrids: the volumes' arrays
+// (buildVolumeGrids). Each throws Error as buildSceneGeometry does for its part.
+void buildLandscapeArrays(RenderScene& rs, const Scene& scene);
+void setLandscapeDensity(RenderScene& rs, const Scene& scene);
+void rebuildVolumeGrids(RenderScene& rs, const Scene& scene);
+
 // Whether `rs` holds every level of detail placeTopLevel needs for `scene` (a LodLevels::All build always
 // does; a LodLevels::Used build for the camera it was built with).
 bool hasLevelsFor(const RenderScene& rs, const Scene& scene);

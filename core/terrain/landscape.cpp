@@ -291,6 +291,21 @@ TilePopulation populateTiles(const TileSetDesc& d, const std::vector<WangTile>& 
     return pop;
 }
 
+void setLandscapeDensity(LandscapeLayout& L, const DensityDesc& density, double terrainY)
+{
+    if (density.enabled && (density.m < 2 || density.a < 1))
+        throw Error("terrain.density: a must be >= 1 and m >= 2");
+    L.densityOn = density.enabled ? 1u : 0u;
+    L.dLower = density.atLower;
+    L.dUpper = density.atUpper;
+    L.hLower = float(density.lower - terrainY);
+    L.hUpper = float(density.upper - terrainY);
+    L.a = uint32_t(density.a);
+    L.m = uint32_t(density.m);
+    L.noSnow = density.enabled && density.noSnow ? 1u : 0u;
+    L.noRock = density.enabled && density.noRock ? 1u : 0u;
+}
+
 LandscapeBuild buildLandscape(const HeightField& field, uint32_t cells, const TileSetDesc& tiles, const TilingDesc& tiling,
                               const DensityDesc& density, double terrainY, float snowY, float rockCos,
                               const std::vector<LandscapeSpecies>& species)
@@ -311,15 +326,7 @@ LandscapeBuild buildLandscape(const HeightField& field, uint32_t cells, const Ti
     L.cellsZ = uint32_t(std::max(1.0, std::ceil(wz / C - 1e-9)));
     L.tileScale = float(C / tiles.size);
     L.invTileScale = float(tiles.size / C);
-    L.densityOn = density.enabled ? 1u : 0u;
-    L.dLower = density.atLower;
-    L.dUpper = density.atUpper;
-    L.hLower = float(density.lower - terrainY);
-    L.hUpper = float(density.upper - terrainY);
-    L.a = uint32_t(density.a);
-    L.m = uint32_t(density.m);
-    L.noSnow = density.enabled && density.noSnow ? 1u : 0u;
-    L.noRock = density.enabled && density.noRock ? 1u : 0u;
+    setLandscapeDensity(L, density, terrainY);
     (void)snowY;
     (void)rockCos;
 

@@ -166,6 +166,12 @@ struct TilePopulation {
 };
 TilePopulation populateTiles(const TileSetDesc& d, const std::vector<WangTile>& set, const std::vector<LandscapeSpecies>& species);
 
+// The density rule's part of the layout (eq. 2, 3 and the snow/rock masks) from `density`, `terrainY` the
+// terrain origin's world y. Only thins plants during traversal: the cells' bounds and trees do not depend on
+// it, so a density edit changes these fields alone (the studio's viewport re-renders without a build).
+// Throws Error when a < 1 or m < 2 with the rule on.
+void setLandscapeDensity(LandscapeLayout& layout, const DensityDesc& density, double terrainY);
+
 // Everything: tiling, populations, tile trees, cells' ground ranges and the cell kd-tree. `cells` per side of
 // the terrain's longer extent (cellsX x cellsZ cover the footprint); snowY / rockCos as the terrain's colour
 // rule (RenderView::terrainSnowY, terrainRockCos), `terrainY` the terrain origin's world y. Throws Error on

@@ -28,4 +28,24 @@ bool viewFrameFits(const ViewFrame& frame, const Scene& scene);
 // frame that does not fit (viewFrameFits).
 void placeViewFrame(ViewFrame& frame, const Scene& scene, const glm::vec3& sunRadiance, int width, int height, int spp);
 
+// Parts of two scenes that the frame's camera-independent build reads (what placeViewFrame does not redo).
+bool sameTerrainHeights(const TerrainDesc& a, const TerrainDesc& b);      // DEM, its heights, origin, spacing, scale
+bool sameLandscapeTiles(const TerrainDesc& a, const TerrainDesc& b);      // cells, tile set and populations, tiling
+bool sameLandscapeDensity(const TerrainDesc& a, const TerrainDesc& b);    // the density rule (eq. 2, 3, masks)
+bool sameVolumes(const std::vector<VolumeDesc>& a, const std::vector<VolumeDesc>& b);   // grids, optics, placements
+
+// What a frame built for `built` needs to show `next` (same species assets), cheapest first: nothing
+// (placeViewFrame re-places the top level: camera, instances, sun, colours), the density rule's fields,
+// the landscape's arrays, the volumes' arrays, or a whole build (terrain heights, groups, sky lights or
+// acceleration kind changed). Pruning is viewFrameFits' question.
+struct ViewFrameUpdate {
+    bool density = false, landscape = false, volumes = false, rebuild = false;
+    bool any() const { return density || landscape || volumes || rebuild; }
+};
+ViewFrameUpdate viewFrameUpdate(const Scene& built, const Scene& next);
+
+// Applies an update short of a rebuild to `frame` for `next` (setLandscapeDensity, buildLandscapeArrays,
+// rebuildVolumeGrids); placeViewFrame follows. Throws Error as those do.
+void updateViewFrame(ViewFrame& frame, const Scene& next, const ViewFrameUpdate& update);
+
 } // namespace sylva
