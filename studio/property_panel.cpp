@@ -20,6 +20,7 @@
 
 #include "core/lb/lb_params.h"
 #include "studio/camera_nav.h"
+#include "studio/scene_item_pages.h"
 
 namespace sylva {
 namespace {
@@ -55,6 +56,10 @@ PropertyPanel::PropertyPanel(SceneDocument* doc, QWidget* parent) : QWidget(pare
     m_stack->addWidget(m_sunPage = buildSunPage());
     m_stack->addWidget(m_cameraPage = buildCameraPage());
     m_stack->addWidget(m_groundPage = buildGroundPage());
+    m_stack->addWidget(m_itemPages = new SceneItemPages(
+                           doc, [this](QObject* editor, const QString& text, const std::function<void(Scene&)>& change) {
+                               apply(editor, text, change);
+                           }));
     connect(doc, &SceneDocument::changed, this, [this] { refresh(); });
     showItem({});
 }
@@ -345,6 +350,13 @@ void PropertyPanel::refresh()
         m_stack->setCurrentWidget(m_groundPage);
         break;
     }
+    case K::Terrain:
+    case K::Tiles:
+    case K::Tiling:
+    case K::Density:
+    case K::Volume:
+        m_stack->setCurrentWidget(m_itemPages->showItem(m_item, s) ? static_cast<QWidget*>(m_itemPages) : m_emptyPage);
+        break;
     default: m_stack->setCurrentWidget(m_emptyPage); break;
     }
 }

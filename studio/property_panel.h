@@ -21,6 +21,8 @@ class QStackedWidget;
 
 namespace sylva {
 
+class SceneItemPages;
+
 class PropertyPanel : public QWidget {
     Q_OBJECT
 
@@ -40,6 +42,8 @@ public:
     QSpinBox* speciesGrid() const { return m_speciesGrid; }
     QLineEdit* speciesName() const { return m_speciesName; }
     QComboBox* speciesPreset() const { return m_speciesPreset; }
+    // The landscape's and the volumes' pages (studio/scene_item_pages.h).
+    SceneItemPages* itemPages() const { return m_itemPages; }
 
 private:
     QWidget* buildEmptyPage();
@@ -57,6 +61,7 @@ private:
     OutlinerItem m_item;
     QStackedWidget* m_stack;
     QWidget *m_emptyPage, *m_instancePage, *m_speciesPage, *m_sunPage, *m_cameraPage, *m_groundPage;
+    SceneItemPages* m_itemPages;
 
     QComboBox* m_instSpecies;
     std::array<QDoubleSpinBox*, 3> m_instPos{}, m_instRot{};
