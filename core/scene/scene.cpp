@@ -36,6 +36,16 @@ bool parseRenderMode(const std::string& name, RenderMode* out)
     return false;
 }
 
+const char* directLightName(DirectLight d) { return d == DirectLight::Once ? "once" : "seed"; }
+
+bool parseDirectLight(const std::string& name, DirectLight* out)
+{
+    if (name == "seed") *out = DirectLight::Seed;
+    else if (name == "once") *out = DirectLight::Once;
+    else return false;
+    return true;
+}
+
 const char* accelName(AccelKind kind) { return kind == AccelKind::KdTree ? "kdtree" : "bvh"; }
 
 bool parseAccel(const std::string& name, AccelKind* out)

@@ -140,6 +140,18 @@ struct CameraDesc {
     float fovY = 45.0f;
 };
 
+// How the species' LB grids and the renderer's shadow-ray sun share the direct light (issue 18 item 4):
+// Seed = the seed's sum (the grid as solved, uncollided sunlight included, added to the drawn sun: direct
+// light counted twice inside crowns); Once = the grid less its uncollided part (lb::scatteredPart), so
+// the grid adds only scattered light to the drawn sun.
+enum class DirectLight { Seed, Once };
+
+// The scene's lighting beyond sun and sky (the `lighting` block).
+struct LightingDesc {
+    DirectLight direct = DirectLight::Seed;
+    bool operator==(const LightingDesc&) const = default;   // the scene file writes the block only when it differs
+};
+
 enum class RenderMode { Full, Local, Ambient, Lb };
 enum class AccelKind { Bvh, KdTree };
 
@@ -169,6 +181,7 @@ struct Scene {
     SunDesc sun;
     glm::vec3 sky{0.55f, 0.70f, 0.95f};  // linear RGB radiance of the background (the constant sky: sky.color)
     SkyDesc skyModel;                    // the rest of the sky block (Preetham, HDR map, virtual lights)
+    LightingDesc lighting;               // the `lighting` block (direct light once or the seed's sum)
     CameraDesc camera;
     RenderSettings render;
 };
@@ -179,6 +192,8 @@ inline glm::vec3 composeSky(const Scene& s) { return s.skyModel.analytic() ? glm
 
 const char* renderModeName(RenderMode mode);      // "full", "local", "ambient", "lb"
 bool parseRenderMode(const std::string& name, RenderMode* out);
+const char* directLightName(DirectLight d);       // "seed", "once"
+bool parseDirectLight(const std::string& name, DirectLight* out);
 const char* accelName(AccelKind kind);            // "bvh", "kdtree"
 bool parseAccel(const std::string& name, AccelKind* out);
 

@@ -51,6 +51,8 @@ Scene sceneForArgs(const Args& args, std::string* stem)
     if (args.has("--accel") && !parseAccel(args.get("--accel"), &r.accel))
         throw UsageError("option --accel: expected bvh or kdtree, got '" + args.get("--accel") + "'");
     if (args.has("--no-shadows")) r.shadows = false;
+    if (args.has("--direct") && !parseDirectLight(args.get("--direct"), &scene.lighting.direct))
+        throw UsageError("option --direct: expected once or seed, got '" + args.get("--direct") + "'");
     if (args.has("--cells")) {
         if (!scene.terrain.enabled()) throw UsageError("option --cells: the scene has no terrain");
         scene.terrain.cells = int(parseInteger("--cells", args.get("--cells"), 1, 65536));
@@ -235,6 +237,8 @@ Command renderCommand()
              {"--mode", "M", "full (LB indirect + sun), local (sun only), ambient (sun + matched constant), lb"},
              {"--accel", "bvh|kdtree", "acceleration structure (default: the scene's, bvh)"},
              {"--no-shadows", "", "no shadow rays"},
+             {"--direct", "once|seed", "once: the LB grids add only scattered light to the shadow-rayed sun; seed: the seed's sum "
+                                   "(grid as solved, direct light counted twice in crowns); default: the scene's lighting.direct"},
              {"--cells", "N", "plant cells along the terrain's longer side (terrain.cells; the scene needs terrain.tiles)"},
              {"--sun", "X,Y,Z", "direction toward the sun (+Y up, any length), replacing the scene's"},
              kSunAt,

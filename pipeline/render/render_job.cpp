@@ -141,6 +141,12 @@ SpeciesGrids gridsForMesh(const Scene& scene, const SpeciesDesc& sp, const Trian
     Progress lightProgress([&](double f, const std::string& msg) { lightPart.report(f, msg); });
     if (progress && progress->isCancelled()) lightProgress.cancel();
     g.lighting = lightingFor(g.density, g.params, cache, &lightProgress, log, backend);
+    if (scene.lighting.direct == DirectLight::Once) {
+        // Direct light counted once: the same LB with scattering off is the uncollided sunlight the
+        // renderer's shadow rays already draw; the grid keeps the scattered rest (cached like any solve).
+        const LightingGrid uncollided = lightingFor(g.density, lb::uncollidedParams(g.params), cache, &lightProgress, log, backend);
+        g.lighting = lb::scatteredPart(g.lighting, uncollided);
+    }
     const std::vector<float> f = lb::boundaryDistribution(g.params.sun);
     const float free = std::accumulate(f.begin(), f.end(), 0.0f);
     g.lightingNorm = g.params.intensity * free;

@@ -616,6 +616,22 @@ const Table<Scene>& skyTable()
     return table;
 }
 
+// The scene's `lighting` block: how the LB grids and the drawn sun share the direct light.
+const Table<LightingDesc>& sceneLightingTable()
+{
+    static const Table<LightingDesc> table = [] {
+        TableBuilder<LightingDesc> b(Layout::Inline);
+        b.enumeration("direct", &LightingDesc::direct, parseDirectLight, directLightName, "direct light", "seed, once")
+            .doc("string",
+                 "`seed`: the grid as solved is added to the shadow-rayed sun (the seed's sum: direct light counted twice inside "
+                 "crowns); `once`: the grid less its uncollided sunlight, so it adds only scattered light "
+                 "([ACCURACY.md](ACCURACY.md))")
+            .summarized([](const LightingDesc& l) { return std::string("direct light ") + directLightName(l.direct); });
+        return b.table;
+    }();
+    return table;
+}
+
 const Table<CameraDesc>& cameraTable()
 {
     static const Table<CameraDesc> table = [] {
@@ -760,6 +776,10 @@ const Table<Scene>& sceneTable()
         b.object("sky", [](auto& s) -> auto& { return s; }, skyTable())
             .doc("object", "")
             .summarized(sectionLine("sky", [](const Scene& s) -> const Scene& { return s; }, skyTable()));
+        b.object("lighting", &Scene::lighting, sceneLightingTable())
+            .writtenIf([](const Scene& sc) { return !(sc.lighting == LightingDesc{}); })
+            .doc("object", "the scene's lighting beyond sun and sky; optional")
+            .summarized(sectionLine("lighting", [](const Scene& s) -> const LightingDesc& { return s.lighting; }, sceneLightingTable()));
         b.object("camera", &Scene::camera, cameraTable())
             .doc("object", "pinhole")
             .summarized(sectionLine("camera", [](const Scene& s) -> const CameraDesc& { return s.camera; }, cameraTable()));
