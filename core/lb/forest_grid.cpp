@@ -38,6 +38,10 @@ ForestSpecies forestSpecies(const DensityGrid& d)
 
 namespace {
 
+// Face factors are capped here: a face the plant alone barely lights can take a large ratio from a little
+// light its neighbours scatter onto it.
+constexpr float kMaxFaceFactor = 4.0f;
+
 struct Box {
     glm::dvec3 lo, hi;
     double rhoPerOverlap;   // coarse density per m^3 of overlap with a node's cell
@@ -90,7 +94,10 @@ glm::vec3 sample(const LightingGrid& l, const glm::dvec3& p)
 // The LB of LB_MODEL.md on a small grid without wood, single-threaded and scalar through the same node
 // collision as the solvers (collideNode): for the hundreds of few-hundred-node windows of a forest, where a
 // full solver's setup (page-aligned copies, thread pool per step) costs far more than the steps.
-LightingGrid solveSmall(const GridGeometry& g, const std::vector<float>& rho, const LbParams& p, int steps)
+// faces (when given): per node and channel the irradiance on the six axis-aligned faces (kFaceNormals order),
+// sum over directions m of f_m x max(0, -c_m . N) / |c_m|: the light arriving at a surface facing N.
+LightingGrid solveSmall(const GridGeometry& g, const std::vector<float>& rho, const LbParams& p, int steps,
+                        std::vector<float>* faces = nullptr)
 {
     const std::vector<float> bc = boundaryOf(p);
     const size_t nodes = g.nodeCount();
@@ -100,8 +107,10 @@ LightingGrid solveSmall(const GridGeometry& g, const std::vector<float>& rho, co
     auto boundary = [&](int i, int j, int k) {
         return i == 0 || j == 0 || k == 0 || i == g.dims.x - 1 || j == g.dims.y - 1 || k == g.dims.z - 1;
     };
-    std::vector<float> a(nodes * kDirections), b(nodes * kDirections);
-    for (int c = 0; c < 3; ++c) {
+    if (faces) faces->assign(nodes * 3 * kFaces, 0.0f);
+    // The channels are independent solves: in parallel (the forest grid's own solve runs alone).
+    tbb::parallel_for(0, 3, [&](int c) {
+        std::vector<float> a(nodes * kDirections), b;
         const ChannelParams& cp = p.channels[size_t(c)];
         const SymmetricOmega om = symmetricOmega(cp);
         for (int i = 0; i < g.dims.x; ++i)
@@ -133,7 +142,34 @@ LightingGrid solveSmall(const GridGeometry& g, const std::vector<float>& rho, co
             double sum = 0.0;
             for (int m = 0; m < kDirections; ++m) sum += double(a[n * kDirections + size_t(m)]);
             out.rgb[n * 3 + size_t(c)] = float(sum) * p.intensity[c];
+            if (!faces) continue;
+            for (int face = 0; face < kFaces; ++face) {
+                double e = 0.0;
+                for (int m = 1; m < kDirections; ++m) {
+                    const int* cm = kC[m];
+                    const double dot = -(cm[0] * kFaceNormals[face][0] + cm[1] * kFaceNormals[face][1] + cm[2] * kFaceNormals[face][2]);
+                    if (dot > 0.0) e += double(a[n * kDirections + size_t(m)]) * dot / std::sqrt(double(cm[0] * cm[0] + cm[1] * cm[1] + cm[2] * cm[2]));
+                }
+                (*faces)[(n * 3 + size_t(c)) * kFaces + size_t(face)] = float(e) * p.intensity[c];
+            }
         }
+    });
+    return out;
+}
+
+// Trilinear sample of a per-node, per-channel face grid (solveSmall's faces) at p: [face] = RGB.
+std::array<glm::vec3, kFaces> sampleFaces(const GridGeometry& g, const std::vector<float>& faces, const glm::dvec3& p)
+{
+    const glm::dvec3 u = glm::clamp((p - g.origin) / g.spacing, glm::dvec3(0.0), glm::dvec3(g.dims - 1));
+    const glm::ivec3 i0 = glm::min(glm::ivec3(u), g.dims - 2);
+    const glm::dvec3 f = u - glm::dvec3(i0);
+    std::array<glm::vec3, kFaces> out{};
+    for (int c = 0; c < 8; ++c) {
+        const glm::ivec3 o(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+        const double w = (o.x ? f.x : 1.0 - f.x) * (o.y ? f.y : 1.0 - f.y) * (o.z ? f.z : 1.0 - f.z);
+        const size_t n = g.index(i0.x + o.x, i0.y + o.y, i0.z + o.z);
+        for (int ch = 0; ch < 3; ++ch)
+            for (int face = 0; face < kFaces; ++face) out[size_t(face)][ch] += float(w * double(faces[(n * 3 + size_t(ch)) * kFaces + size_t(face)]));
     }
     return out;
 }
@@ -191,7 +227,9 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
     p.stepsPerEdge = 2;
     r.steps = p.steps;
     const DensityGrid forest = densityOn(g, r.density);
-    r.lighting = solveLighting(forest, p);
+    std::vector<float> forestFaces;
+    r.lighting = g.nodeCount() <= kSmallNodes ? solveSmall(g, forest.density, p, p.steps, &forestFaces) : solveLighting(forest, p);
+    r.faceFactors.assign(plants.size(), std::array<glm::vec3, kFaces>{});
     // Each plant alone on the same lattice (a local window around its box): the light its own crown leaves.
     tbb::parallel_for(size_t(0), plants.size(), [&](size_t i) {
         const ForestSpecies& s = species[size_t(plants[i].species)];
@@ -220,17 +258,40 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
         pa.steps = std::min(p.steps, 4 * lg.longestEdge());
         // Small windows (most, at forest resolutions) through the scalar loop, large ones through the solver.
         const DensityGrid ld = densityOn(lg, rho);
-        const LightingGrid alone = lg.nodeCount() <= 4096 ? solveSmall(lg, ld.density, pa, pa.steps) : solveLighting(ld, pa);
+        const bool directions = !forestFaces.empty() && lg.nodeCount() <= kSmallNodes;
+        std::vector<float> aloneFaces;
+        const LightingGrid alone = lg.nodeCount() <= 4096 || directions ? solveSmall(lg, ld.density, pa, pa.steps, directions ? &aloneFaces : nullptr)
+                                                                         : solveLighting(ld, pa);
         const glm::dvec3 centre = 0.5 * (b.lo + b.hi);
         const glm::vec3 la = sample(alone, centre), lf = sample(r.lighting, centre);
         for (int c = 0; c < 3; ++c) r.factors[i][c] = la[c] > 0.0f ? lf[c] / la[c] : 1.0f;   // > 1 where neighbours scatter light in
+        for (glm::vec3& f : r.faceFactors[i]) f = r.factors[i];
+        if (!directions) return;
+        const std::array<glm::vec3, kFaces> fa = sampleFaces(lg, aloneFaces, centre), ff = sampleFaces(g, forestFaces, centre);
+        for (int face = 0; face < kFaces; ++face)
+            for (int c = 0; c < 3; ++c) {
+                const float a = fa[size_t(face)][c];
+                // A face the plant alone leaves (nearly) unlit has no ratio to speak of: the plant's factor there.
+                r.faceFactors[i][size_t(face)][c] = a > 1e-6f * la[c] ? std::min(ff[size_t(face)][c] / a, kMaxFaceFactor) : r.factors[i][c];
+            }
     });
-    r.minFactor = 1.0f;
-    r.maxFactor = 0.0f;
-    for (const glm::vec3& f : r.factors)
+    r.minFactor = r.minFaceFactor = 1.0f;
+    r.maxFactor = r.maxFaceFactor = 0.0f;
+    std::vector<float> means;
+    for (size_t i = 0; i < plants.size(); ++i) {
+        const glm::vec3& f = r.factors[i];
+        means.push_back((f.x + f.y + f.z) / 3.0f);
         for (int c = 0; c < 3; ++c) r.minFactor = std::min(r.minFactor, f[c]), r.maxFactor = std::max(r.maxFactor, f[c]);
-    if (r.factors.empty()) r.maxFactor = 1.0f;
-    r.uniform = r.maxFactor <= 0.0f || (r.maxFactor - r.minFactor) / r.maxFactor < settings.uniformSpread;
+        for (const glm::vec3& ff : r.faceFactors[i])
+            for (int c = 0; c < 3; ++c) r.minFaceFactor = std::min(r.minFaceFactor, ff[c]), r.maxFaceFactor = std::max(r.maxFaceFactor, ff[c]);
+    }
+    if (r.factors.empty()) r.maxFactor = r.maxFaceFactor = 1.0f;
+    if (!means.empty()) {
+        std::nth_element(means.begin(), means.begin() + std::ptrdiff_t(means.size() / 2), means.end());
+        r.medianFactor = means[means.size() / 2];
+    }
+    const float least = std::min(r.minFactor, r.minFaceFactor), most = std::max(r.maxFactor, r.maxFaceFactor);
+    r.uniform = most <= 0.0f || (most - least) / most < settings.uniformSpread;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
 }
@@ -238,9 +299,9 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
 std::string forestGridSummary(const ForestGridResult& r)
 {
     char line[256];
-    std::snprintf(line, sizeof line, "forest grid %dx%dx%d (%.3g m), %d steps, %.3f s: factors %.3f-%.3f%s", r.geometry.dims.x,
-                  r.geometry.dims.y, r.geometry.dims.z, r.geometry.spacing, r.steps, r.seconds, r.minFactor, r.maxFactor,
-                  r.uniform ? " (exposure uniform)" : "");
+    std::snprintf(line, sizeof line, "forest grid %dx%dx%d (%.3g m), %d steps, %.3f s: factors %.3f / %.3f / %.3f (min / median / max), "
+                  "per face %.3f-%.3f%s", r.geometry.dims.x, r.geometry.dims.y, r.geometry.dims.z, r.geometry.spacing, r.steps, r.seconds,
+                  r.minFactor, r.medianFactor, r.maxFactor, r.minFaceFactor, r.maxFaceFactor, r.uniform ? " (exposure uniform)" : "");
     return line;
 }
 

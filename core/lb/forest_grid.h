@@ -14,6 +14,7 @@
 // isolated plant, < 1 where other plants shade it (> 1 where they scatter more light in than they take).
 #pragma once
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,11 @@
 #include "core/lb/lb_params.h"
 
 namespace sylva::lb {
+
+// The six axis-aligned faces a plant's directional factors are given for: surfaces facing +x, -x, +y, -y,
+// +z, -z (world axes). The renderer (core/render/shade.h forestFactor) blends them in this order.
+inline constexpr int kFaces = 6;
+inline constexpr int kFaceNormals[kFaces][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
 
 // A species as the forest grid sees it, in its own frame (scale 1, origin at the plant's position).
 struct ForestSpecies {
@@ -48,11 +54,22 @@ struct ForestGridResult {
     std::vector<float> density;     // coarse node density, z fastest
     LightingGrid lighting;          // the forest grid's solve (unit intensity boundary)
     std::vector<glm::vec3> factors; // per plant, per channel
-    float minFactor = 1.0f, maxFactor = 1.0f;   // over plants and channels
-    bool uniform = true;            // (max - min) / max < settings.uniformSpread
+    // Per plant and face (kFaceNormals), per channel: the irradiance on a surface facing that way in the
+    // forest grid over the same with the plant alone, at its crown centre (the light from the open side of a
+    // stand's edge tree keeps ~1, the light from the stand less). Equal to `factors` where the solve kept no
+    // directions (a window or forest grid over kSmallNodes nodes).
+    std::vector<std::array<glm::vec3, kFaces>> faceFactors;
+    float minFactor = 1.0f, maxFactor = 1.0f;   // over plants and channels of `factors`
+    float medianFactor = 1.0f;      // median over plants of the channels' mean of `factors`
+    float minFaceFactor = 1.0f, maxFaceFactor = 1.0f;   // over plants, faces and channels of faceFactors
+    bool uniform = true;            // (max - min) / max < settings.uniformSpread over factors and faceFactors
     int steps = 0;
     double seconds = 0.0;           // build + solve (forest grid and the per-plant solves)
 };
+
+// Lattices up to this many nodes run through a scalar loop that keeps the directions (faceFactors); larger
+// ones through the full solver (no directions).
+inline constexpr size_t kSmallNodes = size_t(1) << 17;
 
 // Throws Error for bad settings, a species index out of range or a non-positive scale. `params` gives the
 // optics, boundary (sun or params.boundary) and storage; steps are 2 x the forest grid's longest edge for
