@@ -44,6 +44,9 @@ struct SpeciesDesc {
     lb::LbParams lighting;               // preset + overrides (sun is set from the scene's sun at solve time);
                                          // scene files start from defaultSpeciesLighting
     int grid = 64;                       // LB grid nodes along the longest edge
+    bool solid = false;                  // voxelized as a solid (interior filled, core/voxel/solid_voxelize.h): plastics
+    bool lit = true;                     // false: no LB grid, conventional lighting (ambient = the diffuse colour x
+                                         // the sun's radiance: the LB's open-space value; seed 004 Figure 5)
 };
 
 inline constexpr uint32_t kNoGroup = 0xffffffffu;

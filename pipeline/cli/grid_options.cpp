@@ -127,7 +127,7 @@ lb::LbParams lightParams(const Args& args)
 void rejectMeshOptionsWithDensity(const Args& args)
 {
     if (!args.has("--density")) return;
-    for (const char* meshOnly : {"--grid", "--subcells", "--leaf-materials"})
+    for (const char* meshOnly : {"--grid", "--subcells", "--leaf-materials", "--solid"})
         if (args.has(meshOnly)) throw UsageError(std::string(meshOnly) + " applies to --mesh, not to --density");
 }
 

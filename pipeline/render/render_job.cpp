@@ -131,6 +131,7 @@ SpeciesGrids gridsForMesh(const Scene& scene, const SpeciesDesc& sp, const Trian
     SpeciesGrids g;
     VoxelizeSettings vs;
     vs.longestAxisNodes = sp.grid;
+    vs.solid = sp.solid;
     SubProgress densityPart(progress, 0.0, 0.2);
     Progress densityProgress([&](double f, const std::string& msg) { densityPart.report(f, msg); });
     if (progress && progress->isCancelled()) densityProgress.cancel();
@@ -177,7 +178,7 @@ std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cach
         SubProgress part(progress, double(s) / double(n), double(s + 1) / double(n));
         part.report(0.0, sp.name + ": geometry");
         out[s] = loadGeometry(sp, log);
-        if (!needLighting) continue;
+        if (!needLighting || !sp.lit) continue;   // unlit: no grid, the open-space value (conventional ambient)
         Progress sub([&](double f, const std::string& msg) { part.report(0.05 + 0.95 * f, sp.name + ": " + msg); });
         if (progress && progress->isCancelled()) sub.cancel();
         SpeciesGrids grids = gridsForMesh(scene, sp, out[s].mesh, cache, &sub, log, backend);

@@ -92,6 +92,16 @@ const Table<SpeciesDesc>& lightingTable()
             .doc("bool", "`true` for plants (zero f_0 each step), `false` keeps absorbed light (clouds, plastics)")
             .shown("preset's");
         b.integer("grid", &SpeciesDesc::grid, 8, 512).doc("integer", "LB grid nodes along the longest edge, 8 .. 512");
+        b.boolean("solid", [](auto& d) -> auto& { return d.solid; })
+            .doc("bool",
+                 "`true`: the mesh is voxelized as a solid (interior filled by winding numbers, open edges do not leak; "
+                 "plastics such as the PMMA teapot), `false` (default): its surface, as plants")
+            .writtenIf([](const SpeciesDesc& d) { return d.solid; });
+        b.boolean("lb", [](auto& d) -> auto& { return d.lit; })
+            .doc("bool",
+                 "`false`: no LB grid is solved; the species is lit conventionally, its ambient term the diffuse colour x the "
+                 "sun's radiance (the LB's value in open space; seed 004 Figure 5), default `true`")
+            .writtenIf([](const SpeciesDesc& d) { return !d.lit; });
         b.custom(
              "steps",
              [](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) {
