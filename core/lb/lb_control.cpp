@@ -10,6 +10,7 @@
 
 #include "core/base/error.h"
 #include "core/lb/lattice.h"
+#include "core/lb/lb_slab.h"
 
 namespace sylva::lb {
 
@@ -47,6 +48,24 @@ DensityGrid coarsen(const DensityGrid& fine)
             }
     });
     return c;
+}
+
+std::vector<ChannelParams> distinctSolves(const LbParams& params, int (&solveOf)[3])
+{
+    // Channels with equal optics share one solve: the result is linear in the sun intensity.
+    std::vector<ChannelParams> solves;
+    for (int c = 0; c < 3; ++c) {
+        const ChannelParams& p = params.channels[size_t(c)];
+        int found = -1;
+        for (size_t s = 0; s < solves.size(); ++s)
+            if (solves[s].sigmaA == p.sigmaA && solves[s].sigmaS == p.sigmaS && solves[s].g == p.g) found = int(s);
+        if (found < 0) {
+            found = int(solves.size());
+            solves.push_back(p);
+        }
+        solveOf[c] = found;
+    }
+    return solves;
 }
 
 namespace {
@@ -132,20 +151,8 @@ private:
 LightingGrid runSolve(LbDevice& device, const DensityGrid& density, const LbParams& params, Progress* progress,
                       SolveStats& stats)
 {
-    // Channels with equal optics share one solve: the result is linear in the sun intensity.
-    std::vector<ChannelParams> solves;
     int solveOf[3];
-    for (int c = 0; c < 3; ++c) {
-        const ChannelParams& p = params.channels[size_t(c)];
-        int found = -1;
-        for (size_t s = 0; s < solves.size(); ++s)
-            if (solves[s].sigmaA == p.sigmaA && solves[s].sigmaS == p.sigmaS && solves[s].g == p.g) found = int(s);
-        if (found < 0) {
-            found = int(solves.size());
-            solves.push_back(p);
-        }
-        solveOf[c] = found;
-    }
+    const std::vector<ChannelParams> solves = distinctSolves(params, solveOf);
     stats.channelSolves = int(solves.size());
 
     // Memory: two copies of 19 values per node for each channel solve advanced together, plus an

@@ -24,6 +24,7 @@
 #include "core/base/half.h"
 #include "core/lb/lb_device.h"
 #include "core/lb/lb_node.h"
+#include "core/lb/lb_slab.h"
 
 namespace sylva::lb {
 
@@ -301,7 +302,6 @@ public:
             m_rowDiff.assign(rows, 0.0);
             m_rowNorm.assign(rows, 0.0);
         }
-        const size_t grain = size_t(std::max(1, m_Y / 16));
         for (size_t c = 0; c < m_fields.size(); ++c) {
             ChannelField<S>& field = *m_fields[c];
             for (int w = 0; w < m_X + levels - 1; ++w) {
@@ -313,17 +313,7 @@ public:
                     const S* src = (field.flip != odd) ? field.b.data() : field.a.data();
                     S* dst = (field.flip != odd) ? field.a.data() : field.b.data();
                     const int outMode = compareLevel < 1 ? 0 : (l == compareLevel - 1 ? 1 : (l == compareLevel ? 2 : 0));
-                    tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(m_Y), grain),
-                                      [&](const tbb::blocked_range<size_t>& range) {
-                                          Scratch& sc = m_scratch.local();
-                                          if (sc.buf.size() != size_t(kDirections) * size_t(m_Zp))
-                                              sc.buf.assign(size_t(kDirections) * size_t(m_Zp), 0.0f);
-                                          for (size_t j = range.begin(); j != range.end(); ++j) {
-                                              const size_t r = size_t(x) * size_t(m_Y) + j;
-                                              if (j + 2 < range.end()) prefetchRow(r + 2, src, dst);   // two rows ahead: measured better than one
-                                              processRow(r, c, src, dst, sc, outMode);
-                                          }
-                                      });
+                    stepPlane(c, x, src, dst, outMode);
                 }
             }
             if (levels & 1) field.flip = !field.flip;
@@ -336,6 +326,45 @@ public:
         }
         return norm > 0.0 ? std::sqrt(diff / norm) : 0.0;
     }
+
+    // One step of source plane x of channel solve c from src into dst (the collision of its rows and their
+    // streaming into planes x-1, x, x+1; the grid's faces are never written): the one node update every
+    // step runs, whole grids (advanceBlock) and slabs of a distributed grid (CpuSlab) alike.
+    void stepPlane(size_t c, int x, const S* src, S* dst, int outMode)
+    {
+        const size_t grain = size_t(std::max(1, m_Y / 16));
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, size_t(m_Y), grain), [&](const tbb::blocked_range<size_t>& range) {
+            Scratch& sc = m_scratch.local();
+            if (sc.buf.size() != size_t(kDirections) * size_t(m_Zp)) sc.buf.assign(size_t(kDirections) * size_t(m_Zp), 0.0f);
+            for (size_t j = range.begin(); j != range.end(); ++j) {
+                const size_t r = size_t(x) * size_t(m_Y) + j;
+                if (j + 2 < range.end()) prefetchRow(r + 2, src, dst);   // two rows ahead: measured better than one
+                processRow(r, c, src, dst, sc, outMode);
+            }
+        });
+    }
+
+    // A step in parts (CpuSlab): source planes [x0, x1) of solve c from the current copy into the other,
+    // which becomes current with flipState once every plane has been stepped.
+    void stepPlanes(size_t c, int x0, int x1)
+    {
+        ChannelField<S>& field = *m_fields[c];
+        const S* src = field.flip ? field.b.data() : field.a.data();
+        S* dst = field.flip ? field.a.data() : field.b.data();
+        for (int x = std::max(0, x0); x < std::min(m_X, x1); ++x) {
+            if (m_progress) m_progress->throwIfCancelled();
+            stepPlane(c, x, src, dst, 0);
+        }
+    }
+    void flipState(size_t c) { m_fields[c]->flip = !m_fields[c]->flip; }
+    // Plane x of the current copy of solve c: Y x 19 x Z stored values, contiguous.
+    S* currentPlane(size_t c, int x)
+    {
+        ChannelField<S>& field = *m_fields[c];
+        return (field.flip ? field.b.data() : field.a.data()) + dindex(x, 0, 0, 0);
+    }
+    size_t planeValues() const { return size_t(m_Y) * kDirections * size_t(m_Z); }
+    int planes() const { return m_X; }
 
     // Slab depth of the wavefront: as many levels as keep (levels + 3) slabs of both copies in ~12 MB.
     int autoLevels() const override
@@ -606,6 +635,28 @@ public:
     }
 };
 
+// A slab of a distributed grid (lb_slab.h): a Solver on the slab's local grid, one channel solve.
+template <typename S>
+class CpuSlab final : public LbSlab {
+public:
+    CpuSlab(const DensityGrid& local, const LbParams& params, Progress* progress)
+        : m_params(params), m_solver(local, m_params, {params.channels[0]})
+    {
+        m_solver.m_progress = progress;
+    }
+    void setSolve(const ChannelParams& solve) override { m_solver.setSolves({solve}, false); }
+    void stepPlanes(int x0, int x1) override { m_solver.stepPlanes(0, x0, x1); }
+    void finishStep() override { m_solver.flipState(0); }
+    void* plane(int x) override { return m_solver.currentPlane(0, x); }
+    size_t planeBytes() const override { return m_solver.planeValues() * sizeof(S); }
+    int planes() const override { return m_solver.planes(); }
+    void totals(std::vector<float>& out) override { m_solver.totals(0, out); }
+
+private:
+    const LbParams m_params;   // the Solver keeps a reference
+    Solver<S> m_solver;
+};
+
 } // namespace
 
 void advance(const DensityGrid& density, const LbParams& params, std::vector<float>& f, int steps)
@@ -625,6 +676,44 @@ void advance(const DensityGrid& density, const LbParams& params, std::vector<flo
     };
     if (params.storage == Storage::Fp16) run(uint16_t{});
     else run(float{});
+}
+
+SlabRange slabOwned(int X, int index, int count)
+{
+    const int interior = X - 2;
+    if (count < 1 || index < 0 || index >= count) throw Error("LB slabs: slab " + std::to_string(index) + " of " + std::to_string(count));
+    if (interior < count)
+        throw Error("the grid has " + std::to_string(interior) + " interior x-planes, fewer than the " + std::to_string(count) +
+                    " slabs it is to be split into; use fewer ranks");
+    const int base = interior / count, extra = interior % count;
+    SlabRange r;
+    r.begin = 1 + index * base + std::min(index, extra);
+    r.end = r.begin + base + (index < extra ? 1 : 0);
+    return r;
+}
+
+DensityGrid slabDensity(const DensityGrid& density, SlabRange owned)
+{
+    const glm::ivec3 d = density.geometry.dims;
+    if (owned.begin < 1 || owned.end > d.x - 1 || owned.begin >= owned.end) throw Error("LB slabs: planes outside the grid");
+    const int x0 = owned.begin - 1, x1 = owned.end + 1;
+    DensityGrid s;
+    s.geometry = density.geometry;
+    s.geometry.dims.x = x1 - x0;
+    s.geometry.origin.x += double(x0) * s.geometry.spacing;
+    const size_t plane = size_t(d.y) * size_t(d.z);
+    s.density.assign(density.density.begin() + long(size_t(x0) * plane), density.density.begin() + long(size_t(x1) * plane));
+    if (!density.woodFraction.empty())
+        s.woodFraction.assign(density.woodFraction.begin() + long(size_t(x0) * plane), density.woodFraction.begin() + long(size_t(x1) * plane));
+    return s;
+}
+
+std::unique_ptr<LbSlab> makeCpuSlab(const DensityGrid& local, const LbParams& params, Progress* progress)
+{
+    validate(params);
+    validateDensity(local);
+    if (params.storage == Storage::Fp16) return std::make_unique<CpuSlab<uint16_t>>(local, params, progress);
+    return std::make_unique<CpuSlab<float>>(local, params, progress);
 }
 
 std::vector<float> boundaryDistribution(const glm::vec3& sun)

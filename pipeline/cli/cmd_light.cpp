@@ -12,6 +12,11 @@
 #include "pipeline/lighting_job.h"
 #include "pipeline/services/grid_stats.h"
 
+#if SYLVA_HAVE_MPI
+#include "pipeline/mpi/mpi_lb.h"
+#include "pipeline/mpi/mpi_render.h"
+#endif
+
 namespace sylva::cli {
 namespace {
 
@@ -41,13 +46,40 @@ void applyLightDefaults(const Args& args, lb::LbParams& p)
     }
 }
 
+int writeLight(const Args& args, const lb::LbParams& params, const DensityGrid& density, const LightingGrid& light, const JobLog& log,
+               const std::string& part, const std::string& out, const PictureOptions& picture);
+
+// --mpi: the checks before anything is loaded (usage errors on every rank alike).
+void checkMpiLight(const Args& args, const lb::LbParams& params)
+{
+    if (!args.has("--mpi")) {
+        if (args.has("--mpi-timeout")) throw UsageError("option --mpi-timeout: applies to --mpi only");
+        return;
+    }
+#if SYLVA_HAVE_MPI
+    if (!mpi::launchedByMpi())
+        throw UsageError("option --mpi: this process was not started by mpirun; run: mpirun -np N sylva light --mpi ... "
+                         "(docs/DISTRIBUTED.md), or drop --mpi");
+    if (args.has("--basis")) throw UsageError("option --mpi: --basis is not distributed; drop one of them");
+    if (params.tolerance > 0.0 || params.coarseStart)
+        throw UsageError("option --mpi: the distributed grid runs a fixed step count; drop --tol and --coarse-start");
+    if (backendName(args) == "cuda") std::fprintf(stderr, "note: --mpi solves each rank's slab on its CPU\n");
+#else
+    (void)params;
+    throw UsageError("option --mpi: this sylva was built without MPI (configure with -DSYLVA_ENABLE_MPI=ON where an MPI "
+                     "library is installed, e.g. Debian's libopenmpi-dev)");
+#endif
+}
+
 int runLight(const Args& args)
 {
     auto threads = threadLimit(args);
+    const bool useMpi = args.has("--mpi");
     if (args.has("--density") == args.has("--mesh")) throw UsageError("'sylva light' needs exactly one of --density FILE or --mesh FILE");
     auto compute = openBackend(backendName(args));
     lb::LbParams params = lightParams(args);
     applyLightDefaults(args, params);
+    checkMpiLight(args, params);
     auto cache = openCache(args);
     if (args.has("--basis") && !cache) throw UsageError("--basis stores the relighting basis in the grid cache; it cannot be used with --no-cache");
     if (args.has("--basis") && params.tolerance > 0.0)
@@ -56,16 +88,42 @@ int runLight(const Args& args)
     if (part != "all" && part != "scattered" && part != "uncollided")
         throw UsageError("option --part: expected all, scattered or uncollided, got '" + part + "'");
     JobLog log;
-    VoxelizeSettings voxel = voxelSettings(args);
-    voxel.solid = args.has("--solid");   // plastics: the interior filled (winding numbers), as sylva voxelize --solid
+    const VoxelizeSettings voxel = voxelSettings(args);
     rejectMeshOptionsWithDensity(args);
     const PictureOptions picture = pictureOptions(args);
     const std::string out = outputFile(args, gridFileExtensions());
-    requireReplaceableFile(out);
+#if SYLVA_HAVE_MPI
+    const bool writer = !useMpi || mpi::launchRank() == 0;   // --mpi: rank 0 writes
+#else
+    const bool writer = true;
+#endif
+    if (writer) requireReplaceableFile(out);
     const DensityGrid density = loadDensityInput(args, voxel, cache.get(), log);
-    printDensitySummary(density);
-    ProgressPrinter bar("light", args.has("--quiet"));
+    if (writer) printDensitySummary(density);
+    ProgressPrinter bar("light", args.has("--quiet") || !writer);
     LightingGrid light;
+    if (useMpi) {
+#if SYLVA_HAVE_MPI
+        // Every rank holds the density and one slab of the distributions; rank 0 gathers and writes.
+        const double timeout = args.has("--mpi-timeout") ? double(parseInteger("--mpi-timeout", args.get("--mpi-timeout"), 1, 86400)) : 10.0;
+        return mpi::runLightSession(
+            [&](int rank, int ranks) {
+                mpi::DistributedStats st;
+                light = mpi::solveDistributed(density, params, rank == 0 ? &bar.progress() : nullptr, &st);
+                if (part != "all") {
+                    const LightingGrid uncollided = mpi::solveDistributed(density, lb::uncollidedParams(params), nullptr, nullptr);
+                    if (rank == 0) light = part == "uncollided" ? uncollided : lb::scatteredPart(light, uncollided);
+                }
+                if (rank != 0) return int(kOk);
+                char line[200];
+                std::snprintf(line, sizeof line, "LB on %d %s, %d steps (%d planes and 2 halo planes of %.3g MB on rank 0), %.2f s", ranks,
+                              ranks == 1 ? "rank" : "ranks", st.steps, st.ownedPlanes, double(st.planeBytes) / 1e6, st.seconds);
+                bar.finish(line);
+                return writeLight(args, params, density, light, log, part, out, picture);
+            },
+            timeout);
+#endif
+    }
     if (args.has("--basis")) {
         const LightingBasis basis = lightingBasisFor(density, params, cache.get(), &bar.progress(), &log, compute.get());
         light = relight(basis, params);
@@ -84,6 +142,13 @@ int runLight(const Args& args)
         ubar.finish(ulog.stages.back());
         light = part == "uncollided" ? uncollided : lb::scatteredPart(light, uncollided);
     }
+    return writeLight(args, params, density, light, log, part, out, picture);
+}
+
+// The lighting grid's file, its summary line and the picture.
+int writeLight(const Args& args, const lb::LbParams& params, const DensityGrid& density, const LightingGrid& light, const JobLog& log,
+               const std::string& part, const std::string& out, const PictureOptions& picture)
+{
     for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
     // The sidecar records what produced the grid: the optics actually used (after any overrides).
     // A .vdb holds the density beside the lighting (one file for a renderer); .npy the lighting alone.
@@ -106,7 +171,6 @@ Command lightCommand()
             {{"--density", "FILE", "density grid: .npy from sylva voxelize, or .vdb (the float grid 'density', else the first float grid)"},
              {"--mesh", "FILE", "mesh to voxelize first (with --grid)"},
              kGrid, kSubcells, kLeafMaterials,
-             {"--solid", "", "with --mesh: voxelize it as a solid (interior filled, as sylva voxelize --solid; e.g. --preset pmma)"},
              {"--preset", "NAME", "leaf (default), dogrose, cloud or pmma"},
              {"--sigma-a", "R,G,B", "absorption per lattice step (one number: all channels)"},
              {"--sigma-s", "R,G,B", "scattering per lattice step; sigma_a + sigma_s <= 1"},
@@ -130,7 +194,10 @@ Command lightCommand()
              {"--coarse-start", "", "with --tol: solve on half-resolution grids first and start from that (fastest to a given error)"},
              kBackend,
              {"--output", "FILE", "output file (also -o): .npy (+ sidecar), or .vdb (lighting, its channels, density and wood fraction)"},
-             kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet},
+             kPicture, kSlices, kAxis, kCache, kNoCache, kThreads, kQuiet,
+             {"--mpi", "", "solve the grid in slabs along x across the ranks of an MPI job, halo planes exchanged every step, the "
+                           "single-process result to the bit: mpirun -np N sylva light --mpi ... (fixed steps; docs/DISTRIBUTED.md)"},
+             {"--mpi-timeout", "S", "with --mpi: end the job when a neighbour's halo is S seconds (plus 3 x the slowest step) late (default 10)"}},
             0, 0, &runLight};
 }
 

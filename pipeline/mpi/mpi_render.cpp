@@ -26,6 +26,7 @@
 #include "core/base/error.h"
 #include "core/base/version.h"
 #include "core/render/render_cpu.h"
+#include "pipeline/mpi/mpi_session.h"
 #include "pipeline/mpi/mpi_tiles.h"
 
 namespace sylva::mpi {
@@ -65,10 +66,14 @@ std::string hostName()
     return h;
 }
 
+// The command of this process's job ("render", "light") and what a failed job did not write.
+const char* g_command = "render";
+const char* g_notWritten = "no picture was written";
+
 // Reports an error on this rank's stderr and ends the whole job (every rank, exit 1).
 [[noreturn]] void abortJob(const std::string& message)
 {
-    std::fprintf(stderr, "sylva render: error: %s; no picture was written\n", message.c_str());
+    std::fprintf(stderr, "sylva %s: error: %s; %s\n", g_command, message.c_str(), g_notWritten);
     std::fflush(stderr);
     MPI_Abort(MPI_COMM_WORLD, 1);
     std::_Exit(1);
@@ -542,11 +547,14 @@ int launchRank()
     return 0;
 }
 
-int runRender(const RenderJob& job)
+int runSession(const char* command, const char* notWritten,
+               const std::function<int(int rank, int size, const std::vector<std::string>& hosts)>& body)
 {
+    g_command = command;
+    g_notWritten = notWritten;
     if (!launchedByMpi())
-        throw Error("--mpi: this process was not started by mpirun; run it as: mpirun -np N sylva render --mpi ... "
-                    "(docs/DISTRIBUTED.md), or drop --mpi");
+        throw Error(std::string("--mpi: this process was not started by mpirun; run it as: mpirun -np N sylva ") + command +
+                    " --mpi ... (docs/DISTRIBUTED.md), or drop --mpi");
     int provided = 0;
     if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) throw Error("--mpi: MPI_Init failed");
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
@@ -554,7 +562,7 @@ int runRender(const RenderJob& job)
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &size);
     if (provided < MPI_THREAD_FUNNELED) {
-        if (rank == 0) std::fprintf(stderr, "sylva render: error: --mpi: this MPI library does not allow threads (MPI_THREAD_FUNNELED)\n");
+        if (rank == 0) std::fprintf(stderr, "sylva %s: error: --mpi: this MPI library does not allow threads (MPI_THREAD_FUNNELED)\n", command);
         MPI_Finalize();
         return 1;
     }
@@ -567,14 +575,27 @@ int runRender(const RenderJob& job)
     }
     if (!mismatch.empty()) {
         if (rank == 0)
-            std::fprintf(stderr, "sylva render: error: --mpi: the ranks run different builds of sylva (%s); install one build on every node\n",
-                         mismatch.c_str());
+            std::fprintf(stderr, "sylva %s: error: --mpi: the ranks run different builds of sylva (%s); install one build on every node\n",
+                         command, mismatch.c_str());
         MPI_Finalize();
         return 1;
     }
-    const int code = rank == 0 ? lead(job, size, hosts) : work(job, rank, size);
+    const int code = body(rank, size, hosts);
     MPI_Finalize();
     return code;
+}
+
+[[noreturn]] void endJob(const std::string& message) { abortJob(message); }
+
+void checkMpi(int rc, const char* what) { check(rc, what); }
+
+std::string thisHost() { return hostName(); }
+
+int runRender(const RenderJob& job)
+{
+    return runSession("render", "no picture was written", [&](int rank, int size, const std::vector<std::string>& hosts) {
+        return rank == 0 ? lead(job, size, hosts) : work(job, rank, size);
+    });
 }
 
 } // namespace sylva::mpi
