@@ -1,7 +1,10 @@
 // The CUDA backend: device selection, the LB solve and the frame behind the Backend interface.
 #include "cuda/cuda_backend.h"
 
+#include <cstdio>
 #include <utility>
+
+#include "core/base/launch_env.h"
 
 #include "cuda/cuda_check.h"
 #include "cuda/device_query.h"
@@ -76,7 +79,14 @@ std::unique_ptr<Backend> makeCudaBackend(std::string* why)
         if (why) *why = q.message.empty() ? "no CUDA device" : q.message;
         return nullptr;
     }
-    return std::make_unique<CudaBackend>(q.devices.front());
+    // Under an MPI launcher every rank of a node would take the first device: rank k on the node takes
+    // device k mod count instead (one GPU per rank with --map-by ppr:G:node), and says which.
+    const int local = launcherLocalRank();
+    const size_t pick = local >= 0 ? size_t(local) % q.devices.size() : 0;
+    const DeviceInfo& d = q.devices[pick];
+    if (local >= 0)
+        std::fprintf(stderr, "note: local rank %d uses CUDA device %d of %zu (%s)\n", local, d.index, q.devices.size(), d.name.c_str());
+    return std::make_unique<CudaBackend>(d);
 }
 
 std::unique_ptr<DeviceDisplay> makeCudaDisplay(std::string* why)
