@@ -88,7 +88,8 @@ int runLight(const Args& args)
     if (part != "all" && part != "scattered" && part != "uncollided")
         throw UsageError("option --part: expected all, scattered or uncollided, got '" + part + "'");
     JobLog log;
-    const VoxelizeSettings voxel = voxelSettings(args);
+    VoxelizeSettings voxel = voxelSettings(args);
+    voxel.solid = args.has("--solid");   // plastics: the interior filled (winding numbers), as sylva voxelize --solid
     rejectMeshOptionsWithDensity(args);
     const PictureOptions picture = pictureOptions(args);
     const std::string out = outputFile(args, gridFileExtensions());
@@ -171,6 +172,7 @@ Command lightCommand()
             {{"--density", "FILE", "density grid: .npy from sylva voxelize, or .vdb (the float grid 'density', else the first float grid)"},
              {"--mesh", "FILE", "mesh to voxelize first (with --grid)"},
              kGrid, kSubcells, kLeafMaterials,
+             {"--solid", "", "with --mesh: voxelize it as a solid (interior filled, as sylva voxelize --solid; e.g. --preset pmma)"},
              {"--preset", "NAME", "leaf (default), dogrose, cloud or pmma"},
              {"--sigma-a", "R,G,B", "absorption per lattice step (one number: all channels)"},
              {"--sigma-s", "R,G,B", "scattering per lattice step; sigma_a + sigma_s <= 1"},
