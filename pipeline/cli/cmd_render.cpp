@@ -79,6 +79,15 @@ Scene sceneForArgs(const Args& args, std::string* stem)
         if (m < 0.0 || m > 1e30) throw UsageError(std::string("option ") + option + ": expected metres >= 0 (0: off), got " + args.get(option));
         *field = float(m);
     }
+    if (args.has("--volume-tracer")) {
+        VolumeTracer t;
+        if (!parseVolumeTracer(args.get("--volume-tracer"), &t))
+            throw UsageError("option --volume-tracer: expected lb, single or combined, got '" + args.get("--volume-tracer") + "'");
+        for (VolumeDesc& v : scene.volumes) {
+            v.tracer = t;
+            v.lit = t != VolumeTracer::Single;   // single scattering solves no LB grid
+        }
+    }
     return scene;
 }
 
@@ -244,6 +253,9 @@ Command renderCommand()
              kSunAt,
              {"--alpha-distance", "M", "skip leaf cut-out tests beyond M metres from the camera (0: off, default)"},
              {"--prune-distance", "M", "prune leaves of plants beyond M metres, area-preserving (0: off, default)"},
+             {"--volume-tracer", "lb|single|combined", "every volume's tracer, replacing its scene's `tracer` (default lb, the "
+                                                       "accuracy study's pick: docs/ACCURACY.md \"Volumes\"); single: sun single "
+                                                       "scattering with shadow marches, combined: single + the LB's multiple scattering"},
              kBackend,
              {"--band-rows", "N", "trace and write the frame in bands of N rows (default: only when the whole frame does not fit in memory)"},
              {"--passes", "", "write one multi-layer EXR (32-bit float) of the render passes: Combined, DiffDir, DiffInd, DiffCol, Env, Normal, Depth, Alpha (docs/RENDERING.md); default output NAME.exr"},
