@@ -47,7 +47,11 @@ Scene lightSceneVolumes(const Scene& scene, GridCache* cache, bool needLighting,
             if (progress && progress->isCancelled()) sub.cancel();
             const lb::LbParams p = volumeLightingParams(s, v);
             JobLog own;
-            data->lighting = lightingFor(data->density, p, cache, &sub, &own, backend);
+            try {
+                data->lighting = lightingFor(data->density, p, cache, &sub, &own, backend);
+            } catch (const Error& e) {   // e.g. sigma_t over the LB's stability bound: name the volume
+                throw Error("volume '" + v.name + "': " + e.what() + " (the LB solve of tracers lb and combined; single needs none)");
+            }
             if (log) {
                 for (const auto& st : own.stages) log->stages.push_back(v.name + ": " + st);
                 for (const auto& w : own.warnings) log->warnings.push_back(v.name + ": " + w);

@@ -346,6 +346,99 @@ private Q_SLOTS:
             QVERIFY(readDensityFile((d + "/t.npy").toStdString()).density == voxelize(mesh, s).density);
         }
     }
+
+    // Bad volume input in a scene (issue 17 item 9): negative, NaN and over-range densities, a grid of
+    // size 0, optics out of range (sigma < 0, g outside [-1, 1], sigma_t over the LB's bound of 1 for a
+    // tracer that solves the LB) each exit 1 with the volume or file named and write no picture; single
+    // scattering needs no LB and takes that medium. --volume-tracer replaces every volume's tracer: its
+    // picture is the one of the scene file saying the same, and a name it does not know exits 2.
+    void badVolumeInputAndTracerFlag()
+    {
+        QTemporaryDir dir;
+        const std::string d = dir.path().toStdString();
+        auto grid = [&](const char* name, float last, glm::ivec3 dims = glm::ivec3(6)) {
+            DensityGrid g;
+            g.geometry.dims = dims;
+            g.geometry.spacing = 0.5;
+            g.density.assign(g.geometry.nodeCount(), 0.5f);
+            if (!g.density.empty()) g.density.back() = last;
+            g.woodFraction.assign(g.density.size(), 0.0f);
+            const std::string path = d + "/" + name + ".npy";
+            if (dims.x > 0) writeDensityFile(path, g);
+            return path;
+        };
+        auto scene = [&](const char* name, const std::string& gridPath, const std::string& extra) {
+            const std::string path = d + "/" + name + ".sylva.json";
+            std::FILE* f = std::fopen(path.c_str(), "w");
+            std::fprintf(f,
+                         "{\"version\": 1, \"species\": [{\"name\": \"s\", \"grow\": {\"species\": \"shrub\", \"triangles\": 2000}, "
+                         "\"lighting\": {\"grid\": 8}}], \"instances\": [{\"species\": \"s\", \"position\": [0, 0, 6]}], "
+                         "\"volumes\": [{\"name\": \"puff\", \"grid\": \"%s\"%s, \"instances\": [{\"position\": [0, 1.5, 3]}]}], "
+                         "\"camera\": {\"position\": [0, 1.5, -3], \"target\": [0, 1.5, 3]}, \"render\": {\"width\": 24, \"height\": 16}}",
+                         gridPath.c_str(), extra.c_str());
+            std::fclose(f);
+            return QString::fromStdString(path);
+        };
+        using sylva::test::runSylva;
+        const QString out = QString::fromStdString(d + "/out.png");   // PNG: no timestamp in the file
+        auto refused = [&](const QString& file, const char* says, const QStringList& more = {}) {
+            const auto r = runSylva(QStringList{"render", file, "--no-cache", "--quiet", "-o", out} + more);
+            QVERIFY2(r.code == 1, qPrintable(file + ": " + r.err));
+            QVERIFY2(r.err.contains(says), qPrintable(r.err));
+            QVERIFY(!QFile::exists(out));
+        };
+        const std::string good = grid("good", 0.5f);
+        refused(scene("neg", grid("neg", -0.25f), ""), "holds -0.25");
+        refused(scene("nan", grid("nan", std::nanf("")), ""), "holds nan");
+        refused(scene("over", grid("over", 0.6f), ", \"density_scale\": 2"), "in [0, 1]");
+        {   // a grid of size 0: a .npy of shape (0, 6, 6) beside a valid sidecar
+            grid("empty_src", 0.5f);
+            QFile::copy(QString::fromStdString(d + "/empty_src.npy.json"), QString::fromStdString(d + "/empty.npy.json"));
+            QFile f(QString::fromStdString(d + "/empty.npy"));
+            QVERIFY(f.open(QIODevice::WriteOnly));
+            std::string header = "{'descr': '<f4', 'fortran_order': False, 'shape': (0, 6, 6), }";
+            header.append(size_t(63 - (header.size() + 10) % 64), ' ');
+            header += '\n';
+            const char magic[8] = {'\x93', 'N', 'U', 'M', 'P', 'Y', 1, 0};
+            f.write(magic, 8);
+            const char len[2] = {char(header.size() & 0xff), char(header.size() >> 8)};
+            f.write(len, 2);
+            f.write(header.data(), qint64(header.size()));
+            f.close();
+            refused(scene("empty", d + "/empty.npy", ""), "zero-sized");
+        }
+        refused(scene("siga", good, ", \"sigma_a\": -0.1"), "must be >= 0");
+        refused(scene("g", good, ", \"g\": 1.5"), "g must lie in [-1, 1]");
+        refused(scene("lbbound", good, ", \"sigma_s\": 3"), "volume 'puff'");   // sigma_t 3.008 x density 0.5 > 1
+
+        // The same medium under single scattering: no LB solve, a finite picture.
+        auto r = runSylva({"render", scene("lbbound_single", good, ", \"sigma_s\": 3, \"tracer\": \"single\""), "--no-cache", "--quiet", "-o", out});
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QFile::remove(out);
+
+        // --volume-tracer against the scene key.
+        auto bytes = [&](const QStringList& args) {
+            const auto run = runSylva(args);
+            if (run.code != 0) qWarning("%s", qPrintable(run.err));
+            QFile f(out);
+            QByteArray b = f.open(QIODevice::ReadOnly) ? f.readAll() : QByteArray();
+            f.close();
+            QFile::remove(out);
+            return b;
+        };
+        const QString plain = scene("plain", good, ""), single = scene("single", good, ", \"tracer\": \"single\"");
+        const QByteArray flagSingle = bytes({"render", plain, "--volume-tracer", "single", "--no-cache", "--quiet", "-o", out});
+        const QByteArray keySingle = bytes({"render", single, "--no-cache", "--quiet", "-o", out});
+        const QByteArray lb = bytes({"render", single, "--volume-tracer", "lb", "--no-cache", "--quiet", "-o", out});
+        const QByteArray keyLb = bytes({"render", plain, "--no-cache", "--quiet", "-o", out});
+        QVERIFY(!flagSingle.isEmpty() && !lb.isEmpty());
+        QCOMPARE(flagSingle, keySingle);
+        QCOMPARE(lb, keyLb);
+        QVERIFY(flagSingle != lb);
+        r = runSylva({"render", plain, "--volume-tracer", "fog", "--no-cache", "--quiet", "-o", out});
+        QCOMPARE(r.code, 2);
+        QVERIFY(r.err.contains("lb, single or combined"));
+    }
 };
 
 QTEST_GUILESS_MAIN(TestVolumeSources)
