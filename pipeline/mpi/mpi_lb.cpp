@@ -22,6 +22,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double g_timeout = 10.0;   // runLightSession's
+constexpr int kTestsBetweenPlanes = 256;
 
 // Halo tags: a plane travelling toward lower ranks, or toward higher ranks.
 enum Tag : int { kToLower = 21, kToHigher = 22, kTotals = 23 };
@@ -129,10 +130,14 @@ LightingGrid solveDistributed(const DensityGrid& density, const lb::LbParams& pa
                 reqs.emplace_back();
                 checkMpi(MPI_Isend(slab->plane(X - 2), planeBytes, MPI_BYTE, higher, kToHigher, MPI_COMM_WORLD, &reqs.back()), "Isend");
             }
+            // A large message over shared memory moves a bounded number of fragments per progress call, so
+            // between planes the requests are tested repeatedly (each test is cheap) for the transfer to
+            // keep pace with the planes instead of waiting for the end of the step.
             int flag = 0;
             for (int x = 1; x < X - 1; ++x) {
                 slab->stepPlanes(x, x + 1);
-                if (!flag && !reqs.empty()) checkMpi(MPI_Testall(int(reqs.size()), reqs.data(), &flag, MPI_STATUSES_IGNORE), "Testall");
+                for (int i = 0; i < kTestsBetweenPlanes && !flag && !reqs.empty(); ++i)
+                    checkMpi(MPI_Testall(int(reqs.size()), reqs.data(), &flag, MPI_STATUSES_IGNORE), "Testall");
             }
             if (flag) reqs.clear();
             const Clock::time_point ti = Clock::now();
