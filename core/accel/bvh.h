@@ -11,6 +11,7 @@
 
 #include "core/accel/ray.h"
 #include "core/base/defines.h"
+#include "core/base/traversal_stats.h"
 #include "core/mesh/triangle_mesh.h"
 
 namespace sylva {
@@ -69,13 +70,7 @@ struct BvhViewT {
 using BvhView = BvhViewT<BvhNode>;
 using BvhView8 = BvhViewT<BvhNode8>;
 
-// Optional traversal counters for profiling tools (compiled in only with SYLVA_TRAVERSAL_STATS).
-#if defined(SYLVA_TRAVERSAL_STATS) && !defined(__CUDA_ARCH__)
-inline thread_local uint64_t g_bvhNodeVisits = 0, g_bvhLeafVisits = 0;
-#define SYLVA_COUNT(counter) (++(counter))
-#else
-#define SYLVA_COUNT(counter) ((void)0)
-#endif
+// Optional traversal counters (g_bvhNodeVisits, g_bvhLeafVisits): core/base/traversal_stats.h.
 
 // Every visit pushes at most W - 1 children; build depth is capped below 64.
 template <int W>

@@ -210,6 +210,7 @@ SYLVA_HD inline bool traceMesh(Query& q, const GeometryRecord& geo, const glm::v
         const TriAccel* tris = v.tris + geo.triOffset;
         auto triFn = [&](uint32_t s, float& t) {
             float u, w;
+            SYLVA_COUNT(g_triangleTests);
             if (!hitTriangle(v, tris[s], o, d, tmin, t, u, w, tAlpha)) return false;
             if (!AnyHit) recordHit<Depth>(q, t, u, w, tris[s].tri);
             return AnyHit;
@@ -221,6 +222,7 @@ SYLVA_HD inline bool traceMesh(Query& q, const GeometryRecord& geo, const glm::v
         auto blockFn = [&](uint32_t block, uint32_t count, float& t) {
             float u, w;
             uint32_t tri;
+            SYLVA_COUNT_ADD(g_triangleTests, count);
             if (!hitBlock<AnyHit>(v, blocks[block], count, o, d, tmin, t, u, w, tri, tAlpha)) return false;
             if (!AnyHit) recordHit<Depth>(q, t, u, w, tri);
             return AnyHit;

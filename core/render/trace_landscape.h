@@ -62,58 +62,82 @@ SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, 
     const LandCell c = v.landCells[cell];
     const TileRecord& tile = v.tileRecords[c.tile];
     if (tile.plantCount == 0) return false;
+    SYLVA_COUNT(g_landCellVisits);
     const uint32_t cx = cell % v.land.cellsX, cz = cell / v.land.cellsX;
     const float ik = v.land.invTileScale;
     const glm::vec3 corner = landCellCorner(v, cx, cz);
     const glm::vec3 ot = (o - corner) * ik, dt = d * ik;   // the tile frame (t unchanged)
     const glm::vec3 inv = safeReciprocal(dt);
-    const float yLo = c.ground.x * ik + tile.yLo, yHi = c.ground.y * ik + tile.yHi;   // the cell corner lies at the terrain frame's y = 0
-    uint32_t stack[64];
+    const float gLo = c.ground.x * ik, gHi = c.ground.y * ik;   // the cell corner lies at the terrain frame's y = 0
+    // A node's box: its rectangle, its plants' vertical extent raised anywhere in the cell's ground range.
+    auto entry = [&](const TileNode& n) {
+        return rayBoxEntry(glm::vec3(n.lox, gLo + n.ylo, n.loz), glm::vec3(n.hix, gHi + n.yhi, n.hiz), ot, inv, q.tmin, tmax);
+    };
+    // Every node's box is tested once, by its parent (the root here): the stack keeps the entry distance of
+    // each deferred child, re-checked against the closest hit when it comes up.
+    uint32_t stackNode[64];
+    float stackDist[64];
     int top = 0;
-    stack[top++] = tile.nodeOffset;
-    while (top > 0) {
-        const TileNode& n = v.tileNodes[stack[--top]];
-        if (!(rayBoxEntry(glm::vec3(n.lox, yLo, n.loz), glm::vec3(n.hix, yHi, n.hiz), ot, inv, q.tmin, tmax) <= tmax)) continue;
+    if (!(entry(v.tileNodes[tile.nodeOffset]) <= tmax)) return false;
+    uint32_t node = tile.nodeOffset;
+    const HeightFieldView heights = landHeights(v);
+    for (;;) {
+        const TileNode& n = v.tileNodes[node];
+        SYLVA_COUNT(g_tileNodeVisits);
         if (n.count == 0) {
-            // Nearer child last (popped first), by entry distance.
-            const TileNode& a = v.tileNodes[n.first];
-            const TileNode& b = v.tileNodes[n.first + 1];
-            const float ta = rayBoxEntry(glm::vec3(a.lox, yLo, a.loz), glm::vec3(a.hix, yHi, a.hiz), ot, inv, q.tmin, tmax);
-            const float tb = rayBoxEntry(glm::vec3(b.lox, yLo, b.loz), glm::vec3(b.hix, yHi, b.hiz), ot, inv, q.tmin, tmax);
+            // Nearer child first, the farther one deferred, by entry distance.
+            const float ta = entry(v.tileNodes[n.first]), tb = entry(v.tileNodes[n.first + 1]);
             const bool ha = ta <= tmax, hb = tb <= tmax;
             if (ha && hb) {
                 const bool aFirst = ta <= tb;
-                stack[top++] = aFirst ? n.first + 1 : n.first;
-                stack[top++] = aFirst ? n.first : n.first + 1;
-            } else if (ha) {
-                stack[top++] = n.first;
-            } else if (hb) {
-                stack[top++] = n.first + 1;
-            }
-            continue;
-        }
-        for (uint32_t k = n.first; k < n.first + n.count; ++k) {
-            const TilePlant& p = v.tilePlants[k];
-            // The plant's box raised anywhere in the cell's ground range first (tile frame): most plants of a
-            // leaf are rejected before the height field is read.
-            if (!(rayBoxEntry(glm::vec3(p.x + p.lo.x, c.ground.x * ik + p.lo.y, p.z + p.lo.z), glm::vec3(p.x + p.hi.x, c.ground.y * ik + p.hi.y, p.z + p.hi.z),
-                              ot, inv, q.tmin, tmax) <= tmax))
+                SYLVA_KERNEL_ASSERT(top < 64);
+                stackNode[top] = aFirst ? n.first + 1 : n.first;
+                stackDist[top] = aFirst ? tb : ta;
+                ++top;
+                node = aFirst ? n.first : n.first + 1;
                 continue;
-            glm::vec3 root;
-            if (!landPlantRoot(v, cell, p, root)) continue;
-            const glm::vec3 op = (o - root) * ik;   // the plant-centred tile frame
-            if (!(rayBoxEntry(p.lo, p.hi, op, inv, q.tmin, tmax) <= tmax)) continue;
-            InstanceRecord in{};
-            in.row[0] = p.row[0];
-            in.row[1] = p.row[1];
-            in.row[2] = p.row[2];
-            const GeometryRecord& geo = v.geometries[p.geometry];
-            q.path[1] = cell;
-            q.path[2] = k;
-            if (traceMesh<AnyHit, Kd, 2>(q, geo, toLocalPoint(in, op), toLocalDir(in, dt), tmax)) return true;
+            }
+            if (ha || hb) {
+                node = ha ? n.first : n.first + 1;
+                continue;
+            }
+        } else {
+            for (uint32_t k = n.first; k < n.first + n.count; ++k) {
+                const TilePlant& p = v.tilePlants[k];
+                SYLVA_COUNT(g_plantBoxTests);
+                // The plant's box raised anywhere in the cell's ground range first (tile frame): most plants of a
+                // leaf are rejected before the height field is read.
+                if (!(rayBoxEntry(glm::vec3(p.x + p.lo.x, gLo + p.lo.y, p.z + p.lo.z), glm::vec3(p.x + p.hi.x, gHi + p.hi.y, p.z + p.hi.z), ot, inv,
+                                  q.tmin, tmax) <= tmax))
+                    continue;
+                // Its root on the ground, its box there, and only then whether it grows (density, snow, rock).
+                SYLVA_COUNT(g_plantRootReads);
+                float y;
+                uint32_t tri;
+                if (!landPlantHeight(v.land, heights, cx, cz, p, y, tri)) continue;
+                const glm::vec3 root = corner + glm::vec3(v.land.tileScale * p.x, y, v.land.tileScale * p.z);
+                const glm::vec3 op = (o - root) * ik;   // the plant-centred tile frame
+                if (!(rayBoxEntry(p.lo, p.hi, op, inv, q.tmin, tmax) <= tmax)) continue;
+                if (!landPlantKept(v.land, heights, v.terrainSnowY, v.terrainRockCos, p, y, tri)) continue;
+                InstanceRecord in{};
+                in.row[0] = p.row[0];
+                in.row[1] = p.row[1];
+                in.row[2] = p.row[2];
+                const GeometryRecord& geo = v.geometries[p.geometry];
+                SYLVA_COUNT(g_plantMeshEntries);
+                q.path[1] = cell;
+                q.path[2] = k;
+                if (traceMesh<AnyHit, Kd, 2>(q, geo, toLocalPoint(in, op), toLocalDir(in, dt), tmax)) return true;
+            }
         }
+        // The nearest deferred node still in reach.
+        for (;;) {
+            if (top == 0) return false;
+            --top;
+            if (stackDist[top] <= tmax) break;
+        }
+        node = stackNode[top];
     }
-    return false;
 }
 
 // The landscape's plants along the ray: its cells' 2D kd-tree top-down, near child first, a node skipped
@@ -134,6 +158,7 @@ SYLVA_HD inline bool traceLandscape(Query& q, const glm::vec3& o, const glm::vec
     while (top > 0) {
         const Entry e = stack[--top];
         const LandNode& n = v.landNodes[e.node];
+        SYLVA_COUNT(g_landNodeVisits);
         const glm::vec3 lo = landCellCorner(v, e.x0, e.z0), hi = landCellCorner(v, e.x1, e.z1);
         if (!(rayBoxEntry(glm::vec3(lo.x, v.landBase.y + n.range.x, lo.z), glm::vec3(hi.x, v.landBase.y + n.range.y, hi.z), o, inv, q.tmin, tmax) <= tmax))
             continue;

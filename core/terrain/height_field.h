@@ -9,6 +9,7 @@
 
 #include "core/accel/ray.h"
 #include "core/base/defines.h"
+#include "core/base/traversal_stats.h"
 
 namespace sylva {
 
@@ -116,6 +117,7 @@ SYLVA_HD SYLVA_INLINE bool intersectBlock(const HeightFieldView& h, uint32_t bi,
         const float s01 = sampleAt(h, uint32_t(ci), uint32_t(cj) + 1), s11 = sampleAt(h, uint32_t(ci) + 1, uint32_t(cj) + 1);
         const float clo = minf(minf(s00, s10), minf(s01, s11)), chi = maxf(maxf(s00, s10), maxf(s01, s11));
         const float pad = 1e-5f * (fabsf(ya) + fabsf(yb) + fabsf(clo) + fabsf(chi)) + 1e-6f;
+        SYLVA_COUNT(g_terrainCellTests);
         if (!(minf(ya, yb) > chi + pad || maxf(ya, yb) < clo - pad) &&
             intersectCell(h, uint32_t(ci), uint32_t(cj), org, dir, tmin, tmax, prim, u, v))
             return true;
@@ -153,6 +155,7 @@ SYLVA_HD SYLVA_INLINE bool intersectHeightField(const HeightFieldView& h, const 
     const float cellsX = float(h.layout.nx - 1), cellsZ = float(h.layout.nz - 1);
     while (top > 0) {
         const Entry e = stack[--top];
+        SYLVA_COUNT(g_terrainBlockVisits);
         const float span = float(kHeightBlock << e.level);
         const glm::vec2 r = h.ranges[h.layout.levelOffset[e.level] + e.bj * h.layout.levelWidth[e.level] + e.bi];
         const float bx = float(h.baseI), bz = float(h.baseJ);

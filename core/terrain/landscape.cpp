@@ -133,16 +133,17 @@ void buildTileTree(std::vector<TilePlant>& plants, uint32_t plantBase, std::vect
     while (!todo.empty()) {
         const Item it = todo.back();
         todo.pop_back();
-        float lox = 3e38f, loz = 3e38f, hix = -3e38f, hiz = -3e38f;
+        float lox = 3e38f, loz = 3e38f, hix = -3e38f, hiz = -3e38f, ylo = 3e38f, yhi = -3e38f;
         float cx0 = 3e38f, cz0 = 3e38f, cx1 = -3e38f, cz1 = -3e38f;
         for (uint32_t k = it.first; k < it.first + it.count; ++k) {
             const TilePlant& p = plants[k];
             lox = std::min(lox, p.x + p.lo.x), loz = std::min(loz, p.z + p.lo.z);
             hix = std::max(hix, p.x + p.hi.x), hiz = std::max(hiz, p.z + p.hi.z);
+            ylo = std::min(ylo, p.lo.y), yhi = std::max(yhi, p.hi.y);
             cx0 = std::min(cx0, p.x), cx1 = std::max(cx1, p.x), cz0 = std::min(cz0, p.z), cz1 = std::max(cz1, p.z);
         }
         TileNode& n = nodes[it.node];
-        n.lox = lox, n.loz = loz, n.hix = hix, n.hiz = hiz;
+        n.lox = lox, n.loz = loz, n.hix = hix, n.hiz = hiz, n.ylo = ylo, n.yhi = yhi;
         if (it.count <= 4) {
             n.first = plantBase + it.first;
             n.count = it.count;
@@ -350,7 +351,7 @@ LandscapeBuild buildLandscape(const HeightField& field, uint32_t cells, const Ti
         if (ps.empty()) e = glm::vec4(0.0f, 0.0f, float(tiles.size), float(tiles.size));
         extent[t] = e;
         if (!ps.empty()) buildTileTree(ps, r.plantOffset, b.tileNodes);
-        else b.tileNodes.push_back(TileNode{1.0f, 1.0f, 0.0f, 0.0f, r.plantOffset, 0});   // an empty box
+        else b.tileNodes.push_back(TileNode{1.0f, 1.0f, 0.0f, 0.0f, 1.0f, 0.0f, r.plantOffset, 0});   // an empty box
         b.plants.insert(b.plants.end(), ps.begin(), ps.end());
         b.stats.plantsPerTileMin = std::min(b.stats.plantsPerTileMin, ps.size());
         b.stats.plantsPerTileMax = std::max(b.stats.plantsPerTileMax, ps.size());

@@ -58,11 +58,14 @@ struct TileRecord {
     float pad2[2];
 };
 
-// A node of a tile's 2D tree: a horizontal rectangle (tile frame); its height is the tile's, raised by the
-// cell's ground range at traversal. count > 0: a leaf of plants [first, first + count) (tilePlants, absolute);
-// else children first and first + 1 (tileNodes, absolute). 24 bytes.
+// A node of a tile's 2D tree: a horizontal rectangle (tile frame) and the vertical extent [ylo, yhi] of its
+// plants' boxes in the plant-centred frame (root at 0), raised by the cell's ground range at traversal (splits
+// stay horizontal-only; the per-node extent only lowers the top over short plants). count > 0: a leaf of plants
+// [first, first + count) (tilePlants, absolute); else children first and first + 1 (tileNodes, absolute).
+// 32 bytes.
 struct TileNode {
     float lox, loz, hix, hiz;
+    float ylo, yhi;
     uint32_t first, count;
 };
 
@@ -203,10 +206,11 @@ SYLVA_HD inline float groundHeightAt(const HeightFieldView& h, float x, float z,
     return h00 + r * (h01 - h00) + s * (h11 - h01);
 }
 
-// Eq. 2: p = (a (id_inst + id_tile) mod m) / (m - 1).
+// Eq. 2: p = (a (id_inst + id_tile) mod m) / (m - 1) (a mask for the usual power-of-two m: no 64-bit division).
 SYLVA_HD SYLVA_INLINE float densityValue(uint32_t id, uint32_t a, uint32_t m)
 {
-    return float((uint64_t(a) * uint64_t(id)) % uint64_t(m)) / float(m - 1);
+    const uint64_t x = uint64_t(a) * uint64_t(id);
+    return float((m & (m - 1u)) == 0u ? (x & uint64_t(m - 1u)) : x % uint64_t(m)) / float(m - 1);
 }
 
 // Eq. 3: the threshold at terrain-frame height y, linear between the tree lines and clamped beyond them.
@@ -218,19 +222,34 @@ SYLVA_HD SYLVA_INLINE float densityThreshold(const LandscapeLayout& L, float y)
     return L.dLower + c * (L.dUpper - L.dLower);
 }
 
+// Where plant `p` of cell (cx, cz) stands: its DEM-frame root height `y` and the ground triangle `tri` there;
+// false off the terrain.
+SYLVA_HD SYLVA_INLINE bool landPlantHeight(const LandscapeLayout& L, const HeightFieldView& h, uint32_t cx, uint32_t cz, const TilePlant& p, float& y,
+                                           uint32_t& tri)
+{
+    const float x = float(cx) * L.cellSize + L.tileScale * p.x, z = float(cz) * L.cellSize + L.tileScale * p.z;
+    y = groundHeightAt(h, x, z, tri);
+    return y == y;
+}
+
+// Whether a plant standing at height y on triangle tri is kept: by the density rule (p <= d), not on snow or
+// rock when those masks are on. (The traversal asks only for plants whose lifted box the ray enters.)
+SYLVA_HD SYLVA_INLINE bool landPlantKept(const LandscapeLayout& L, const HeightFieldView& h, float snowY, float rockCos, const TilePlant& p, float y,
+                                         uint32_t tri)
+{
+    if (L.densityOn && densityValue(p.densityId, L.a, L.m) > densityThreshold(L, y)) return false;
+    if (L.noSnow && y > snowY) return false;
+    if (L.noRock && heightFieldNormal(h, tri).y < rockCos) return false;
+    return true;
+}
+
 // Where plant `p` of cell (cx, cz) stands (DEM-frame root height `y`) and whether it grows there: on the
 // terrain, kept by the density rule (p <= d), not on snow or rock when those masks are on.
 SYLVA_HD inline bool landPlantGrows(const LandscapeLayout& L, const HeightFieldView& h, float snowY, float rockCos, uint32_t cx, uint32_t cz,
                                     const TilePlant& p, float& y)
 {
-    const float x = float(cx) * L.cellSize + L.tileScale * p.x, z = float(cz) * L.cellSize + L.tileScale * p.z;
     uint32_t tri = 0;
-    y = groundHeightAt(h, x, z, tri);
-    if (!(y == y)) return false;   // off the terrain
-    if (L.densityOn && densityValue(p.densityId, L.a, L.m) > densityThreshold(L, y)) return false;
-    if (L.noSnow && y > snowY) return false;
-    if (L.noRock && heightFieldNormal(h, tri).y < rockCos) return false;
-    return true;
+    return landPlantHeight(L, h, cx, cz, p, y, tri) && landPlantKept(L, h, snowY, rockCos, p, y, tri);
 }
 
 } // namespace sylva

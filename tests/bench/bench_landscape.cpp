@@ -7,8 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <memory>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -23,6 +25,9 @@
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "tests/bench/bench_timing.h"
+#ifdef SYLVA_HAVE_EMBREE
+#include "tests/bench/bench_embree.h"
+#endif
 
 using namespace sylva;
 
@@ -52,6 +57,121 @@ double keptFraction(const RenderView& v)
     return all > 0.0 ? kept / all : 0.0;
 }
 
+#ifdef SYLVA_HAVE_EMBREE
+// The landscape flattened for Embree 3: the terrain as one indexed triangle mesh (the height field's triangles,
+// camera-relative), every plant that grows (landPlantGrows) as an instance of its species' scene with the
+// landscape's own map (landPlantInstance) inverted. Stops adding instances once Embree's bytes pass `capBytes`
+// (complete = false: Embree cannot hold this landscape under the cap).
+struct EmbreeLandscape {
+    RTCDevice device = nullptr;
+    RTCScene top = nullptr;
+    std::vector<RTCScene> species;
+    std::vector<std::unique_ptr<bench::EmbreeGeomData>> geomData;
+    long long bytes = 0;
+    size_t instances = 0;
+    bool complete = true;
+    double buildSeconds = 0.0;
+
+    EmbreeLandscape(const RenderScene& rs, const RenderView& v, int threads, long long capBytes)
+    {
+        const std::string config = "threads=" + std::to_string(threads);
+        device = rtcNewDevice(config.c_str());
+        if (!device) throw std::runtime_error("rtcNewDevice failed");
+        rtcSetDeviceErrorFunction(device, bench::embreeError, nullptr);
+        rtcSetDeviceMemoryMonitorFunction(device, bench::embreeMemoryMonitor, nullptr);
+        const long long base = bench::g_embreeBytes.load();
+        const double t0 = bench::now();
+        species = bench::embreeSpeciesScenes(device, rs, v, RTC_BUILD_QUALITY_MEDIUM, geomData, false);
+        top = rtcNewScene(device);
+        rtcSetSceneBuildQuality(top, RTC_BUILD_QUALITY_MEDIUM);
+        // The terrain: sample (i, j) at terrainBase + ((i - baseI) dx, h, (j - baseJ) dz); triangles 2c = (p00, p11,
+        // p10), 2c + 1 = (p00, p01, p11) as height_field.h splits its cells.
+        const HeightFieldLayout& H = v.terrain;
+        RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+        auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), size_t(H.nx) * H.nz));
+        for (uint32_t j = 0; j < H.nz; ++j)
+            for (uint32_t i = 0; i < H.nx; ++i) {
+                const size_t k = size_t(j) * H.nx + i;
+                vb[3 * k + 0] = v.terrainBase.x + float(int(i) - v.terrainBaseI) * H.dx;
+                vb[3 * k + 1] = v.terrainBase.y + v.terrainHeights[k];
+                vb[3 * k + 2] = v.terrainBase.z + float(int(j) - v.terrainBaseJ) * H.dz;
+            }
+        const size_t cellsT = size_t(H.nx - 1) * (H.nz - 1);
+        auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), 2 * cellsT));
+        for (uint32_t j = 0; j + 1 < H.nz; ++j)
+            for (uint32_t i = 0; i + 1 < H.nx; ++i) {
+                const size_t c = size_t(j) * (H.nx - 1) + i;
+                const uint32_t p00 = j * H.nx + i, p10 = p00 + 1, p01 = p00 + H.nx, p11 = p01 + 1;
+                const uint32_t t[6] = {p00, p11, p10, p00, p01, p11};
+                for (int q = 0; q < 6; ++q) ib[6 * c + size_t(q)] = t[q];
+            }
+        rtcCommitGeometry(g);
+        const unsigned terrainId = rtcAttachGeometry(top, g);
+        rtcReleaseGeometry(g);
+        (void)terrainId;
+        const HeightFieldView h{v.terrain, v.terrainHeights, v.terrainRanges};
+        for (uint32_t cell = 0; cell < v.land.cellsX * v.land.cellsZ && complete; ++cell) {
+            const LandCell& c = v.landCells[cell];
+            const TileRecord& t = v.tileRecords[c.tile];
+            const uint32_t cx = cell % v.land.cellsX, cz = cell / v.land.cellsX;
+            for (uint32_t q = t.plantOffset; q < t.plantOffset + t.plantCount; ++q) {
+                float y;
+                if (!landPlantGrows(v.land, h, v.terrainSnowY, v.terrainRockCos, cx, cz, v.tilePlants[q], y)) continue;
+                const InstanceRecord in = trace_detail::landPlantInstance(v, cell, q);
+                float xfm[12];
+                bench::embreeInstanceTransform(in, xfm);
+                RTCGeometry gi = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
+                rtcSetGeometryInstancedScene(gi, species[in.geometry]);
+                rtcSetGeometryTimeStepCount(gi, 1);
+                rtcSetGeometryTransform(gi, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+                rtcCommitGeometry(gi);
+                rtcAttachGeometry(top, gi);
+                rtcReleaseGeometry(gi);
+                ++instances;
+            }
+            if ((cell & 63u) == 0 && bench::g_embreeBytes.load() - base > capBytes) complete = false;
+        }
+        if (complete) rtcCommitScene(top);
+        bytes = bench::g_embreeBytes.load() - base;
+        if (bytes > capBytes) complete = false;
+        buildSeconds = bench::now() - t0;
+    }
+
+    ~EmbreeLandscape()
+    {
+        if (top) rtcReleaseScene(top);
+        for (RTCScene sc : species)
+            if (sc) rtcReleaseScene(sc);
+        if (device) rtcReleaseDevice(device);
+    }
+};
+
+void embreeRay(RTCRay& r, const Ray& ray)
+{
+    r.org_x = ray.org.x, r.org_y = ray.org.y, r.org_z = ray.org.z, r.tnear = ray.tmin;
+    r.dir_x = ray.dir.x, r.dir_y = ray.dir.y, r.dir_z = ray.dir.z, r.time = 0.0f;
+    r.tfar = ray.tmax, r.mask = 0xffffffffu, r.id = 0, r.flags = 0;
+}
+#endif
+
+#if defined(SYLVA_TRAVERSAL_STATS)
+// The work per ray (core/base/traversal_stats.h), counted on this thread over `rays` serial traces.
+template <class Fn>
+void countPerRay(const char* what, int cells, size_t rays, Fn&& trace)
+{
+    uint64_t* const c[] = {&g_landNodeVisits, &g_landCellVisits, &g_tileNodeVisits, &g_plantBoxTests, &g_plantRootReads, &g_plantMeshEntries,
+                           &g_bvhNodeVisits, &g_bvhLeafVisits, &g_triangleTests, &g_terrainBlockVisits, &g_terrainCellTests};
+    const char* const name[] = {"land_nodes", "land_cells", "tile_nodes", "plant_box_tests", "plant_root_reads", "plant_mesh_entries",
+                                "mesh_bvh_nodes", "mesh_bvh_leaves", "triangle_tests", "terrain_blocks", "terrain_cells"};
+    for (uint64_t* p : c) *p = 0;
+    trace();
+    std::printf("%4d^2 cells, %s rays (%zu), per ray:", cells, what, rays);
+    for (size_t k = 0; k < std::size(c); ++k) std::printf(" %s %.2f", name[k], double(*c[k]) / double(std::max<size_t>(rays, 1)));
+    std::printf("\n");
+    for (size_t k = 0; k < std::size(c); ++k) std::printf("cells%d_%s_%s_per_ray=%.3f\n", cells, what, name[k], double(*c[k]) / double(std::max<size_t>(rays, 1)));
+}
+#endif
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -60,6 +180,8 @@ int main(int argc, char** argv)
     int reps = 3, threads = 0, width = 640, height = 480;
     double spacing = 41.0, plantSpacing = 0.36;
     std::vector<int> cellCounts = {64, 128, 256, 512};
+    std::vector<int> embreeCells;   // --embree: these cell counts flattened into Embree beside ours
+    double embreeCapGb = 8.0;
     for (int a = 1; a < argc; ++a) {
         const std::string s = argv[a];
         const bool more = a + 1 < argc;
@@ -70,15 +192,21 @@ int main(int argc, char** argv)
         else if (s == "--threads" && more) threads = std::max(1, std::atoi(argv[++a]));
         else if (s == "--width" && more) width = std::max(8, std::atoi(argv[++a]));
         else if (s == "--height" && more) height = std::max(8, std::atoi(argv[++a]));
+        else if (s == "--embree" && more) {
+            std::stringstream ss(argv[++a]);
+            for (std::string item; std::getline(ss, item, ',');) embreeCells.push_back(std::max(1, std::atoi(item.c_str())));
+        } else if (s == "--embree-cap-gb" && more) embreeCapGb = std::atof(argv[++a]);
         else if (s == "--cells" && more) {
             cellCounts.clear();
             std::stringstream ss(argv[++a]);
             for (std::string item; std::getline(ss, item, ',');) cellCounts.push_back(std::max(1, std::atoi(item.c_str())));
         } else {
             std::printf("usage: bench_landscape [--scene PATH] [--spacing M] [--plant-spacing F] [--cells 64,128,256,512] [--reps N]\n"
-                        "                       [--threads N] [--width W] [--height H]\n"
+                        "                       [--threads N] [--width W] [--height H] [--embree 16,32,64] [--embree-cap-gb G]\n"
                         "  default: resources/landscape.sylva.json, its DEM stretched to 41 m spacing (82 km), the tiles' plant\n"
-                        "  spacings x 0.36 (the seed's plant density), 640x480, one primary + one shadow ray per pixel\n");
+                        "  spacings x 0.36 (the seed's plant density), 640x480, one primary + one shadow ray per pixel;\n"
+                        "  --embree: the landscape flattened into Embree 3 at those cell counts (terrain mesh + every plant an\n"
+                        "  instance, built until Embree holds more than the cap, default 8 GB), same rays, side by side\n");
             return s == "--help" ? 0 : 2;
         }
     }
@@ -158,12 +286,96 @@ int main(int argc, char** argv)
                        });
                    }).median;
         for (char c : occ) r.occluded += c != 0;
+#if defined(SYLVA_TRAVERSAL_STATS)
+        countPerRay("primary", n, np, [&] {
+            for (size_t i = 0; i < np; ++i) {
+                Hit h{};
+                traceScene<false>(v, cam[i], h);
+            }
+        });
+        countPerRay("shadow", n, sh.size(), [&] {
+            for (size_t i = 0; i < sh.size(); ++i) {
+                Hit h{};
+                traceScene<true>(v, sh[i], h);
+            }
+        });
+#endif
         std::printf("%4d^2 cells: build %.2f s (landscape %.3f s), %.1f MB (landscape %.1f MB); %.3g instances, %.3g triangles potentially "
                     "visible (%.3g after thinning, %.0f%% kept); primary %.3f s (%zu hits), shadow %.3f s (%zu occluded), frame %.3f s\n",
                     n, r.build, r.landscapeBuild, r.mb, r.landscapeMb, r.instances, r.triangles, r.triangles * r.keptFraction, 100.0 * r.keptFraction,
                     r.primary, r.hits, r.shadow, r.occluded, r.primary + r.shadow);
         std::fflush(stdout);
         rows.push_back(r);
+#ifdef SYLVA_HAVE_EMBREE
+        if (std::find(embreeCells.begin(), embreeCells.end(), n) == embreeCells.end()) continue;
+        // The same rays through Embree holding the landscape flattened; ours timed again beside it (same run).
+        const EmbreeLandscape em(rs, v, threadsUsed, (long long)(embreeCapGb * 1e9));
+        if (!em.complete) {
+            std::printf("%4d^2 cells: Embree ran out: %.2f GB (cap %.1f GB) after %zu instances of %.0f\n", n, double(em.bytes) / 1e9, embreeCapGb,
+                        em.instances, r.instances * r.keptFraction);
+            std::printf("cells%d_embree_out_of_memory=1\n", n);
+            continue;
+        }
+        std::vector<float> tEm(np);
+        std::vector<char> occEm(sh.size());
+        const double ourPrimary = bench::timeReps(reps, [&] {
+                                      tbb::parallel_for(tbb::blocked_range<size_t>(0, np, 64), [&](const tbb::blocked_range<size_t>& b) {
+                                          for (size_t i = b.begin(); i != b.end(); ++i) got[i] = traceScene<false>(v, cam[i], hits[i]);
+                                      });
+                                  }).median;
+        const double emPrimary = bench::timeReps(reps, [&] {
+                                     tbb::parallel_for(tbb::blocked_range<size_t>(0, np, 64), [&](const tbb::blocked_range<size_t>& b) {
+                                         RTCIntersectContext ctx;
+                                         rtcInitIntersectContext(&ctx);
+                                         for (size_t i = b.begin(); i != b.end(); ++i) {
+                                             RTCRayHit rh;
+                                             embreeRay(rh.ray, cam[i]);
+                                             rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                                             rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                                             rtcIntersect1(em.top, &ctx, &rh);
+                                             tEm[i] = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID ? rh.ray.tfar : -1.0f;
+                                         }
+                                     });
+                                 }).median;
+        const double ourShadow = bench::timeReps(reps, [&] {
+                                     tbb::parallel_for(tbb::blocked_range<size_t>(0, sh.size(), 64), [&](const tbb::blocked_range<size_t>& b) {
+                                         for (size_t i = b.begin(); i != b.end(); ++i) {
+                                             Hit h{};
+                                             occ[i] = traceScene<true>(v, sh[i], h);
+                                         }
+                                     });
+                                 }).median;
+        const double emShadow = bench::timeReps(reps, [&] {
+                                    tbb::parallel_for(tbb::blocked_range<size_t>(0, sh.size(), 64), [&](const tbb::blocked_range<size_t>& b) {
+                                        RTCIntersectContext ctx;
+                                        rtcInitIntersectContext(&ctx);
+                                        for (size_t i = b.begin(); i != b.end(); ++i) {
+                                            RTCRay ray;
+                                            embreeRay(ray, sh[i]);
+                                            rtcOccluded1(em.top, &ctx, &ray);
+                                            occEm[i] = ray.tfar < 0.0f;
+                                        }
+                                    });
+                                }).median;
+        size_t primaryDiffer = 0, shadowDiffer = 0;
+        for (size_t i = 0; i < np; ++i) {
+            const bool a = got[i] != 0, b = tEm[i] >= 0.0f;
+            if (a != b || (a && std::fabs(hits[i].t - tEm[i]) > 1e-3f * std::max(hits[i].t, tEm[i]))) ++primaryDiffer;
+        }
+        for (size_t i = 0; i < sh.size(); ++i) shadowDiffer += occ[i] != occEm[i];
+        const double raysAll = double(np + sh.size());
+        const double ours = raysAll / (ourPrimary + ourShadow), theirs = raysAll / (emPrimary + emShadow);
+        std::printf("%4d^2 cells vs Embree 3 (%zu instances + the terrain mesh, built in %.1f s): memory %.1f MB ours / %.1f MB Embree = %.4f; "
+                    "primary %.3f / %.3f s, shadow %.3f / %.3f s; rays/s ours / Embree = %.3f (primary %.3f, shadow %.3f); %zu of %zu primary and "
+                    "%zu of %zu shadow results differ\n",
+                    n, em.instances, em.buildSeconds, r.mb, double(em.bytes) / 1e6, r.mb * 1e6 / double(em.bytes), ourPrimary, emPrimary, ourShadow,
+                    emShadow, ours / theirs, emPrimary / ourPrimary, emShadow / ourShadow, primaryDiffer, np, shadowDiffer, sh.size());
+        std::printf("cells%d_embree_instances=%zu\ncells%d_embree_mb=%.3f\ncells%d_memory_ratio=%.5f\ncells%d_rays_per_s_ratio=%.4f\n"
+                    "cells%d_primary_ratio=%.4f\ncells%d_shadow_ratio=%.4f\ncells%d_primary_differ=%zu\ncells%d_shadow_differ=%zu\n",
+                    n, em.instances, n, double(em.bytes) / 1e6, n, r.mb * 1e6 / double(em.bytes), n, ours / theirs, n, emPrimary / ourPrimary, n,
+                    emShadow / ourShadow, n, primaryDiffer, n, shadowDiffer);
+        std::fflush(stdout);
+#endif
     }
     std::printf("\n| cells | triangles (thinned) | instances (thinned) | frame s | primary s | shadow s | build s | MB |\n|---|---|---|---|---|---|---|---|\n");
     for (const Row& r : rows)

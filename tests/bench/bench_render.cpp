@@ -23,7 +23,7 @@
 #include "tests/bench/bench_timing.h"
 
 #ifdef SYLVA_HAVE_EMBREE
-#include <embree3/rtcore.h>
+#include "tests/bench/bench_embree.h"
 #endif
 
 using namespace sylva;
@@ -102,38 +102,11 @@ double mrays(size_t rays, double seconds) { return double(rays) / seconds / 1e6;
 
 #ifdef SYLVA_HAVE_EMBREE
 
-// Bytes Embree holds, summed through its memory monitor.
-std::atomic<long long> g_embreeBytes{0};
-
-bool embreeMemoryMonitor(void*, ssize_t bytes, bool)
-{
-    g_embreeBytes.fetch_add(bytes, std::memory_order_relaxed);
-    return true;
-}
-
-void embreeError(void*, RTCError code, const char* message)
-{
-    std::fprintf(stderr, "embree error %d: %s\n", int(code), message ? message : "");
-}
-
-// User data of one Embree triangle geometry: its primID -> slot in RenderView::tris.
-struct EmbreeGeomData {
-    const RenderView* view;
-    std::vector<uint32_t> slots;
-};
-
-// Intersection and occlusion filter of the alpha-tested geometries: trace.h's alphaOpaque on the hit's uv.
-void embreeAlphaFilter(const RTCFilterFunctionNArguments* args)
-{
-    const EmbreeGeomData& g = *static_cast<const EmbreeGeomData*>(args->geometryUserPtr);
-    const RenderView& v = *g.view;
-    for (unsigned i = 0; i < args->N; ++i) {
-        if (args->valid[i] != -1) continue;
-        const TriAccel& tri = v.tris[g.slots[RTCHitN_primID(args->hit, args->N, i)]];
-        const glm::vec2 uv = triangleUv(v, tri.tri, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i));
-        if (!alphaOpaque(v, tri.alpha - 1u, uv)) args->valid[i] = 0;
-    }
-}
+using bench::embreeAlphaFilter;
+using bench::embreeError;
+using bench::embreeMemoryMonitor;
+using bench::EmbreeGeomData;
+using bench::g_embreeBytes;
 
 // The same instanced geometry in Embree: per species an opaque and an alpha-tested triangle geometry
 // (unshared vertices v0, v0 + e1, v0 + e2 from the TriAccels), per instance an instance of its species'
@@ -157,48 +130,7 @@ struct EmbreePeer {
         const long long base = g_embreeBytes.load();
 
         double t0 = now();
-        for (const GeometryRecord& g : rs.geometries) {   // the forest's geometries are meshes only
-            if (g.kind != GeometryKind::Mesh) throw std::runtime_error("the Embree peer takes meshes only");
-            const uint32_t first = g.triOffset, last = g.triOffset + g.primCount;
-            RTCScene scene = rtcNewScene(device);
-            rtcSetSceneFlags(scene, RTC_SCENE_FLAG_NONE);
-            rtcSetSceneBuildQuality(scene, quality);
-            for (int alpha = 0; alpha < 2; ++alpha) {
-                auto data = std::make_unique<EmbreeGeomData>();
-                data->view = &v;
-                for (uint32_t slot = first; slot < last; ++slot)
-                    if ((rs.tris[slot].alpha != 0u) == (alpha == 1)) data->slots.push_back(slot);
-                if (data->slots.empty()) continue;
-                const size_t n = data->slots.size();
-                RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-                rtcSetGeometryBuildQuality(geom, quality);
-                auto* vb = static_cast<float*>(
-                    rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), 3 * n));
-                auto* ib = static_cast<uint32_t*>(
-                    rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), n));
-                for (size_t k = 0; k < n; ++k) {
-                    const TriAccel& t = rs.tris[data->slots[k]];
-                    const glm::vec3 p[3] = {t.v0, t.v0 + t.e1, t.v0 + t.e2};
-                    for (int c = 0; c < 3; ++c) {
-                        vb[(3 * k + size_t(c)) * 3 + 0] = p[c].x;
-                        vb[(3 * k + size_t(c)) * 3 + 1] = p[c].y;
-                        vb[(3 * k + size_t(c)) * 3 + 2] = p[c].z;
-                        ib[3 * k + size_t(c)] = uint32_t(3 * k + size_t(c));
-                    }
-                }
-                rtcSetGeometryUserData(geom, data.get());
-                if (alpha) {
-                    rtcSetGeometryIntersectFilterFunction(geom, embreeAlphaFilter);
-                    rtcSetGeometryOccludedFilterFunction(geom, embreeAlphaFilter);
-                }
-                rtcCommitGeometry(geom);
-                rtcAttachGeometryByID(scene, geom, unsigned(alpha));
-                rtcReleaseGeometry(geom);
-                geomData.push_back(std::move(data));
-            }
-            rtcCommitScene(scene);
-            species.push_back(scene);
-        }
+        species = bench::embreeSpeciesScenes(device, rs, v, quality, geomData);   // the forest's geometries are meshes only
         speciesBuildSeconds = now() - t0;
         speciesBytes = g_embreeBytes.load() - base;
 
@@ -208,19 +140,8 @@ struct EmbreePeer {
         rtcSetSceneBuildQuality(top, quality);
         for (size_t i = 0; i < rs.instances.size(); ++i) {
             const InstanceRecord& in = rs.instances[i];
-            // world -> local is local = A world + b; local -> world is world = A^-1 (local - b).
-            glm::dmat3 a;   // column-major: a[col][row]
-            glm::dvec3 b;
-            for (int r = 0; r < 3; ++r) {
-                for (int c = 0; c < 3; ++c) a[c][r] = double(in.row[r][c]);
-                b[r] = double(in.row[r].w);
-            }
-            const glm::dmat3 ai = glm::inverse(a);
-            const glm::dvec3 ti = -(ai * b);
-            float xfm[12];   // RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR: three linear columns, then the translation
-            for (int c = 0; c < 3; ++c)
-                for (int r = 0; r < 3; ++r) xfm[c * 3 + r] = float(ai[c][r]);
-            for (int r = 0; r < 3; ++r) xfm[9 + r] = float(ti[r]);
+            float xfm[12];
+            bench::embreeInstanceTransform(in, xfm);
             RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_INSTANCE);
             rtcSetGeometryInstancedScene(geom, species[in.geometry]);
             rtcSetGeometryTimeStepCount(geom, 1);

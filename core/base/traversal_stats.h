@@ -1,0 +1,23 @@
+// Optional traversal counters for profiling tools (compiled in only with SYLVA_TRAVERSAL_STATS, host only):
+// per-thread tallies of what a ray visits, so a benchmark built with the flag can state the work per ray
+// (BVH nodes and leaves, triangles tested, the terrain's pyramid blocks and cells, the landscape's cells,
+// tile nodes and plants). Without the flag every SYLVA_COUNT compiles to nothing.
+#pragma once
+
+#include <cstdint>
+
+namespace sylva {
+
+#if defined(SYLVA_TRAVERSAL_STATS) && !defined(__CUDA_ARCH__)
+inline thread_local uint64_t g_bvhNodeVisits = 0, g_bvhLeafVisits = 0, g_triangleTests = 0;
+inline thread_local uint64_t g_terrainBlockVisits = 0, g_terrainCellTests = 0;
+inline thread_local uint64_t g_landNodeVisits = 0, g_landCellVisits = 0, g_tileNodeVisits = 0;
+inline thread_local uint64_t g_plantBoxTests = 0, g_plantRootReads = 0, g_plantMeshEntries = 0;
+#define SYLVA_COUNT(counter) (++(counter))
+#define SYLVA_COUNT_ADD(counter, n) ((counter) += (n))
+#else
+#define SYLVA_COUNT(counter) ((void)0)
+#define SYLVA_COUNT_ADD(counter, n) ((void)0)
+#endif
+
+} // namespace sylva
