@@ -55,6 +55,20 @@ std::vector<AssetsPtr> AssetStore::forScene(const Scene& scene, bool lit) const
     return out;
 }
 
+std::vector<AssetsPtr> AssetStore::litForAnySun(const Scene& scene) const
+{
+    std::lock_guard lock(m_mutex);
+    std::vector<AssetsPtr> out;
+    for (const SpeciesDesc& sp : scene.species) {
+        const std::string prefix = assetKey(sp, scene.sun, false) + "|lit sun ";
+        auto it = m_assets.lower_bound(prefix);
+        if (it != m_assets.end() && it->first.compare(0, prefix.size(), prefix) != 0) it = m_assets.end();
+        if (it == m_assets.end()) return {};
+        out.push_back(it->second);
+    }
+    return out;
+}
+
 std::vector<size_t> AssetStore::missingSpecies(const Scene& scene, bool lit) const
 {
     std::lock_guard lock(m_mutex);

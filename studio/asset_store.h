@@ -32,6 +32,10 @@ public:
     // Assets for every species of the scene (lit ones also serve unlit requests), or an empty vector
     // when any is missing.
     std::vector<AssetsPtr> forScene(const Scene& scene, bool lit) const;
+    // Lit assets of every species for any sun (the first in key order: the same answer while the store
+    // holds the same entries), or empty when a species has none: the geometry and grid layout a relit
+    // frame keeps while the sun moves.
+    std::vector<AssetsPtr> litForAnySun(const Scene& scene) const;
     // Keys of the scene's species that are missing.
     std::vector<size_t> missingSpecies(const Scene& scene, bool lit) const;
     // Drops every entry whose key is not in keep.

@@ -3,12 +3,16 @@
 // scene moves on), and the result into the viewport.
 #pragma once
 
+#include <map>
+#include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <QPointer>
 #include <QTimer>
 
+#include "studio/relight.h"
 #include "studio/studio_controller.h"
 #include "studio/volume_lighting.h"
 
@@ -49,6 +53,21 @@ public:
     bool isPending() const { return m_job || m_timer.isActive(); }
     // Cancels the running lighting job (New: the old scene's grids are not needed).
     void cancel();
+
+    // Relighting from bases (issue 18 item 2). Each species' basis (one LB solve per lattice direction,
+    // lightingBasisFor) held in memory lets a sun change relight the viewport's kept frame with no LB
+    // solve and no job (updateViewport). buildRelightingBasis solves what the grid cache lacks (18 solves
+    // a species) and loads the rest; a basis already in the cache (`sylva light --basis`, an earlier
+    // session) is loaded by itself after a lighting job that relit from it.
+    Job* buildRelightingBasis();
+    // Every species of the scene has its basis in memory (the CPU viewport relights from it).
+    bool hasBases(const Scene& scene) const;
+    // The relighting updateViewport hands the viewport for `scene`, if every species has a basis and
+    // the viewport traces on the CPU.
+    std::optional<Relighting> relightingFor(const Scene& scene) const;
+    // Counters for tests and the bench: sun changes served from bases (no job), lighting jobs started.
+    int relights() const { return m_relights; }
+    int lightingJobs() const { return m_lightingJobs; }
     // The volumes' lit data the lighting jobs made (the viewport's scene carries it).
     VolumeLightStore* volumeLights() { return &m_volumes; }
 
@@ -58,6 +77,8 @@ Q_SIGNALS:
     // grids may look again (isPending() says whether another job follows).
     void settled();
     void lightingFinished(bool succeeded);
+    // A relighting-basis job ended; ok: every species it was asked for has its basis in memory.
+    void basisFinished(bool ok);
 
 private:
     SceneDocument* m_doc;
@@ -72,6 +93,12 @@ private:
     std::vector<std::string> m_target;   // asset keys (then volume keys) the running lighting job produces
     VolumeLightStore m_volumes;
     bool m_again = false;
+
+    Job* startBasisJob(bool solve);
+    std::map<std::string, BasisPtr> m_bases;   // by speciesFingerprint (a basis does not depend on the sun)
+    QPointer<Job> m_basisJob;
+    bool m_cachedBasisSeen = false;            // the running lighting job relit a species from a cached basis
+    int m_relights = 0, m_lightingJobs = 0;
 };
 
 } // namespace sylva

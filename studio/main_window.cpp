@@ -35,6 +35,7 @@
 #include "studio/job_manager.h"
 #include "studio/job_panel.h"
 #include "studio/lighting_scheduler.h"
+#include "studio/sky_panel.h"
 #include "studio/materials_controller.h"
 #include "studio/outliner_model.h"
 #include "studio/property_panel.h"
@@ -195,6 +196,13 @@ void MainWindow::buildDocks()
     propDock->setObjectName("propertiesDock");
     propDock->setWidget(m_properties);
 
+    m_skyPanel = new SkyPanel(m_doc);
+    auto* skyDock = new QDockWidget(tr("Sky"), this);
+    skyDock->setObjectName("skyDock");
+    skyDock->setWidget(m_skyPanel);
+    connect(m_doc, &SceneDocument::editRefused, this,
+            [this](const QString& text, const QString& why) { appendLog(tr("%1 refused: %2").arg(text, why)); });
+
     m_jobPanel = new JobPanel(m_jobs);
     auto* jobDock = new QDockWidget(tr("Jobs"), this);
     jobDock->setObjectName("jobsDock");
@@ -221,6 +229,8 @@ void MainWindow::buildDocks()
     setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
     addDockWidget(Qt::RightDockWidgetArea, outlinerDock);
     splitDockWidget(outlinerDock, propDock, Qt::Vertical);
+    tabifyDockWidget(propDock, skyDock);
+    propDock->raise();
     addDockWidget(Qt::BottomDockWidgetArea, jobDock);
     splitDockWidget(jobDock, logDock, Qt::Horizontal);
     // The inspector on the left, hidden until View > Lighting Inspector.
@@ -311,6 +321,7 @@ void MainWindow::buildActions()
     add(render, tr("Compute &Lighting"), "actionLight", QKeySequence(Qt::CTRL | Qt::Key_L), [this] { m_lighting->computeLighting(); });
     add(render, tr("&Reload Lighting"), "actionReload", QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_L),
         [this] { m_lighting->computeLighting(true); });
+    add(render, tr("Build Relighting &Basis"), "actionRelightBasis", QKeySequence(), [this] { m_lighting->buildRelightingBasis(); });
     QAction* autoLight = render->addAction(tr("&Automatic Lighting"));
     autoLight->setObjectName("actionAutoLighting");
     autoLight->setCheckable(true);

@@ -36,6 +36,7 @@ class LightingScheduler;
 class MaterialsController;
 class OutlinerModel;
 class PropertyPanel;
+class SkyPanel;
 class RecentFiles;
 class ScatterTool;
 class SpeciesImporter;
@@ -54,6 +55,7 @@ public:
     OutlinerModel* outlinerModel() const { return m_model; }
     QTreeView* outliner() const { return m_outliner; }
     PropertyPanel* propertyPanel() const { return m_properties; }
+    SkyPanel* skyPanel() const { return m_skyPanel; }
     Viewport* viewport() const { return m_viewport; }
     JobManager* jobs() const { return m_jobs; }
     JobPanel* jobPanel() const { return m_jobPanel; }
@@ -140,6 +142,7 @@ private:
     OutlinerModel* m_model;
     QTreeView* m_outliner;
     PropertyPanel* m_properties;
+    SkyPanel* m_skyPanel = nullptr;
     Viewport* m_viewport;
     JobPanel* m_jobPanel;
     QPlainTextEdit* m_log;

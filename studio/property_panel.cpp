@@ -209,7 +209,10 @@ QWidget* PropertyPanel::buildSunPage()
     m_sunTemperature = spin("sun.temperature", 1000.0, 40000.0, 0, 100.0);
     m_sunIntensity = spin("sun.intensity", 0.0, 100.0, 3, 0.1);
     auto setAngles = [this](QObject* editor, double elevation, double azimuth) {
-        apply(editor, tr("Move sun"), [&](Scene& s) { s.sun.direction = sunDirection(elevation, azimuth); });
+        apply(editor, tr("Move sun"), [&](Scene& s) {
+            s.sun.place.reset();   // by direction now (the sky panel sets the sun by date and place)
+            s.sun.direction = sunDirection(elevation, azimuth);
+        });
     };
     connect(m_sunElevation, &QDoubleSpinBox::valueChanged, this,
             [this, setAngles](double v) { setAngles(m_sunElevation, v, m_sunAzimuth->value()); });

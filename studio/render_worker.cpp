@@ -73,13 +73,15 @@ std::vector<RenderPass> RenderWorker::passes() const
     return m_passes;
 }
 
-void RenderWorker::request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size, std::optional<RenderMode> compare)
+void RenderWorker::request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size, std::optional<RenderMode> compare,
+                           Relighting relight)
 {
     QMutexLocker lock(&m_mutex);
     m_request.scene = scene;
     m_request.assets = std::move(assets);
     m_request.size = size;
     m_request.compare = compare;
+    m_request.relight = std::move(relight);
     ++m_request.serial;
     m_hasRequest = true;
     m_sinceRequest.start();
@@ -179,7 +181,8 @@ void RenderWorker::process(const Request& req, Progress& progress)
     }
 
     // A change of mode, compare mode or exposure alone: the film already holds every mode's parts.
-    if (m_lastScene && m_frameAssets == req.assets && m_lastSize == req.size && m_lastPass == int(passes.size()) - 1) {
+    if (m_lastScene && m_frameAssets == req.assets && m_frameRelight == req.relight && m_lastSize == req.size &&
+        m_lastPass == int(passes.size()) - 1) {
         Scene a = *m_lastScene, b = scene;
         a.render.mode = b.render.mode;
         a.render.exposureKey = b.render.exposureKey;
@@ -191,6 +194,11 @@ void RenderWorker::process(const Request& req, Progress& progress)
         }
     }
 
+    // A sky edit (another built sky, light count or interleave): the frame's sky part is built with the rest.
+    const SkyDesc& sky = scene.skyModel;
+    if (m_frame && !(sky.kind == m_frameSky.kind && sky.built == m_frameSky.built && sky.lights == m_frameSky.lights &&
+                     sky.interleave == m_frameSky.interleave))
+        m_frame.reset();
     // The species' structures are kept while the assets stay; an edit of the landscape or the volumes
     // updates only its part (viewFrameUpdate), anything else the build reads builds the frame again.
     const ViewFrameUpdate update = m_frame ? viewFrameUpdate(m_frameScene, scene) : ViewFrameUpdate{};
@@ -201,6 +209,8 @@ void RenderWorker::process(const Request& req, Progress& progress)
         for (const AssetsPtr& a : req.assets) copies.push_back(*a);
         m_frame = buildViewFrame(scene, copies, sunRadiance(scene.sun));
         m_frameAssets = req.assets;
+        m_frameRelight = {};
+        m_frameSky = scene.skyModel;
         m_frameScene = scene;
         ++m_frameBuilds;
         if (interrupted()) throw Cancelled();
@@ -213,6 +223,14 @@ void RenderWorker::process(const Request& req, Progress& progress)
         }
         m_frameScene = scene;
         ++m_frameUpdates;
+        if (interrupted()) throw Cancelled();
+    }
+    if (!(m_frameRelight == req.relight)) {
+        // A sun change relit from the species' bases: the composed grids into the kept frame (not
+        // interrupted: a frame half relit would have to be built again).
+        applyRelighting(m_frame->rs, req.assets, req.relight);
+        m_frameRelight = req.relight;
+        if (req.relight.active()) ++m_relitFrames;
         if (interrupted()) throw Cancelled();
     }
     const glm::vec3 sun = sunRadiance(scene.sun);

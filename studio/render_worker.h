@@ -21,6 +21,7 @@
 #include "core/scene/scene.h"
 #include "pipeline/render/view_frame.h"
 #include "studio/asset_store.h"
+#include "studio/relight.h"
 
 namespace sylva {
 
@@ -75,8 +76,10 @@ public:
     // the render mode alone recomposes the last film without tracing.
     // compare: a second mode for the right half of the picture (compareImage); a change of it alone
     // recomposes like a mode change.
+    // relight (active): the species' lighting composed from their bases for relight.sun replaces the
+    // assets' grids in the kept frame (applyRelighting; a sun change then costs no build; CPU mode only).
     void request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size,
-                 std::optional<RenderMode> compare = std::nullopt);
+                 std::optional<RenderMode> compare = std::nullopt, Relighting relight = {});
     // Stops the frame in progress and forgets the request (e.g. assets are being recomputed).
     void clear();
 
@@ -85,6 +88,9 @@ public:
     // Switching (either way) forgets the last GPU frame.
     void setGpuMode(bool on);
     bool gpuMode() const { return m_gpu.load(); }
+
+    // How often a request relit the kept frame from bases (applyRelighting) instead of building it.
+    int relitFrames() const { return m_relitFrames.load(); }
 
     // How often the frame's camera-independent part was built whole (buildViewFrame), and how often an
     // edit was taken in by updating it in place (viewFrameUpdate: a landscape density, tile or tiling edit,
@@ -110,6 +116,7 @@ private:
         std::vector<AssetsPtr> assets;
         QSize size;
         std::optional<RenderMode> compare;
+        Relighting relight;
         quint64 serial = 0;
     };
     void process(const Request& req, Progress& progress);
@@ -126,6 +133,9 @@ private:
     // Worker-thread state.
     std::optional<ViewFrame> m_frame;
     std::vector<AssetsPtr> m_frameAssets;
+    Relighting m_frameRelight;            // the relighting m_frame's lighting array holds (inactive: the assets')
+    SkyDesc m_frameSky;                   // the sky m_frame was built with
+    std::atomic<int> m_relitFrames{0};
     Scene m_frameScene;                   // the scene m_frame's camera-independent part holds
     std::atomic<int> m_frameBuilds{0}, m_frameUpdates{0};
     std::optional<Scene> m_lastScene;     // what m_lastFilm shows

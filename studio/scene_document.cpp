@@ -8,6 +8,7 @@
 #include "core/base/error.h"
 #include "pipeline/render/view_frame.h"
 #include "pipeline/scene/scene_file.h"
+#include "studio/scene_sky.h"
 
 namespace sylva {
 namespace {
@@ -54,9 +55,10 @@ ScenePart changedParts(const Scene& a, const Scene& b)
     if (!sameInstances) p = p | ScenePart::Instances;
     if (a.ground.enabled != b.ground.enabled || a.ground.height != b.ground.height || a.ground.color != b.ground.color)
         p = p | ScenePart::Ground;
-    if (a.sun.direction != b.sun.direction || a.sun.temperature != b.sun.temperature || a.sun.intensity != b.sun.intensity)
+    if (a.sun.direction != b.sun.direction || a.sun.temperature != b.sun.temperature || a.sun.intensity != b.sun.intensity ||
+        !sameSunPlace(a.sun, b.sun))
         p = p | ScenePart::Sun;
-    if (a.sky != b.sky) p = p | ScenePart::Sky;
+    if (a.sky != b.sky || !sameSkySettings(a.skyModel, b.skyModel)) p = p | ScenePart::Sky;
     if (!sameTerrain(a.terrain, b.terrain)) p = p | ScenePart::Terrain;
     if (!sameVolumes(a.volumes, b.volumes)) p = p | ScenePart::Volumes;
     const CameraDesc &ca = a.camera, &cb = b.camera;
@@ -85,8 +87,15 @@ int SceneDocument::newMergeKey()
     return next.fetch_add(1);
 }
 
-void SceneDocument::edit(const Scene& after, const QString& text, int mergeKey)
+void SceneDocument::edit(const Scene& afterIn, const QString& text, int mergeKey)
 {
+    // The sky the edit asks for (a Preetham sky follows the sun), built before the step is pushed.
+    Scene after = afterIn;
+    std::string why;
+    if (!refreshSceneSky(m_scene, after, &why)) {
+        Q_EMIT editRefused(text, QString::fromStdString(why));
+        return;
+    }
     if (changedParts(m_scene, after) == ScenePart::None) return;
     m_pushing = true;
     m_undo.push(new SceneEditCommand(this, m_scene, after, text, mergeKey));

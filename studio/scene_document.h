@@ -49,6 +49,8 @@ public:
 
     // Pushes one undoable edit that replaces the scene with `after` (no-op when nothing differs).
     // Consecutive edits with the same non-zero mergeKey collapse into one undo step (a drag, a spin).
+    // The sky is built for `after` first (refreshSceneSky: a Preetham sky follows the sun, a map is
+    // read); when that fails nothing is pushed and editRefused says why.
     void edit(const Scene& after, const QString& text, int mergeKey = 0);
 
     // Replaces the document (new or opened file): clears undo history, marks clean.
@@ -66,6 +68,8 @@ Q_SIGNALS:
     void changed(sylva::ScenePart parts);   // after every applied state, with what differs
     void filePathChanged(const QString& path);
     void modifiedChanged(bool modified);
+    // An edit was not applied: its sky cannot be built (a map that cannot be read, a sun the model refuses).
+    void editRefused(const QString& text, const QString& reason);
 
 private:
     friend class SceneEditCommand;

@@ -82,10 +82,11 @@ QSize Viewport::renderSize() const
     return QSize(std::max(1, int(width() * dpr)), std::max(1, int(height() * dpr)));
 }
 
-void Viewport::setScene(const Scene& scene, std::vector<AssetsPtr> assets)
+void Viewport::setScene(const Scene& scene, std::vector<AssetsPtr> assets, Relighting relight)
 {
     m_scene = scene;
     m_assets = std::move(assets);
+    m_relight = std::move(relight);
     requestRender();
 }
 
@@ -116,7 +117,7 @@ void Viewport::requestRender()
         update();
         return;
     }
-    m_worker->request(m_scene, m_assets, renderSize(), m_compare);
+    m_worker->request(m_scene, m_assets, renderSize(), m_compare, m_relight);
 }
 
 void Viewport::onImage(const QImage& image, int pass, bool last, double seconds)

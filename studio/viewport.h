@@ -30,8 +30,9 @@ public:
     explicit Viewport(QWidget* parent = nullptr);
     ~Viewport() override;
 
-    // What to draw. assets: one per species, in order; empty = not ready (status says why).
-    void setScene(const Scene& scene, std::vector<AssetsPtr> assets);
+    // What to draw. assets: one per species, in order; empty = not ready (status says why). relight
+    // (active): the species' lighting composed from bases for the scene's sun (RenderWorker::request).
+    void setScene(const Scene& scene, std::vector<AssetsPtr> assets, Relighting relight = {});
     void setStatus(const QString& status);
     QString status() const { return m_status; }
 
@@ -94,6 +95,7 @@ private:
     RenderWorker* m_worker;
     Scene m_scene;
     std::vector<AssetsPtr> m_assets;
+    Relighting m_relight;
     QString m_status;
 
     QImage m_image;

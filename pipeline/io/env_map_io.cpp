@@ -53,7 +53,7 @@ std::string envMapCleanSummary(const std::string& path, const EnvMapFile& file)
     return s + buf;
 }
 
-std::string loadSceneSky(Scene& scene)
+std::string loadSceneSky(Scene& scene, const EnvMapReader& read)
 {
     SkyDesc& d = scene.skyModel;
     if (!d.analytic() || d.built) return std::string();
@@ -65,7 +65,7 @@ std::string loadSceneSky(Scene& scene)
         d.built = std::make_shared<const sky::Sky>(sky::preethamSky(p, bundledCieTable()));
         return std::string();
     }
-    EnvMapFile f = readEnvMap(d.path);
+    EnvMapFile f = read ? read(d.path) : readEnvMap(d.path);
     const std::string summary = envMapCleanSummary(d.path, f);
     d.built = std::make_shared<const sky::Sky>(sky::mapSky(std::move(f.map), d.rotationDeg, d.intensity, d.sunFromMap));
     return summary;

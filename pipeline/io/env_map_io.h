@@ -2,6 +2,7 @@
 // checked and cleaned (core/sky/env_map.h).
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include "core/sky/env_map.h"
@@ -27,6 +28,9 @@ std::string envMapCleanSummary(const std::string& path, const EnvMapFile& file);
 // (readEnvMap of skyModel.path, its sun taken out when sunFromMap, rotated and scaled); nothing for the
 // constant sky or when already built. Returns the map's envMapCleanSummary line (empty for other skies).
 // Throws sylva::Error for a bad map or Preetham parameters the model refuses (sun below -10 degrees).
-std::string loadSceneSky(Scene& scene);
+// read: how the map file is read (default readEnvMap; the studio passes one that keeps maps in memory, so a
+// rotation or intensity edit does not read the file again).
+using EnvMapReader = std::function<EnvMapFile(const std::string& path)>;
+std::string loadSceneSky(Scene& scene, const EnvMapReader& read = {});
 
 } // namespace sylva

@@ -1,0 +1,356 @@
+// SkyPanel: the sky block and the sun of the scene as controls; each change one SceneDocument edit.
+#include "studio/sky_panel.h"
+
+#include <cmath>
+
+#include <QComboBox>
+#include <QDateEdit>
+#include <QDateTime>
+#include <QDial>
+#include <QDoubleSpinBox>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QLineEdit>
+#include <QPushButton>
+#include <QSignalBlocker>
+#include <QSlider>
+#include <QSpinBox>
+#include <QStackedWidget>
+#include <QTimeEdit>
+#include <QVBoxLayout>
+
+#include "core/base/error.h"
+#include "core/sky/sun_position.h"
+#include "core/sky/virtual_lights.h"
+#include "studio/camera_nav.h"
+
+namespace sylva {
+namespace {
+
+void setValue(QDoubleSpinBox* box, double v)
+{
+    const QSignalBlocker block(box);
+    box->setValue(v);
+}
+
+QWidget* row(std::initializer_list<QWidget*> widgets)
+{
+    auto* w = new QWidget;
+    auto* l = new QHBoxLayout(w);
+    l->setContentsMargins(0, 0, 0, 0);
+    for (QWidget* x : widgets) l->addWidget(x);
+    return w;
+}
+
+QFormLayout* form(QWidget* w)
+{
+    auto* f = new QFormLayout(w);
+    f->setContentsMargins(0, 0, 0, 0);
+    return f;
+}
+
+sky::SunPlace placeOf(const Scene& s) { return s.sun.place ? *s.sun.place : sky::SunPlace{}; }
+
+} // namespace
+
+SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc(doc)
+{
+    m_chooseMap = [this] {
+        return QFileDialog::getOpenFileName(this, tr("HDR Environment Map"), QString(), tr("HDR maps (*.exr *.hdr);;All files (*)"));
+    };
+    auto* layout = new QVBoxLayout(this);
+    layout->setContentsMargins(4, 4, 4, 4);
+
+    // The sky.
+    auto* skyBox = new QGroupBox(tr("Sky"));
+    auto* skyForm = new QFormLayout(skyBox);
+    m_kind = new QComboBox;
+    m_kind->setObjectName("sky.kind");
+    m_kind->addItem(tr("Constant colour"), int(sky::SkyKind::Constant));
+    m_kind->addItem(tr("Preetham (analytic)"), int(sky::SkyKind::Preetham));
+    m_kind->addItem(tr("HDR map"), int(sky::SkyKind::Map));
+    skyForm->addRow(tr("Model"), m_kind);
+    connect(m_kind, &QComboBox::currentIndexChanged, this, [this](int idx) {
+        const auto kind = sky::SkyKind(m_kind->itemData(idx).toInt());
+        if (kind == sky::SkyKind::Map && m_doc->scene().skyModel.path.empty()) {
+            chooseMap();   // a map sky needs its file first
+            refresh();
+            return;
+        }
+        apply(m_kind, tr("Change sky model"), [&](Scene& s) { s.skyModel.kind = kind; });
+    });
+
+    m_preethamRows = new QWidget;
+    m_turbidity = spin("sky.turbidity", 2.0, 10.0, 2, 0.25);
+    m_turbidity->setToolTip(tr("Haze of the atmosphere: 2 a very clear sky, 10 a hazy one"));
+    connect(m_turbidity, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+        apply(m_turbidity, tr("Change turbidity"), [&](Scene& s) { s.skyModel.turbidity = v; });
+    });
+    form(m_preethamRows)->addRow(tr("Turbidity"), m_turbidity);
+    skyForm->addRow(m_preethamRows);
+
+    m_mapRows = new QWidget;
+    QFormLayout* mapForm = form(m_mapRows);
+    m_path = new QLineEdit;
+    m_path->setObjectName("sky.path");
+    m_path->setReadOnly(true);
+    m_browse = new QPushButton(tr("Choose..."));
+    m_browse->setObjectName("sky.choose");
+    connect(m_browse, &QPushButton::clicked, this, [this] { chooseMap(); });
+    mapForm->addRow(tr("Map file"), row({m_path, m_browse}));
+    m_rotation = spin("sky.rotation", -360.0, 360.0, 1, 5.0);
+    m_rotation->setWrapping(true);
+    m_rotation->setToolTip(tr("Turns the map about the up axis (adds to every azimuth)"));
+    connect(m_rotation, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+        apply(m_rotation, tr("Rotate sky map"), [&](Scene& s) { s.skyModel.rotationDeg = float(v); });
+    });
+    mapForm->addRow(tr("Rotation (deg)"), m_rotation);
+    m_intensity = spin("sky.intensity", 0.0, 1000.0, 3, 0.1);
+    connect(m_intensity, &QDoubleSpinBox::valueChanged, this, [this](double v) {
+        apply(m_intensity, tr("Change sky map intensity"), [&](Scene& s) { s.skyModel.intensity = float(v); });
+    });
+    mapForm->addRow(tr("Intensity"), m_intensity);
+    skyForm->addRow(m_mapRows);
+
+    m_lightRows = new QWidget;
+    QFormLayout* lightForm = form(m_lightRows);
+    m_lights = new QSpinBox;
+    m_lights->setObjectName("sky.lights");
+    m_lights->setRange(sky::kMinVirtualLights, 4096);
+    m_lights->setKeyboardTracking(false);
+    m_lights->setToolTip(tr("Virtual directional lights the sky is split into (the sun is its own light)"));
+    connect(m_lights, &QSpinBox::valueChanged, this, [this](int v) {
+        apply(m_lights, tr("Change sky lights"), [&](Scene& s) { s.skyModel.lights = v; });
+    });
+    lightForm->addRow(tr("Lights"), m_lights);
+    m_interleave = new QSpinBox;
+    m_interleave->setObjectName("sky.interleave");
+    m_interleave->setRange(1, 256);
+    m_interleave->setKeyboardTracking(false);
+    m_interleave->setToolTip(tr("Subsets of the lights over neighbouring pixels and samples (interleaved sampling)"));
+    connect(m_interleave, &QSpinBox::valueChanged, this, [this](int v) {
+        apply(m_interleave, tr("Change sky interleave"), [&](Scene& s) { s.skyModel.interleave = v; });
+    });
+    lightForm->addRow(tr("Interleave"), m_interleave);
+    skyForm->addRow(m_lightRows);
+    layout->addWidget(skyBox);
+
+    // The sun.
+    auto* sunBox = new QGroupBox(tr("Sun"));
+    auto* sunLayout = new QVBoxLayout(sunBox);
+    m_sunMode = new QComboBox;
+    m_sunMode->setObjectName("sun.mode");
+    m_sunMode->addItem(tr("Elevation and azimuth"));
+    m_sunMode->addItem(tr("Date, time and place"));
+    sunLayout->addWidget(m_sunMode);
+    m_sunPages = new QStackedWidget;
+    sunLayout->addWidget(m_sunPages);
+    connect(m_sunMode, &QComboBox::currentIndexChanged, this, [this](int idx) {
+        if (idx == 0) {
+            apply(m_sunMode, tr("Sun by direction"), [](Scene& s) { s.sun.place.reset(); });
+        } else {
+            const sky::SunPlace p = placeOf(m_doc->scene());
+            applyPlace(m_sunMode, [p](sky::SunPlace& q) { q = p; });
+        }
+    });
+
+    auto* dialPage = new QWidget;
+    QFormLayout* dialForm = form(dialPage);
+    m_elevation = spin("sun.elevation", -90.0, 90.0, 1, 1.0);
+    m_azimuth = spin("sun.azimuth", 0.0, 360.0, 1, 1.0);
+    m_azimuth->setWrapping(true);
+    m_dial = new QDial;
+    m_dial->setObjectName("sun.azimuthDial");
+    m_dial->setRange(0, 359);
+    m_dial->setWrapping(true);
+    m_dial->setNotchesVisible(true);
+    m_dial->setNotchTarget(15.0);
+    m_dial->setFixedSize(72, 72);
+    auto setAngles = [this](QObject* editor, double elevation, double azimuth) {
+        apply(editor, tr("Move sun"), [&](Scene& s) {
+            s.sun.place.reset();
+            s.sun.direction = sunDirection(elevation, azimuth);
+        });
+    };
+    connect(m_elevation, &QDoubleSpinBox::valueChanged, this,
+            [this, setAngles](double v) { setAngles(m_elevation, v, m_azimuth->value()); });
+    connect(m_azimuth, &QDoubleSpinBox::valueChanged, this,
+            [this, setAngles](double v) { setAngles(m_azimuth, m_elevation->value(), v); });
+    // As the properties' dial: 0 at the bottom is azimuth 0 (+Z), clockwise as a compass seen from above.
+    connect(m_dial, &QDial::valueChanged, this, [this, setAngles](int v) { setAngles(m_dial, m_elevation->value(), double(v)); });
+    dialForm->addRow(tr("Elevation (deg)"), m_elevation);
+    dialForm->addRow(tr("Azimuth (deg)"), row({m_dial, m_azimuth}));
+    m_sunPages->addWidget(dialPage);
+
+    auto* placePage = new QWidget;
+    QFormLayout* placeForm = form(placePage);
+    m_date = new QDateEdit;
+    m_date->setObjectName("sun.date");
+    m_date->setDisplayFormat("yyyy-MM-dd");
+    m_date->setDateRange(QDate(1583, 1, 1), QDate(3000, 12, 31));
+    m_date->setCalendarPopup(true);
+    m_date->setKeyboardTracking(false);
+    connect(m_date, &QDateEdit::dateChanged, this, [this](const QDate& d) {
+        applyPlace(m_date, [d](sky::SunPlace& p) {
+            p.year = d.year();
+            p.month = d.month();
+            p.day = d.day();
+        });
+    });
+    m_time = new QTimeEdit;
+    m_time->setObjectName("sun.time");
+    m_time->setDisplayFormat("HH:mm");
+    m_time->setKeyboardTracking(false);
+    connect(m_time, &QTimeEdit::timeChanged, this, [this](const QTime& t) {
+        applyPlace(m_time, [t](sky::SunPlace& p) { p.hour = t.hour() + t.minute() / 60.0; });
+    });
+    m_timeSlider = new QSlider(Qt::Horizontal);
+    m_timeSlider->setObjectName("sun.timeSlider");
+    m_timeSlider->setRange(0, 24 * 60 - 1);   // minutes of the local day
+    m_timeSlider->setSingleStep(5);
+    m_timeSlider->setPageStep(60);
+    m_timeSlider->setToolTip(tr("Local clock time: drag to move the sun through the day"));
+    connect(m_timeSlider, &QSlider::valueChanged, this, [this](int minutes) {
+        applyPlace(m_timeSlider, [minutes](sky::SunPlace& p) { p.hour = minutes / 60.0; });
+    });
+    m_zone = spin("sun.timezone", -14.0, 14.0, 2, 0.5);
+    m_zone->setToolTip(tr("Hours of local time ahead of UTC (east +: 1 for CET, 2 for CEST)"));
+    connect(m_zone, &QDoubleSpinBox::valueChanged, this,
+            [this](double v) { applyPlace(m_zone, [v](sky::SunPlace& p) { p.timeZoneHours = v; }); });
+    m_latitude = spin("sun.latitude", -90.0, 90.0, 4, 0.5);
+    connect(m_latitude, &QDoubleSpinBox::valueChanged, this,
+            [this](double v) { applyPlace(m_latitude, [v](sky::SunPlace& p) { p.latitudeDeg = v; }); });
+    m_longitude = spin("sun.longitude", -180.0, 180.0, 4, 0.5);
+    connect(m_longitude, &QDoubleSpinBox::valueChanged, this,
+            [this](double v) { applyPlace(m_longitude, [v](sky::SunPlace& p) { p.longitudeDeg = v; }); });
+    placeForm->addRow(tr("Date"), m_date);
+    placeForm->addRow(tr("Time"), row({m_time, m_timeSlider}));
+    placeForm->addRow(tr("Time zone (h)"), m_zone);
+    placeForm->addRow(tr("Latitude (deg N)"), m_latitude);
+    placeForm->addRow(tr("Longitude (deg E)"), m_longitude);
+    m_sunPages->addWidget(placePage);
+    m_sunInfo = new QLabel;
+    m_sunInfo->setObjectName("sun.info");
+    m_sunInfo->setWordWrap(true);
+    sunLayout->addWidget(m_sunInfo);
+    layout->addWidget(sunBox);
+
+    m_status = new QLabel;
+    m_status->setObjectName("sky.status");
+    m_status->setWordWrap(true);
+    m_status->setStyleSheet("color: #b00020");
+    layout->addWidget(m_status);
+    layout->addStretch(1);
+
+    connect(doc, &SceneDocument::changed, this, [this] {
+        m_status->clear();
+        refresh();
+    });
+    connect(doc, &SceneDocument::editRefused, this, [this](const QString& text, const QString& reason) {
+        m_status->setText(tr("%1 refused: %2").arg(text, reason));
+        refresh();
+    });
+    refresh();
+}
+
+QString SkyPanel::status() const { return m_status->text(); }
+
+QDoubleSpinBox* SkyPanel::spin(const char* name, double lo, double hi, int decimals, double step)
+{
+    auto* s = new QDoubleSpinBox;
+    s->setObjectName(QString::fromLatin1(name));
+    s->setRange(lo, hi);
+    s->setDecimals(decimals);
+    s->setSingleStep(step);
+    s->setKeyboardTracking(false);
+    s->setAccelerated(true);
+    s->setMinimumWidth(64);
+    return s;
+}
+
+void SkyPanel::apply(QObject* editor, const QString& text, const std::function<void(Scene&)>& change)
+{
+    Scene s = m_doc->scene();
+    change(s);
+    MergeState& m = m_mergeKeys[editor];
+    const qint64 now = QDateTime::currentMSecsSinceEpoch();
+    if (m.key == 0 || now - m.lastMs > 1000) m.key = SceneDocument::newMergeKey();
+    m.lastMs = now;
+    m_doc->edit(s, text, m.key);
+}
+
+void SkyPanel::applyPlace(QObject* editor, const std::function<void(sky::SunPlace&)>& change)
+{
+    sky::SunPlace p = placeOf(m_doc->scene());
+    change(p);
+    glm::vec3 direction;
+    try {
+        direction = sky::placeSunDirection(p);
+    } catch (const Error& e) {
+        m_status->setText(tr("Sun refused: %1").arg(QString::fromStdString(e.what())));
+        refresh();
+        return;
+    }
+    apply(editor, tr("Move sun (date and place)"), [&](Scene& s) {
+        s.sun.place = p;
+        s.sun.direction = direction;
+    });
+}
+
+void SkyPanel::chooseMap()
+{
+    const QString path = m_chooseMap ? m_chooseMap() : QString();
+    if (!path.isEmpty()) setMapPath(path);
+}
+
+void SkyPanel::setMapPath(const QString& path)
+{
+    const std::string abs = QFileInfo(path).absoluteFilePath().toStdString();
+    apply(m_path, tr("Choose sky map"), [&](Scene& s) {
+        s.skyModel.kind = sky::SkyKind::Map;
+        s.skyModel.path = abs;
+    });
+}
+
+void SkyPanel::refresh()
+{
+    const Scene& s = m_doc->scene();
+    const SkyDesc& d = s.skyModel;
+    {
+        const QSignalBlocker b1(m_kind), b2(m_lights), b3(m_interleave), b4(m_sunMode), b5(m_dial), b6(m_date), b7(m_time),
+            b8(m_timeSlider);
+        m_kind->setCurrentIndex(m_kind->findData(int(d.kind)));
+        m_lights->setValue(d.lights);
+        m_interleave->setValue(d.interleave);
+        m_sunMode->setCurrentIndex(s.sun.place ? 1 : 0);
+        double el = 0.0, az = 0.0;
+        sunAngles(s.sun.direction, &el, &az);
+        setValue(m_elevation, el);
+        setValue(m_azimuth, az);
+        m_dial->setValue(int(std::lround(az)) % 360);
+        const sky::SunPlace p = placeOf(s);
+        m_date->setDate(QDate(p.year, p.month, p.day));
+        const int minutes = int(std::lround(p.hour * 60.0));
+        m_time->setTime(QTime(std::min(23, minutes / 60), minutes >= 24 * 60 ? 59 : minutes % 60));
+        m_timeSlider->setValue(std::min(24 * 60 - 1, minutes));
+        setValue(m_zone, p.timeZoneHours);
+        setValue(m_latitude, p.latitudeDeg);
+        setValue(m_longitude, p.longitudeDeg);
+        m_sunInfo->setText(tr("Elevation %1 deg, azimuth %2 deg").arg(el, 0, 'f', 2).arg(az, 0, 'f', 2) +
+                           (d.kind == sky::SkyKind::Map && d.sunFromMap ? tr(" (the picture's sun is the map's own)") : QString()));
+    }
+    setValue(m_turbidity, d.turbidity);
+    setValue(m_rotation, double(d.rotationDeg));
+    setValue(m_intensity, double(d.intensity));
+    m_path->setText(QString::fromStdString(d.path));
+    m_preethamRows->setVisible(d.kind == sky::SkyKind::Preetham);
+    m_mapRows->setVisible(d.kind == sky::SkyKind::Map);
+    m_lightRows->setVisible(d.analytic());
+    m_sunPages->setCurrentIndex(s.sun.place ? 1 : 0);
+}
+
+} // namespace sylva
