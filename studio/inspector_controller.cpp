@@ -6,6 +6,7 @@
 #include <QDockWidget>
 
 #include "pipeline/render/render_job.h"
+#include "pipeline/render/volume_job.h"
 #include "pipeline/services/exports.h"
 #include "studio/asset_store.h"
 #include "studio/job_manager.h"
@@ -38,6 +39,11 @@ void InspectorController::refresh()
 {
     if (!m_dock->isVisible()) return;
     const int species = m_selectedSpecies();
+    if (species < 0 && m_selectedVolume && m_selectedVolume() >= 0) {
+        if (m_job) m_job->cancel();
+        m_inspectedKey.clear();
+        if (inspectVolume(m_selectedVolume())) return;
+    }
     if (species < 0) {
         if (m_job) m_job->cancel();
         m_inspectedKey.clear();
@@ -57,6 +63,25 @@ void InspectorController::refresh()
         return;
     }
     inspectSpecies(species);
+}
+
+bool InspectorController::inspectVolume(int volume)
+{
+    const Scene& scene = m_doc->scene();
+    if (volume < 0 || size_t(volume) >= scene.volumes.size() || !scene.volumes[size_t(volume)].data) return false;
+    // The lit copy when the lighting job has made it (the viewport's), else the loaded density alone.
+    Scene lit;
+    const bool solved = m_lighting->volumeLights()->litScene(scene, true, &lit);
+    const VolumeDesc& v = solved ? lit.volumes[size_t(volume)] : scene.volumes[size_t(volume)];
+    auto g = std::make_shared<SpeciesGrids>();
+    g->density = v.data->density;
+    if (g->density.woodFraction.size() != g->density.density.size()) g->density.woodFraction.assign(g->density.density.size(), 0.0f);
+    g->lighting = v.data->lighting;
+    g->lightingNorm = v.data->lightingNorm;
+    g->params = volumeLightingParams(scene, v);
+    m_inspector->setGrids(QString::fromStdString(v.name), g);
+    Q_EMIT updated();
+    return true;
 }
 
 Job* InspectorController::inspectSpecies(int species)

@@ -38,6 +38,11 @@ public:
     void refresh();
     // Loads the species' density and lighting grids in a job and shows them. Null for a bad index.
     Job* inspectSpecies(int species);
+    // selectedVolume: the volume the selection points at (-1: none); refresh shows its density grid and,
+    // once the lighting job has solved it, its LB lighting (VolumeLightStore).
+    void setSelectedVolume(std::function<int()> selectedVolume) { m_selectedVolume = std::move(selectedVolume); }
+    // Shows volume `volume`'s grids now; false for a bad index or a volume whose grid is not loaded.
+    bool inspectVolume(int volume);
 
 Q_SIGNALS:
     void updated();   // the inspector shows new grids (or a message)
@@ -52,6 +57,7 @@ private:
     VolumeInspector* m_inspector;
     QDockWidget* m_dock;
     std::function<int()> m_selectedSpecies;
+    std::function<int()> m_selectedVolume;
     QPointer<Job> m_job;
     std::string m_inspectedKey;   // asset key of what the inspector shows (or is loading)
 };

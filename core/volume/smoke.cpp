@@ -119,6 +119,20 @@ bool SmokeShape::contains(const glm::vec3& p) const
     return d.x <= halfSize.x && d.y <= halfSize.y && d.z <= halfSize.z;
 }
 
+void setSmokeDomain(SmokeSettings& s, float width)
+{
+    s.cellSize = width / float(std::max(1, s.cells.x));
+    s.origin = glm::vec3(-0.5f * width, 0.0f, -0.5f * float(s.cells.z) * s.cellSize);
+}
+
+SmokeShape defaultSmokeSource(const SmokeSettings& s, float width)
+{
+    SmokeShape sphere;
+    sphere.centre = glm::vec3(0.0f, 0.15f * float(s.cells.y) * s.cellSize, 0.0f);
+    sphere.radius = 0.1f * width;
+    return sphere;
+}
+
 double smokeBytes(const glm::ivec3& c)
 {
     const double cells = double(c.x) * double(c.y) * double(c.z);

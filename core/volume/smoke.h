@@ -85,6 +85,12 @@ struct SmokeStepStats {
 // Throws sylva::Error naming the setting for values out of range (sizes 0 or over 512, a grid over the
 // memory limit (SYLVA_MEMORY_LIMIT_MB or what the machine has), dt <= 0, NaN, densities outside [0, 1]).
 void validateSmoke(const SmokeSettings& settings);
+// The domain `sylva simulate` and the studio's smoke job set up: cubic cells, `width` metres along x, the
+// floor at y = 0 and the domain centred on the y axis (sets cellSize and origin from cells). Width must be > 0.
+void setSmokeDomain(SmokeSettings& settings, float width);
+// Their default source: one sphere at the bottom centre (15% of the height up), a tenth of the width in radius.
+SmokeShape defaultSmokeSource(const SmokeSettings& settings, float width);
+
 // Bytes the simulation holds for these cells (the memory check uses it).
 double smokeBytes(const glm::ivec3& cells);
 

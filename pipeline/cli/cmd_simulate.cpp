@@ -65,8 +65,7 @@ int runSimulate(const Args& args)
     }
     const float width = args.has("--size") ? float(parseNumber("--size", args.get("--size"))) : 1.0f;
     if (!(width > 0.0f)) throw Error("simulate: --size " + args.get("--size") + " must be > 0");
-    s.cellSize = width / float(std::max(1, s.cells.x));
-    s.origin = glm::vec3(-0.5f * width, 0.0f, -0.5f * float(s.cells.z) * s.cellSize);
+    volume::setSmokeDomain(s, width);
     if (args.has("--dt")) s.dt = float(parseNumber("--dt", args.get("--dt")));
     const int steps = args.has("--steps") ? int(parseInteger("--steps", args.get("--steps"), 1, 1000000)) : 100;
     const int every = args.has("--every") ? int(parseInteger("--every", args.get("--every"), 1, 1000000)) : 10;
@@ -80,15 +79,9 @@ int runSimulate(const Args& args)
     if (args.has("--cubic")) s.interp = volume::SmokeInterp::MonotonicCubic;
     if (args.has("--tol")) s.pressureTolerance = parseNumber("--tol", args.get("--tol"));
     if (args.has("--seed")) s.seed = uint64_t(parseInteger("--seed", args.get("--seed"), 0, (1ll << 62)));
-    const float h = s.cellSize;
     std::vector<volume::SmokeShape> sources = args.has("--source") ? parseShapes("--source", args.get("--source"))
                                                                    : std::vector<volume::SmokeShape>{};
-    if (!args.has("--source")) {   // one sphere at the bottom centre, a tenth of the width in radius
-        volume::SmokeShape sphere;
-        sphere.centre = glm::vec3(0.0f, 0.15f * float(s.cells.y) * h, 0.0f);
-        sphere.radius = 0.1f * width;
-        sources.push_back(sphere);
-    }
+    if (!args.has("--source")) sources.push_back(volume::defaultSmokeSource(s, width));   // one sphere at the bottom centre
     const float sourceDensity = args.has("--source-density") ? float(parseNumber("--source-density", args.get("--source-density"))) : 1.0f;
     const float sourceTemp = args.has("--source-temperature") ? float(parseNumber("--source-temperature", args.get("--source-temperature"))) : 1.0f;
     const glm::vec3 sourceVel = args.has("--source-velocity") ? parseTriple("--source-velocity", args.get("--source-velocity")) : glm::vec3(0.0f);

@@ -20,11 +20,6 @@ using json::Layout;
 using json::Table;
 using json::TableBuilder;
 
-namespace {
-
-SceneReadContext& in(JsonReader& r) { return static_cast<SceneReadContext&>(r); }
-SceneWriteContext& out(JsonWriter& w) { return static_cast<SceneWriteContext&>(w); }
-
 VolumeDesc defaultVolume()
 {
     VolumeDesc d;
@@ -33,6 +28,11 @@ VolumeDesc defaultVolume()
     d.lighting.storage = lb::Storage::Fp16;
     return d;
 }
+
+namespace {
+
+SceneReadContext& in(JsonReader& r) { return static_cast<SceneReadContext&>(r); }
+SceneWriteContext& out(JsonWriter& w) { return static_cast<SceneWriteContext&>(w); }
 
 json::Field<VolumeDesc>& channels(TableBuilder<VolumeDesc>& b, const char* key, float lb::ChannelParams::*member)
 {

@@ -5,6 +5,9 @@
 
 namespace sylva {
 
+// A volume entry's defaults when read (preset cloud, the LB's 2 steps per edge, fp16 lighting storage).
+VolumeDesc defaultVolume();
+
 // The fields of one entry of "volumes".
 const json::Table<VolumeDesc>& volumeTable();
 
