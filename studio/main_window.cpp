@@ -43,6 +43,7 @@
 #include "studio/scatter_tool.h"
 #include "studio/species_importer.h"
 #include "studio/viewport.h"
+#include "studio/volume_dialogs.h"
 #include "studio/volume_inspector.h"
 
 namespace sylva {
@@ -125,11 +126,14 @@ MainWindow::MainWindow(QWidget* parent)
     m_materials = new MaterialsController(m_doc, m_jobs, this, this);
     m_scatter = new ScatterTool(m_doc, [this] { return selectedSpecies(); }, this, this);
     m_importer = new SpeciesImporter(m_doc, m_jobs, this, this);
-    for (StudioController* c : std::initializer_list<StudioController*>{m_lighting, m_export, m_materials, m_scatter, m_importer})
+    m_volumeTools = new VolumeTools(m_doc, m_jobs, this, this);
+    for (StudioController* c : std::initializer_list<StudioController*>{m_lighting, m_export, m_materials, m_scatter, m_importer, m_volumeTools})
         adopt(c);
     connect(m_importer, &SpeciesImporter::instanceAdded, this,
             [this](int instance) { m_outliner->setCurrentIndex(m_model->indexOf({OutlinerItem::Kind::Instance, instance})); });
     connect(m_lighting, &LightingScheduler::settled, this, [this] { refreshInspector(); });
+    connect(m_volumeTools, &VolumeTools::volumeAdded, this,
+            [this](int volume) { m_outliner->setCurrentIndex(m_model->indexOf({OutlinerItem::Kind::Volume, volume})); });
 
     buildDocks();
     buildActions();
@@ -158,6 +162,7 @@ MainWindow::~MainWindow()
     delete std::exchange(m_autosave, nullptr);
     delete std::exchange(m_inspection, nullptr);
     delete std::exchange(m_importer, nullptr);
+    delete std::exchange(m_volumeTools, nullptr);
     delete std::exchange(m_scatter, nullptr);
     delete std::exchange(m_materials, nullptr);
     delete std::exchange(m_export, nullptr);
@@ -224,6 +229,10 @@ void MainWindow::buildDocks()
     m_inspection = new InspectorController(m_doc, m_jobs, &m_assets, m_cache.get(), m_backend.get(), m_lighting, m_inspector,
                                            m_inspectorDock, [this] { return selectedSpecies(); }, this);
     adopt(m_inspection);
+    m_inspection->setSelectedVolume([this] {
+        const OutlinerItem it = m_model->itemAt(m_outliner->currentIndex());
+        return it.kind == OutlinerItem::Kind::Volume ? it.row : -1;
+    });
 
     // Outliner over properties on the right, full height; jobs beside the log under the viewport.
     setCorner(Qt::BottomRightCorner, Qt::RightDockWidgetArea);
@@ -316,6 +325,8 @@ void MainWindow::buildActions()
     add(edit, tr("&Delete"), "actionDelete", QKeySequence::Delete, [this] { deleteSelection(); });
     add(edit, tr("Species &Materials..."), "actionMaterials", QKeySequence(), [this] { m_materials->editMaterials(selectedSpecies()); });
     add(edit, tr("&Scatter Instances..."), "actionScatter", QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_T), [this] { m_scatter->scatterDialog(); });
+    add(edit, tr("Add &Cloud..."), "actionAddCloud", QKeySequence(), [this] { m_volumeTools->cloudDialog(); });
+    add(edit, tr("Simulate S&moke..."), "actionSimulateSmoke", QKeySequence(), [this] { m_volumeTools->smokeDialog(); });
 
     QMenu* render = menuBar()->addMenu(tr("&Render"));
     add(render, tr("Compute &Lighting"), "actionLight", QKeySequence(Qt::CTRL | Qt::Key_L), [this] { m_lighting->computeLighting(); });
@@ -490,6 +501,10 @@ void MainWindow::deleteSelection()
     if (it.kind == OutlinerItem::Kind::Instance && it.row >= 0 && size_t(it.row) < s.instances.size()) {
         s.instances.erase(s.instances.begin() + it.row);
         m_doc->edit(s, tr("Delete instance"));
+    } else if (it.kind == OutlinerItem::Kind::Volume && it.row >= 0 && size_t(it.row) < s.volumes.size()) {
+        const std::string name = s.volumes[size_t(it.row)].name;
+        s.volumes.erase(s.volumes.begin() + it.row);
+        m_doc->edit(s, tr("Delete volume %1").arg(QString::fromStdString(name)));
     } else if (it.kind == OutlinerItem::Kind::Species && it.row >= 0 && size_t(it.row) < s.species.size()) {
         // The species and its instances; later species move down one index.
         const uint32_t gone = uint32_t(it.row);

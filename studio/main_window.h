@@ -43,6 +43,7 @@ class SpeciesImporter;
 class StudioController;
 class Viewport;
 class VolumeInspector;
+class VolumeTools;
 
 class MainWindow : public QMainWindow {
     Q_OBJECT
@@ -84,6 +85,7 @@ public:
     MaterialsController* materials() const { return m_materials; }
     ScatterTool* scatterTool() const { return m_scatter; }
     SpeciesImporter* importer() const { return m_importer; }
+    VolumeTools* volumeTools() const { return m_volumeTools; }
 
     // How errors and the unsaved-changes question reach the user. Defaults: modal message boxes.
     // Tests install non-blocking ones; errorReported is emitted either way (for the controllers'
@@ -161,6 +163,7 @@ private:
     MaterialsController* m_materials = nullptr;
     ScatterTool* m_scatter = nullptr;
     SpeciesImporter* m_importer = nullptr;
+    VolumeTools* m_volumeTools = nullptr;
 
     ErrorReporter m_reportError;
     SavePrompt m_askSave;
