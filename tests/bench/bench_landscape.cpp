@@ -58,16 +58,29 @@ double keptFraction(const RenderView& v)
 }
 
 #ifdef SYLVA_HAVE_EMBREE
+// This process's resident bytes (/proc/self/statm): Embree's memory monitor does not see every allocation (its
+// instance objects), so the cap and the comparison use what the process holds.
+long long residentBytes()
+{
+    long long pages = 0, resident = 0;
+    if (FILE* f = std::fopen("/proc/self/statm", "r")) {
+        if (std::fscanf(f, "%lld %lld", &pages, &resident) != 2) resident = 0;
+        std::fclose(f);
+    }
+    return resident * 4096;
+}
+
 // The landscape flattened for Embree 3: the terrain as one indexed triangle mesh (the height field's triangles,
 // camera-relative), every plant that grows (landPlantGrows) as an instance of its species' scene with the
-// landscape's own map (landPlantInstance) inverted. Stops adding instances once Embree's bytes pass `capBytes`
-// (complete = false: Embree cannot hold this landscape under the cap).
+// landscape's own map (landPlantInstance) inverted. Stops adding instances once the process has grown by more
+// than `capBytes` (complete = false: Embree cannot hold this landscape under the cap). bytes: Embree's memory
+// monitor; resident: the process's growth over the build.
 struct EmbreeLandscape {
     RTCDevice device = nullptr;
     RTCScene top = nullptr;
     std::vector<RTCScene> species;
     std::vector<std::unique_ptr<bench::EmbreeGeomData>> geomData;
-    long long bytes = 0;
+    long long bytes = 0, resident = 0;
     size_t instances = 0;
     bool complete = true;
     double buildSeconds = 0.0;
@@ -79,7 +92,7 @@ struct EmbreeLandscape {
         if (!device) throw std::runtime_error("rtcNewDevice failed");
         rtcSetDeviceErrorFunction(device, bench::embreeError, nullptr);
         rtcSetDeviceMemoryMonitorFunction(device, bench::embreeMemoryMonitor, nullptr);
-        const long long base = bench::g_embreeBytes.load();
+        const long long base = bench::g_embreeBytes.load(), rss0 = residentBytes();
         const double t0 = bench::now();
         species = bench::embreeSpeciesScenes(device, rs, v, RTC_BUILD_QUALITY_MEDIUM, geomData, false);
         top = rtcNewScene(device);
@@ -129,11 +142,12 @@ struct EmbreeLandscape {
                 rtcReleaseGeometry(gi);
                 ++instances;
             }
-            if ((cell & 63u) == 0 && bench::g_embreeBytes.load() - base > capBytes) complete = false;
+            if ((cell & 63u) == 0 && residentBytes() - rss0 > capBytes) complete = false;
         }
         if (complete) rtcCommitScene(top);
         bytes = bench::g_embreeBytes.load() - base;
-        if (bytes > capBytes) complete = false;
+        resident = residentBytes() - rss0;
+        if (resident > capBytes) complete = false;
         buildSeconds = bench::now() - t0;
     }
 
@@ -311,8 +325,8 @@ int main(int argc, char** argv)
         // The same rays through Embree holding the landscape flattened; ours timed again beside it (same run).
         const EmbreeLandscape em(rs, v, threadsUsed, (long long)(embreeCapGb * 1e9));
         if (!em.complete) {
-            std::printf("%4d^2 cells: Embree ran out: %.2f GB (cap %.1f GB) after %zu instances of %.0f\n", n, double(em.bytes) / 1e9, embreeCapGb,
-                        em.instances, r.instances * r.keptFraction);
+            std::printf("%4d^2 cells: Embree ran out: %.2f GB resident (cap %.1f GB) after %zu instances of %.0f\n", n, double(em.resident) / 1e9,
+                        embreeCapGb, em.instances, r.instances * r.keptFraction);
             std::printf("cells%d_embree_out_of_memory=1\n", n);
             continue;
         }
@@ -365,11 +379,13 @@ int main(int argc, char** argv)
         for (size_t i = 0; i < sh.size(); ++i) shadowDiffer += occ[i] != occEm[i];
         const double raysAll = double(np + sh.size());
         const double ours = raysAll / (ourPrimary + ourShadow), theirs = raysAll / (emPrimary + emShadow);
-        std::printf("%4d^2 cells vs Embree 3 (%zu instances + the terrain mesh, built in %.1f s): memory %.1f MB ours / %.1f MB Embree = %.4f; "
+        std::printf("%4d^2 cells vs Embree 3 (%zu instances + the terrain mesh, built in %.1f s): memory %.1f MB ours / %.1f MB Embree (monitor; resident %.1f MB) = %.4f (resident %.4f); "
                     "primary %.3f / %.3f s, shadow %.3f / %.3f s; rays/s ours / Embree = %.3f (primary %.3f, shadow %.3f); %zu of %zu primary and "
                     "%zu of %zu shadow results differ\n",
-                    n, em.instances, em.buildSeconds, r.mb, double(em.bytes) / 1e6, r.mb * 1e6 / double(em.bytes), ourPrimary, emPrimary, ourShadow,
+                    n, em.instances, em.buildSeconds, r.mb, double(em.bytes) / 1e6, double(em.resident) / 1e6, r.mb * 1e6 / double(em.bytes),
+                    r.mb * 1e6 / double(std::max(em.resident, 1ll)), ourPrimary, emPrimary, ourShadow,
                     emShadow, ours / theirs, emPrimary / ourPrimary, emShadow / ourShadow, primaryDiffer, np, shadowDiffer, sh.size());
+        std::printf("cells%d_embree_resident_mb=%.3f\n", n, double(em.resident) / 1e6);
         std::printf("cells%d_embree_instances=%zu\ncells%d_embree_mb=%.3f\ncells%d_memory_ratio=%.5f\ncells%d_rays_per_s_ratio=%.4f\n"
                     "cells%d_primary_ratio=%.4f\ncells%d_shadow_ratio=%.4f\ncells%d_primary_differ=%zu\ncells%d_shadow_differ=%zu\n",
                     n, em.instances, n, double(em.bytes) / 1e6, n, r.mb * 1e6 / double(em.bytes), n, ours / theirs, n, emPrimary / ourPrimary, n,
