@@ -17,30 +17,6 @@ namespace sylva::study {
 
 namespace fs = std::filesystem;
 
-double forwardShare(double g)
-{
-    if (std::fabs(g) < 1e-6) return 0.5 + 0.375 * g;   // series: 1/2 + 3g/8 + O(g^3)
-    if (g >= 1.0) return 1.0;
-    if (g <= -1.0) return 0.0;
-    return (1.0 + g) / (2.0 * g) - (1.0 - g * g) / (2.0 * g * std::sqrt(1.0 + g * g));
-}
-
-LeafOptics leafOptics(const lb::LbParams& params)
-{
-    LeafOptics o{};
-    for (int c = 0; c < 3; ++c) {
-        const lb::ChannelParams& ch = params.channels[size_t(c)];
-        const double st = double(ch.sigmaA) + double(ch.sigmaS);
-        const double a = st > 0.0 ? double(ch.sigmaS) / st : 0.0;
-        const double f = forwardShare(double(ch.g));
-        o.albedo[c] = float(a);
-        o.transmittance[c] = float(a * f);
-        o.reflectance[c] = float(a * (1.0 - f));
-        o.ratio[c] = f < 1.0 ? float(f / (1.0 - f)) : 0.0f;
-    }
-    return o;
-}
-
 glm::dvec3 toBlender(const glm::dvec3& p) { return {p.x, -p.z, p.y}; }
 
 namespace {
@@ -136,6 +112,12 @@ BlenderSun blenderSun(const glm::vec3& rad)
     return {rad / m, M_PI * double(m)};
 }
 
+BlenderGlossy blenderGlossy(const glm::vec3& specular, float shininess)
+{
+    const double a2 = 2.0 / (4.0 * double(shininess) + 2.0);   // Blinn exponent 4n about the half vector
+    return {glm::vec3(float(4.0 * a2)) * specular, std::sqrt(std::sqrt(a2))};
+}
+
 std::string writeBlenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const std::string& dir,
                               const BlenderOptions& o, const std::string& skyExr)
 {
@@ -151,14 +133,14 @@ std::string writeBlenderScene(const Scene& scene, const std::vector<SpeciesAsset
 
     std::ostringstream py;
     py << "# Written by sylva (pipeline/study/blender_scene.cpp): a Sylva scene for Cycles.\n"
-          "# blender -b --factory-startup --python scene.py -- [--samples N] [--seed S] [--out FILE.exr] [--sun 0|1] [--sky 0|1] [--translucent 0|1] [--threads N]\n"
+          "# blender -b --factory-startup --python scene.py -- [--samples N] [--seed S] [--out FILE.exr] [--sun 0|1] [--sky 0|1] [--translucent 0|1] [--bounces N] [--ground 0|1] [--threads N]\n"
           "import bpy, sys, os, time\nfrom array import array\n"
           "from mathutils import Matrix\n"
           "argv = sys.argv[sys.argv.index('--') + 1:] if '--' in sys.argv else []\n"
           "def arg(name, default):\n"
           "    return type(default)(argv[argv.index(name) + 1]) if name in argv else default\n";
     py << "SAMPLES = arg('--samples', " << o.samples << ")\nSEED = arg('--seed', " << o.seed << ")\nTHREADS = arg('--threads', "
-       << o.threads << ")\nOUT = arg('--out', " << pyString(o.exrPath) << ")\nSUN_ON = arg('--sun', 1)\nSKY_ON = arg('--sky', 1)\nTRANS_ON = arg('--translucent', 1)\n";
+       << o.threads << ")\nOUT = arg('--out', " << pyString(o.exrPath) << ")\nSUN_ON = arg('--sun', 1)\nSKY_ON = arg('--sky', 1)\nTRANS_ON = arg('--translucent', 1)\nGROUND_ON = arg('--ground', 1)\n";
     py << "DATA = " << pyString(base) << "\n";
     py << R"PY(
 for ob in list(bpy.data.objects):
@@ -180,9 +162,9 @@ cy.caustics_reflective = False
 cy.caustics_refractive = False
 cy.blur_glossy = 0.0
 )PY";
-    py << "cy.max_bounces = " << o.bounces << "\ncy.diffuse_bounces = " << o.bounces << "\ncy.transmission_bounces = " << o.bounces
-       << "\ncy.glossy_bounces = " << o.bounces << "\ncy.volume_bounces = 0\ncy.transparent_max_bounces = " << o.transparentBounces
-       << "\n";
+    py << "BOUNCES = arg('--bounces', " << o.bounces << ")\n";
+    py << "cy.max_bounces = BOUNCES\ncy.diffuse_bounces = BOUNCES\ncy.transmission_bounces = BOUNCES\ncy.glossy_bounces = BOUNCES\n"
+          "cy.volume_bounces = 0\ncy.transparent_max_bounces = " << o.transparentBounces << "\n";
     py << "sc.render.resolution_x = " << scene.render.width << "\nsc.render.resolution_y = " << scene.render.height << "\n";
     py << R"PY(sc.render.resolution_percentage = 100
 sc.render.pixel_aspect_x = 1.0
@@ -219,7 +201,10 @@ def image(path, colorspace):
 # Sylva's surface material: kd = diffuse x texture (sRGB decoded, bilinear, wrapped); leaves add
 # diffuse transmission kd x ratio, capped at 0.98 - kd (translucent BSDF); a cut-out (nearest texel, opaque where alpha >= 0.5)
 # lets the ray through as a transparent BSDF.
-def material(name, diffuse, leaf, ratio, color_png, mask_png):
+# Sylva's Phong term ks x (r . v)^n x sunRadiance (sun only) as a GGX Glossy BSDF of the same peak radiance
+# and about the same lobe: Phong n about the reflection vector is Blinn n' = 4n about the half vector, alpha^2 =
+# 2 / (n' + 2), colour 4 alpha^2 ks (spec, roughness = sqrt(alpha) already computed by the export).
+def material(name, diffuse, leaf, ratio, color_png, mask_png, spec=(0.0, 0.0, 0.0), roughness=0.0):
     m = bpy.data.materials.new(name)
     m.use_nodes = True
     nt = m.node_tree
@@ -258,6 +243,14 @@ def material(name, diffuse, leaf, ratio, color_png, mask_png):
         nt.links.new(surf, add.inputs[0])
         nt.links.new(tl.outputs[0], add.inputs[1])
         surf = add.outputs[0]
+    if max(spec) > 0.0:
+        gl = node(nt, 'ShaderNodeBsdfGlossy', distribution='GGX')
+        gl.inputs['Color'].default_value = (spec[0], spec[1], spec[2], 1.0)
+        gl.inputs['Roughness'].default_value = roughness
+        add2 = node(nt, 'ShaderNodeAddShader')
+        nt.links.new(surf, add2.inputs[0])
+        nt.links.new(gl.outputs[0], add2.inputs[1])
+        surf = add2.outputs[0]
     if mask_png:
         mt = node(nt, 'ShaderNodeTexImage', interpolation='Closest', extension='REPEAT')
         mt.image = image(mask_png, 'Non-Color')
@@ -369,7 +362,12 @@ def place(coll, name, matrix):
             }
             mats += "material(" + pyString(stem + "_" + (mt.name.empty() ? std::string("default") : mt.name)) + ", " +
                     vec(glm::dvec3(mt.diffuse)) + ", " + (mt.isLeaf ? "True" : "False") + ", " + vec(glm::dvec3(lo.ratio)) + ", " +
-                    (colorPng.empty() ? "None" : pyString(colorPng)) + ", " + (maskPng.empty() ? "None" : pyString(maskPng)) + "), ";
+                    (colorPng.empty() ? "None" : pyString(colorPng)) + ", " + (maskPng.empty() ? "None" : pyString(maskPng));
+            if (mt.shininess > 0.0f && (mt.specular.x > 0.0f || mt.specular.y > 0.0f || mt.specular.z > 0.0f)) {
+                const BlenderGlossy gl = blenderGlossy(mt.specular, mt.shininess);
+                mats += ", " + vec(glm::dvec3(gl.color)) + ", " + num(gl.roughness);
+            }
+            mats += "), ";
         }
         mats += "]";
         py << "coll" << s << " = species(" << pyString(sp.name) << ", " << pyString(stem) << ", " << mats << ")\n";
@@ -394,13 +392,13 @@ def place(coll, name, matrix):
               "gmat = material('ground', "
            << vec(glm::dvec3(scene.ground.color))
            << ", False, (0, 0, 0), None, None)\ngm.materials.append(gmat)\ngo = bpy.data.objects.new('ground', gm)\n"
-              "sc.collection.objects.link(go)\n";
+              "if GROUND_ON:\n    sc.collection.objects.link(go)\n";
     }
     // Sun lamp: the same direction, colour and irradiance (blenderSun); a point-like sun (angle 0).
     {
-        const glm::vec3 rad = sunRadiance(scene.sun);
-        const BlenderSun bs = blenderSun(rad);
-        const glm::dvec3 z = glm::normalize(toBlender(glm::dvec3(scene.sun.direction)));   // lamp shines along -z
+        const FrameSun fs = frameSun(scene, sunRadiance(scene.sun));   // a Preetham or map sky's own sun, as the renderer's
+        const BlenderSun bs = blenderSun(fs.radiance);
+        const glm::dvec3 z = glm::normalize(toBlender(glm::dvec3(fs.direction)));   // lamp shines along -z
         glm::dvec3 x = glm::cross(glm::dvec3(0, 0, 1), z);
         if (glm::length(x) < 1e-9) x = glm::dvec3(1, 0, 0);
         x = glm::normalize(x);

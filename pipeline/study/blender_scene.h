@@ -8,24 +8,16 @@
 
 #include <glm/glm.hpp>
 
+#include "core/lb/leaf_optics.h"
 #include "core/render/render_scene.h"
 #include "core/scene/scene.h"
 
 namespace sylva::study {
 
-// The leaf's surface optics that one LB channel (sigma_a, sigma_s, g) stands for: of the light a leaf
-// scatters, the Henyey-Greenstein phase sends forwardShare(g) through the leaf (transmission) and the
-// rest back (reflection); the single-scattering albedo sigma_s / (sigma_a + sigma_s) is their sum.
-// forwardShare(g) = integral of the HG phase over the forward hemisphere
-//                 = (1 + g) / (2 g) - (1 - g^2) / (2 g sqrt(1 + g^2)), 1/2 at g = 0.
-double forwardShare(double g);
-struct LeafOptics {
-    glm::vec3 albedo;        // sigma_s / sigma_t per channel
-    glm::vec3 reflectance;   // albedo x (1 - forwardShare)
-    glm::vec3 transmittance; // albedo x forwardShare
-    glm::vec3 ratio;         // transmittance / reflectance: the translucent colour per unit of diffuse colour
-};
-LeafOptics leafOptics(const lb::LbParams& params);
+// The leaf optics of an LB channel (core/lb/leaf_optics.h): the translucent colour the export gives leaves.
+using lb::forwardShare;
+using lb::LeafOptics;
+using lb::leafOptics;
 
 // Sylva (+Y up) to Blender (+Z up) world coordinates: (x, y, z) -> (x, -z, y), a proper rotation.
 glm::dvec3 toBlender(const glm::dvec3& p);
@@ -45,9 +37,21 @@ struct BlenderSun {
 };
 BlenderSun blenderSun(const glm::vec3& sunRadiance);
 
+// Sylva's Phong term (specular ks, shininess n: ks x (r . v)^n x sunRadiance, sun only) as a GGX Glossy BSDF:
+// Phong about the reflection vector is about Blinn 4n about the half vector, alpha^2 = 2 / (4n + 2); the colour
+// 4 alpha^2 ks gives the same radiance at the mirror direction under a head-on sun (GGX's peak D / 4 = 1 /
+// (4 pi alpha^2) per unit irradiance), roughness = sqrt(alpha) (Cycles squares it). What differs: the lobe's
+// shape away from its peak, and Cycles' glossy also reflects sky and inter-reflected light.
+struct BlenderGlossy {
+    glm::vec3 color;
+    double roughness;
+};
+BlenderGlossy blenderGlossy(const glm::vec3& specular, float shininess);
+
 // Which lights and optics a script run uses; the script also takes them from its command line after
-// "--" (--samples N --seed S --out FILE.exr --sun 0|1 --sky 0|1 --threads N), so one script serves a
-// whole sample sweep.
+// "--" (--samples N --seed S --out FILE.exr --sun 0|1 --sky 0|1 --translucent 0|1 --bounces N --threads N), so
+// one script serves a whole sample sweep (and, by --bounces, the scattering orders: 0 direct light only, 1 up
+// to single scattering).
 struct BlenderOptions {
     int samples = 64;
     int seed = 0;

@@ -17,7 +17,9 @@
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/render/tonemap.h"
+#include "core/sky/sky_light.h"
 #include "pipeline/io/atomic_file.h"
+#include "pipeline/io/env_map_io.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/study/blender_scene.h"
@@ -177,12 +179,13 @@ struct CyclesRun {
 };
 
 CyclesRun runCycles(const std::string& blender, const std::string& script, const std::string& exr, int samples, int seed,
-                    bool sun, bool sky, bool translucent = true)
+                    bool sun, bool sky, bool translucent = true, int bounces = -1, bool ground = true)
 {
     const std::string log = exr + ".log";
     const std::string cmd = "nice -n 5 '" + blender + "' -b --factory-startup --python '" + script + "' -- --samples " +
                             std::to_string(samples) + " --seed " + std::to_string(seed) + " --out '" + exr + "' --sun " +
-                            (sun ? "1" : "0") + " --sky " + (sky ? "1" : "0") + " --translucent " + (translucent ? "1" : "0") + " --threads 2 > '" + log + "' 2>&1";
+                            (sun ? "1" : "0") + " --sky " + (sky ? "1" : "0") + " --translucent " + (translucent ? "1" : "0") +
+                            (bounces >= 0 ? " --bounces " + std::to_string(bounces) : std::string()) + (ground ? "" : " --ground 0") + " --threads 2 > '" + log + "' 2>&1";
     const int rc = std::system(cmd.c_str());
     std::ifstream in(log);
     std::string line;
@@ -228,6 +231,18 @@ TruthScene treeScene(const Options& o)
     t.title = "one tree near the camera (" + fs::path(mesh).filename().string() + ", textured leaf cut-outs)";
     t.refSamples = 2048;
     t.sweep = {1, 4, 16, 64, 256, 512};
+    return t;
+}
+
+// The same tree under a Preetham sky (turbidity 3, the same sun direction): Cycles sees the sky through the
+// equirectangular map `sylva sky` writes, Sylva lights with its virtual sky lights (leaves included) and the
+// sky's own sun.
+TruthScene treeSkyScene(const Options& o)
+{
+    TruthScene t = treeScene(o);
+    t.key = "tree_sky";
+    t.title = t.title.substr(0, t.title.size() - 1) + ", under a Preetham sky)";
+    t.scene.skyModel.kind = sky::SkyKind::Preetham;
     return t;
 }
 
@@ -337,11 +352,11 @@ double cyclesTimeAt(const std::vector<Point>& c, double e, bool* bound)
 
 // Error against time on log-log axes: each scene's Cycles curve and Sylva points, one SVG.
 void writeSvg(const std::string& path, const std::vector<std::string>& names, const std::vector<std::vector<Point>>& cycles,
-              const std::vector<std::vector<Point>>& sylva)
+              const std::vector<std::vector<Point>>& sylva, const std::vector<std::vector<Point>>& sylvaOnce)
 {
     const double W = 640, H = 420, L = 70, R = 150, T = 20, B = 50;
     double t0 = 1e30, t1 = 0, e0 = 1e30, e1 = 0;
-    for (const auto* set : {&cycles, &sylva})
+    for (const auto* set : {&cycles, &sylva, &sylvaOnce})
         for (const auto& v : *set)
             for (const Point& p : v) {
                 t0 = std::min(t0, p.seconds), t1 = std::max(t1, p.seconds);
@@ -372,11 +387,15 @@ void writeSvg(const std::string& path, const std::vector<std::string>& names, co
         for (const Point& p : sylva[k])
             s << "<rect x='" << X(p.seconds) - 3.5 << "' y='" << Y(p.m.lum) - 3.5 << "' width='7' height='7' fill='none' stroke='" << col
               << "' stroke-width='1.5'/>\n";
-        const double ly = T + 15 + 30.0 * double(k);
+        for (const Point& p : sylvaOnce[k])
+            s << "<rect x='" << X(p.seconds) - 3.5 << "' y='" << Y(p.m.lum) - 3.5 << "' width='7' height='7' fill='" << col << "'/>\n";
+        const double ly = T + 15 + 45.0 * double(k);
         s << "<circle cx='" << W - R + 15 << "' cy='" << ly << "' r='3' fill='" << col << "'/><text x='" << W - R + 25 << "' y='" << ly + 4
           << "'>Cycles, " << names[k] << "</text>\n";
         s << "<rect x='" << W - R + 11.5 << "' y='" << ly + 10.5 << "' width='7' height='7' fill='none' stroke='" << col
           << "'/><text x='" << W - R + 25 << "' y='" << ly + 18 << "'>Sylva, " << names[k] << "</text>\n";
+        s << "<rect x='" << W - R + 11.5 << "' y='" << ly + 25.5 << "' width='7' height='7' fill='" << col << "'/><text x='" << W - R + 25
+          << "' y='" << ly + 33 << "'>Sylva once, " << names[k] << "</text>\n";
     }
     s << "</svg>\n";
     AtomicFile file(path, AtomicFile::Sync::No, "plot");
@@ -417,11 +436,11 @@ bool measureTruth(const Options& o)
     const std::string work = (fs::temp_directory_path() / ("sylva_truth_" + std::to_string(::getpid()))).string();
     fs::create_directories(pics);
     fs::create_directories(work);
-    std::vector<TruthScene> scenes = {treeScene(o), standScene(), forestScene()};
+    std::vector<TruthScene> scenes = {treeScene(o), treeSkyScene(o), standScene(), forestScene()};
     if (const char* only = std::getenv("SYLVA_TRUTH_SCENES")) {   // e.g. "tree,stand": a subset
         std::vector<TruthScene> kept;
         for (TruthScene& t : scenes)
-            if (std::string(only).find(t.key) != std::string::npos) kept.push_back(std::move(t));
+            if (("," + std::string(only) + ",").find("," + t.key + ",") != std::string::npos) kept.push_back(std::move(t));
         scenes = std::move(kept);
     }
     if (const char* div = std::getenv("SYLVA_TRUTH_SAMPLE_DIVISOR")) {   // a trial of the harness: fewer samples everywhere
@@ -465,7 +484,10 @@ bool measureTruth(const Options& o)
           "98%), F(g) = the HG phase's forward share (1 + g) / (2g) - (1 - g^2) / (2g sqrt(1 + g^2)) |\n"
           "| cut-out: opaque where alpha >= 0.5, nearest texel | Mix of Transparent BSDF and the leaf by alpha > 0.5, image "
           "'Closest' |\n"
-          "| LB indirect: kd x L x sunRadiance, L the normalized photon density (1 in open space) | all bounces of sun and sky "
+          "| LB indirect, the seed's sum (`lighting.direct` seed): kd x L x sunRadiance, L the normalized photon density (1 in "
+          "open space); direct light once (`lighting.direct` once): L less its uncollided part, weighed kd x (1 + t) / 4 on "
+          "leaves and kd / 4 on bark (a scattered field from all directions: a quarter of the fluence on each face) | all "
+          "bounces of sun and sky "
           "(64 diffuse and transmission bounces, 256 transparent) |\n\n";
     {
         const LeafOptics lo = leafOptics(defaultSpeciesLighting(*lb::findPreset("leaf")));
@@ -477,28 +499,48 @@ bool measureTruth(const Options& o)
            << f("%.3f", lo.ratio.z)
            << ". The texture colour, not the preset's albedo, is the leaf's reflectance in both renderers (it is what Sylva's "
               "surface shading multiplies); the preset only sets how much of it also goes through the leaf. What cannot match: "
-              "(1) Sylva's full mode adds the LB photon density, which includes the unscattered sun (L = 1 in open space), to the "
-              "local sun term, so direct light is counted twice where the leaf is lit; (2) Sylva lights leaves with no sky light "
-              "(the constant sky lights only the ground); (3) the LB volume scatters with albedo 0.89-0.91 while the textured "
+              "(1) Sylva's full mode with the seed's sum adds the LB photon density, which includes the unscattered sun (L = 1 in "
+              "open space), to the local sun term, so direct light is counted twice where the leaf is lit (`lighting.direct` once "
+              "removes it); (2) Sylva lights leaves with no sky light "
+              "under the constant sky (it lights only the ground; a Preetham or map sky lights leaves through its virtual lights, "
+              "the tree_sky scene); (3) the LB volume scatters with albedo 0.89-0.91 while the textured "
               "leaf reflects about kd, so the LB's inter-reflection is brighter than the surfaces'; (4) Sylva has no transmitted "
-              "direct sun (the back of a sunlit leaf gets only the LB term); (5) Sylva's Phong specular term is not mapped (the "
-              "study's materials have none).\n\n";
+              "direct sun (the back of a sunlit leaf gets only the LB term); (5) Sylva's Phong specular term (sun only) is not mapped (the "
+              "study's materials have none: the grown and imported trees' Ks is 0); (6) the LB grid's boundary is the sun alone, "
+              "so the ground's bounce onto the crown is missing from Sylva's indirect light.\n\n";
     }
 
     std::vector<std::string> names;
     std::vector<std::vector<Point>> cyclesCurves, sylvaPoints;
-    std::vector<double> convergedLum, bestRatios;
+    std::vector<double> convergedLum, convergedOnceLum, bestRatios;
+    std::vector<std::vector<Point>> sylvaOncePoints;
     md << "### Results\n\n";
     for (TruthScene& t : scenes) {
       try {
         Scene& s = t.scene;
         say(o, "truth " + t.key + ": loading the species");
         std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, o.cache, true);
-        if (t.key == "tree") frameTree(s, meshBounds(assets[0].mesh));
+        const bool tree = t.key.rfind("tree", 0) == 0;
+        if (tree) frameTree(s, meshBounds(assets[0].mesh));
         const int w = s.render.width, h = s.render.height;
         const std::string sdir = work + "/" + t.key;
         BlenderOptions bo;
-        const std::string script = writeBlenderScene(s, assets, sdir, bo);
+        std::string skyExr;
+        if (s.skyModel.analytic()) {   // the sky as `sylva sky` writes it: equirectangular, row 0 at the zenith
+            loadSceneSky(s);
+            const sky::EnvMap map = sky::skyToMap(*s.skyModel.built, 512);
+            ImageRgba img(map.width, map.height);
+            for (int y = 0; y < map.height; ++y)
+                for (int x = 0; x < map.width; ++x) {
+                    const glm::vec3 c = map.at(x, y);
+                    float* px = img.at(x, y);
+                    px[0] = c.x, px[1] = c.y, px[2] = c.z, px[3] = 1.0f;
+                }
+            fs::create_directories(sdir);
+            skyExr = sdir + "/sky.exr";
+            writeImage(skyExr, img, 3);
+        }
+        const std::string script = writeBlenderScene(s, assets, sdir, bo, skyExr);
         // Cycles: the converged reference, then the sweep (each against the reference).
         say(o, "truth " + t.key + ": Cycles reference, " + std::to_string(t.refSamples) + " samples");
         const CyclesRun ref = runCycles(blender, script, sdir + "/ref.exr", t.refSamples, 7, true, true);
@@ -519,10 +561,22 @@ bool measureTruth(const Options& o)
             int grid, spp;
         };
         const std::vector<Setting> settings = {{64, 1}, {64, 4}, {64, 16}, {64, 64}, {32, 4}};
-        std::vector<Point> syl;
+        std::vector<Point> syl, sylOnce;
         std::map<std::string, std::vector<SpeciesAssets>> byGrid;
         byGrid["64"] = std::move(assets);
-        Film converged;
+        Film converged, convergedOnce;
+        // Direct light counted once (lighting.direct once): each grid less its uncollided sunlight.
+        Scene once = s;
+        once.lighting.direct = DirectLight::Once;
+        const std::vector<SpeciesAssets> onceAssets = loadSpeciesAssets(once, o.cache, true);
+        for (int spp : {1, 4, 16, 64}) {
+            const SylvaRun r = runSylva(once, onceAssets, spp, 2);
+            const Image full = composeMode(r.film, RenderMode::Full, composeSky(s));
+            sylOnce.push_back({"grid 64, " + std::to_string(spp) + " spp", r.seconds, compare(full, refImg, w, h, scale)});
+            say(o, "truth " + t.key + ": Sylva once " + sylOnce.back().label + " " + f("%.3f s", r.seconds) + ", error " +
+                       f("%.4f", sylOnce.back().m.lum));
+            if (spp == 64) convergedOnce = r.film;
+        }
         double lbSeconds = 0.0;
         for (const Setting& st : settings) {
             const std::string gk = std::to_string(st.grid);
@@ -554,28 +608,41 @@ bool measureTruth(const Options& o)
         for (const glm::vec3& c : refImg) refMean += luminance(c);
         refMean /= double(refImg.size());
         writePng(pics + "/" + t.key + "_cycles.png", toneMap(refImg, scale), w, h);
-        for (RenderMode mode : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient}) {
-            const Image im = composeMode(converged, mode, composeSky(s));
+        struct Variant {
+            const char *name, *label;
+            const Film* film;
+            RenderMode mode;
+        };
+        const Variant variants[] = {{"full", "full, the seed's sum (`lighting.direct` seed)", &converged, RenderMode::Full},
+                                    {"once", "full, direct light once (`lighting.direct` once)", &convergedOnce, RenderMode::Full},
+                                    {"local", "local", &converged, RenderMode::Local},
+                                    {"ambient", "ambient", &converged, RenderMode::Ambient}};
+        for (const Variant& vr : variants) {
+            const RenderMode mode = vr.mode;
+            const Image im = composeMode(*vr.film, mode, composeSky(s));
             std::vector<float> fmap;
             const Metrics m = compare(im, refImg, w, h, scale, &fmap);
             double mean = 0.0;
             for (const glm::vec3& c : im) mean += luminance(c);
             mean /= double(im.size());
-            const std::string mname = renderModeName(mode);
-            md << "| Sylva " << mname << " (grid 64, 64 spp) | " << f("%.3f", m.lum) << " | " << f("%.3f", m.rgb) << " | " << f("%.3f", m.flip)
+            const std::string mname = vr.name;
+            md << "| Sylva " << vr.label << " (grid 64, 64 spp) | " << f("%.3f", m.lum) << " | " << f("%.3f", m.rgb) << " | " << f("%.3f", m.flip)
                << " | " << f("%.3f", mean / refMean) << " |\n";
             writePng(pics + "/" + t.key + "_sylva_" + mname + ".png", toneMap(im, scale), w, h);
             writePng(pics + "/" + t.key + "_flip_" + mname + ".png", heat(fmap), w, h);
             std::vector<float> lerr(im.size());
             for (size_t p = 0; p < im.size(); ++p) lerr[p] = float(std::fabs(luminance(im[p]) - luminance(refImg[p])) / (2.0 * refMean));
             writePng(pics + "/" + t.key + "_lum_" + mname + ".png", heat(lerr), w, h);
-            if (mode == RenderMode::Full) summary << "| " << t.key << " | " << f("%.3f", m.lum) << " | " << f("%.3f", m.flip) << " | ";
+            if (mname == "full") summary << "| " << t.key << " | " << f("%.3f", m.lum) << " | " << f("%.3f", m.flip) << " | ";
+            if (mname == "once") summary << f("%.3f", m.lum) << " | " << f("%.3f", m.flip) << " | ";
         }
         md << "\n";
-        md << "| Cycles | Sylva full | Sylva local | Sylva ambient | FLIP full | luminance error full |\n| --- | --- | --- | --- | --- | --- |\n";
+        md << "| Cycles | Sylva full (seed's sum) | Sylva full, direct once | Sylva local | Sylva ambient | FLIP full | FLIP once | luminance "
+              "error full | luminance error once |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
         md << "| ![](accuracy/truth/" << t.key << "_cycles.png) | ![](accuracy/truth/" << t.key << "_sylva_full.png) | ![](accuracy/truth/"
-           << t.key << "_sylva_local.png) | ![](accuracy/truth/" << t.key << "_sylva_ambient.png) | ![](accuracy/truth/" << t.key
-           << "_flip_full.png) | ![](accuracy/truth/" << t.key << "_lum_full.png) |\n\n";
+           << t.key << "_sylva_once.png) | ![](accuracy/truth/" << t.key << "_sylva_local.png) | ![](accuracy/truth/" << t.key
+           << "_sylva_ambient.png) | ![](accuracy/truth/" << t.key << "_flip_full.png) | ![](accuracy/truth/" << t.key
+           << "_flip_once.png) | ![](accuracy/truth/" << t.key << "_lum_full.png) | ![](accuracy/truth/" << t.key << "_lum_once.png) |\n\n";
         md << "Error maps: FLIP in [0, 1] and |luminance difference| / (2 x the reference's mean luminance), black - red - yellow - white.\n\n";
         // Equal time.
         md << "| run | seconds | relative L2 luminance | relative L2 colour | FLIP | Cycles' time to the same luminance error | Cycles / Sylva |\n"
@@ -584,12 +651,16 @@ bool measureTruth(const Options& o)
             md << "| Cycles " << p.label << " | " << f("%.2f", p.seconds) << " | " << f("%.4f", p.m.lum) << " | " << f("%.4f", p.m.rgb) << " | "
                << f("%.4f", p.m.flip) << " | | |\n";
         double bestRatio = 0.0;
-        for (const Point& p : syl) {
+        std::vector<std::pair<const char*, const Point*>> both;
+        for (const Point& p : syl) both.push_back({"full, ", &p});
+        for (const Point& p : sylOnce) both.push_back({"full, direct once, ", &p});
+        for (const auto& [kind, pp] : both) {
+            const Point& p = *pp;
             bool bound = false;
             const double tc = cyclesTimeAt(cyc, p.m.lum, &bound);
             const double ratio = tc > 0.0 ? tc / p.seconds : 0.0;
             bestRatio = std::max(bestRatio, ratio);
-            md << "| Sylva full, " << p.label << " | " << f("%.3f", p.seconds) << " | " << f("%.4f", p.m.lum) << " | " << f("%.4f", p.m.rgb) << " | "
+            md << "| Sylva " << kind << p.label << " | " << f("%.3f", p.seconds) << " | " << f("%.4f", p.m.lum) << " | " << f("%.4f", p.m.rgb) << " | "
                << f("%.4f", p.m.flip) << " | " << (tc > 0.0 ? (bound ? "< " : "") + f("%.2f s", tc) : std::string("beyond the sweep")) << " | "
                << (tc > 0.0 ? (bound ? "< " : "") + f("%.0fx", ratio) : std::string("-")) << " |\n";
         }
@@ -597,6 +668,7 @@ bool measureTruth(const Options& o)
         summary << f("%.0fx", bestRatio) << " |\n";
         bestRatios.push_back(bestRatio);
         convergedLum.push_back(syl[3].m.lum);
+        convergedOnceLum.push_back(sylOnce.back().m.lum);
         // Which term differs: on the plants' pixels, Sylva's parts against Cycles' passes of a sun-only run.
         if (t.key == "tree") {
             say(o, "truth tree: Cycles sun only, for the terms");
@@ -606,10 +678,11 @@ bool measureTruth(const Options& o)
             const SylvaRun mask = runSylva(ng, byGrid["64"], 4, 1);
             std::vector<char> plant(size_t(w) * size_t(h));
             for (size_t p = 0; p < plant.size(); ++p) plant[p] = mask.film.pixels[p].skyCover == 0.0f;
-            Image sLocal(plant.size()), sInd(plant.size());
+            Image sLocal(plant.size()), sInd(plant.size()), sIndOnce(plant.size());
             for (size_t p = 0; p < plant.size(); ++p) {
                 sLocal[p] = converged.pixels[p].local;
                 sInd[p] = converged.pixels[p].indirect;
+                sIndOnce[p] = convergedOnce.pixels[p].indirect;
             }
             // Cycles files the translucent BSDF under its diffuse passes: the reflected direct sun is DiffDir of a
             // run without transmission (shadow rays do not pass leaves either way), the transmitted the rest.
@@ -624,7 +697,19 @@ bool measureTruth(const Options& o)
             const Image sunComb = sunOnly.combined();
             for (size_t p = 0; p < plant.size(); ++p) skyPart[p] = refImg[p] - sunComb[p];
             const double cd = meanLum(dDir, plant), ct = meanLum(tDir, plant), ci = meanLum(ind, plant), cs = meanLum(skyPart, plant);
-            const double sl = meanLum(sLocal, plant), si = meanLum(sInd, plant);
+            const double sl = meanLum(sLocal, plant), si = meanLum(sInd, plant), sio = meanLum(sIndOnce, plant);
+            // The scattering orders: Cycles with one bounce (single scattering) and without the ground (the LB
+            // grid has none: its boundary is the sun alone).
+            say(o, "truth tree: Cycles sun only, 1 bounce and no ground, for the orders");
+            const CyclesRun one = runCycles(blender, script, sdir + "/sun_b1.exr", t.sweep.back(), 9, true, false, true, 1);
+            const CyclesRun bare = runCycles(blender, script, sdir + "/sun_noground.exr", t.sweep.back(), 11, true, false, true, -1, false);
+            auto indOf = [&](const CyclesRun& r) {
+                return add(mul(layer(r.channels, "DiffInd"), layer(r.channels, "DiffCol")), mul(layer(r.channels, "TransInd"), layer(r.channels, "TransCol")));
+            };
+            const double ci1 = meanLum(indOf(one), plant), ciBare = meanLum(indOf(bare), plant);
+            say(o, "truth tree terms: direct " + f("%.4f", cd) + " / local " + f("%.4f", sl) + "; Cycles indirect " + f("%.4f", ci) +
+                       " (1 bounce " + f("%.4f", ci1) + ", no ground " + f("%.4f", ciBare) + "); LB seed " + f("%.4f", si) + ", once " +
+                       f("%.4f", sio) + "; sky " + f("%.4f", cs) + "; transmitted direct " + f("%.4f", ct));
             const double total = cd + ct + ci + cs;
             md << "**Which term differs** (the tree's pixels only, mean luminance; Cycles' terms from its passes of a sun-only run, "
                   "the sky's as the full run minus it):\n\n";
@@ -634,9 +719,21 @@ bool measureTruth(const Options& o)
             };
             row("direct sun, reflected (DiffDir without transmission)", cd, "local", sl);
             row("direct sun, transmitted (DiffDir: the rest)", ct, "none", 0.0);
-            row("sun's indirect light (DiffInd + TransInd)", ci, "LB indirect", si);
+            row("sun's indirect light (DiffInd + TransInd)", ci, "LB indirect, seed's sum", si);
+            row("  the same, direct light once", ci, "LB indirect, once", sio);
+            row("  of it: single scattering (1 bounce)", ci1, "-", 0.0);
+            row("  of it: without the ground (the LB grid has none)", ciBare, "LB indirect, once", sio);
             row("sky (all bounces)", cs, "none", 0.0);
             row("all", total, "full", sl + si);
+            md << "\nDirect light once, term by term: the LB's scattered light alone is " << f("%.2f", ciBare > 0 ? sio / ciBare : 0.0)
+               << " x the sun's indirect light Cycles brings to the tree without the ground (" << f("%.2f", ci > 0 ? sio / ci : 0.0)
+               << " x with it; the ground's bounce is " << f("%.0f%%", ci > 0 ? 100.0 * (ci - ciBare) / ci : 0.0)
+               << " of Cycles' indirect light, single scattering " << f("%.0f%%", ci > 0 ? 100.0 * ci1 / ci : 0.0)
+               << "). Under `lighting.direct` once the renderer weighs the scattered photon density as a field from all "
+                  "directions (each face receives a quarter of the fluence; leaves also pass t of it from their other face: "
+                  "kd x (1 + t) / 4 x L, bark kd / 4 x L; core/lb/leaf_optics.h), which the LB indirect once row includes; what "
+                  "is left is the LB volume's albedo (0.89-0.91) against the textured leaves' kd x (1 + t), and the ground's bounce "
+                  "the grid does not see.\n";
             md << "\nOn the tree, Sylva's local term is " << f("%.2f", cd > 0 ? sl / cd : 0.0) << " x Cycles' reflected direct sun "
                << "(the same shadows and cosines: the direct term is right). Its LB indirect light is " << f("%.1f", ci > 0 ? si / ci : 0.0)
                << " x what Cycles' paths bring after the first bounce, because the normalized photon density includes the "
@@ -654,16 +751,18 @@ bool measureTruth(const Options& o)
         names.push_back(t.key);
         cyclesCurves.push_back(cyc);
         sylvaPoints.push_back(syl);
+        sylvaOncePoints.push_back(sylOnce);
       } catch (const Error& e) {
         say(o, "truth " + t.key + ": failed: " + e.what());
         md << "#### " << t.title << "\n\nFailed: " << e.what() << "\n\n";
       }
     }
-    if (!names.empty()) writeSvg(dir + "/truth_time.svg", names, cyclesCurves, sylvaPoints);
+    if (!names.empty()) writeSvg(dir + "/truth_time.svg", names, cyclesCurves, sylvaPoints, sylvaOncePoints);
     md << "### Error against time\n\n![error against time](accuracy/truth_time.svg)\n\n"
           "Circles: Cycles at increasing samples, against its own converged picture; squares: Sylva's settings (full mode) against "
-          "the same picture. Summary:\n\n| scene | Sylva full (converged) relative L2 luminance | FLIP | best Cycles / Sylva time at "
-          "Sylva's error |\n| --- | --- | --- | --- |\n"
+          "the same picture; filled squares: the same with direct light counted once. Summary (converged: grid 64, 64 spp):\n\n"
+          "| scene | Sylva full (seed's sum) relative L2 luminance | FLIP | Sylva full, direct once, relative L2 luminance | FLIP | "
+          "best Cycles / Sylva time at Sylva's error |\n| --- | --- | --- | --- | --- | --- |\n"
        << summary.str() << "\n";
     if (names.size() == scenes.size() && !names.empty()) {
         // Fixed costs: the time extrapolated to 0 samples from the 1- and 4-sample runs, t(1) - (t(4) - t(1)) / 3.
