@@ -244,6 +244,77 @@ static void setSky(RenderScene& rs, const SkyDesc& d)
     rs.base.skyInterleave = sky::makeInterleave(d.interleave, int(rs.skyLights.size()));
 }
 
+namespace {
+
+// The forest-level LB grid (core/lb/forest_grid.h) over the scene's top-level instances of species with a
+// density grid, with the scene's sun and the first such species' optics; its factors become instanceLights
+// (one record per scene instance, factor 1 for those outside it). Auto applies them only where exposure
+// differs: factors and face factors spread by at least uniformSpread (2%).
+void buildForestGrid(RenderScene& rs, const Scene& scene, const std::vector<SpeciesAssets>& assets)
+{
+    ForestGridStats& st = rs.m_stats.forestGrid;
+    const ForestGridMode mode = scene.lighting.forestGrid;
+    st = ForestGridStats{};
+    st.mode = forestGridModeName(mode);
+    st.resolution = scene.lighting.forestGridResolution;
+    rs.instanceLights.clear();
+    if (mode == ForestGridMode::Off) return;
+    std::vector<lb::ForestSpecies> species(assets.size());
+    int optics = -1;
+    for (size_t s = 0; s < assets.size(); ++s) {
+        species[s] = assets[s].forest;
+        if (optics < 0 && species[s].biomass > 0.0) optics = int(s);
+    }
+    std::vector<lb::ForestPlant> plants;
+    std::vector<size_t> which;   // plant -> scene instance
+    for (size_t i = 0; i < scene.instances.size(); ++i) {
+        const InstanceDesc& d = scene.instances[i];
+        if (d.group != kNoGroup || !(species[d.species].biomass > 0.0)) continue;
+        plants.push_back({d.position, d.scale, int(d.species)});
+        which.push_back(i);
+    }
+    st.plants = plants.size();
+    if (plants.empty()) {
+        st.skipped = mode == ForestGridMode::Auto;
+        return;
+    }
+    lb::LbParams p = scene.species[size_t(optics)].lighting;
+    p.sun = scene.sun.direction;
+    lb::ForestGridSettings settings;
+    settings.resolution = scene.lighting.forestGridResolution;
+    const lb::ForestGridResult r = lb::solveForestGrid(plants, species, p, settings);
+    st.solved = true;
+    st.dims = r.geometry.dims;
+    st.spacing = r.geometry.spacing;
+    st.seconds = r.seconds;
+    st.minFactor = r.minFactor;
+    st.medianFactor = r.medianFactor;
+    st.maxFactor = r.maxFactor;
+    st.minFaceFactor = r.minFaceFactor;
+    st.maxFaceFactor = r.maxFaceFactor;
+    const float most = std::max(r.maxFactor, r.maxFaceFactor);
+    st.spread = most > 0.0f ? (most - std::min(r.minFactor, r.minFaceFactor)) / most : 0.0f;
+    st.skipped = mode == ForestGridMode::Auto && r.uniform;
+    st.applied = !st.skipped;
+    if (!st.applied) return;
+    rs.instanceLights.assign(scene.instances.size(), InstanceLightRecord{});
+    for (InstanceLightRecord& rec : rs.instanceLights) {   // outside the grid: factor 1
+        rec.factor = glm::vec4(1.0f);
+        for (glm::vec4& f : rec.face) f = glm::vec4(1.0f);
+    }
+    for (size_t k = 0; k < plants.size(); ++k) {
+        const lb::ForestSpecies& sp = species[size_t(plants[k].species)];
+        InstanceLightRecord& rec = rs.instanceLights[which[k]];
+        rec.centre = glm::vec3(0.5 * (sp.boxMin + sp.boxMax));
+        const glm::dvec3 e = sp.boxMax - sp.boxMin;
+        rec.invRadius = float(2.0 / std::max({e.x, e.y, e.z, 1e-9}));
+        rec.factor = glm::vec4(r.factors[k], 1.0f);
+        for (int f = 0; f < lb::kFaces; ++f) rec.face[f] = glm::vec4(r.faceFactors[k][size_t(f)], 1.0f);
+    }
+}
+
+} // namespace
+
 RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAssets>& assets, LodLevels lod, Progress* progress)
 {
     Scene lifted;
@@ -601,6 +672,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
 
     buildLandscapeArrays(rs, scene);
     buildVolumeGrids(rs, scene);   // volumes (core/render/render_volumes.h)
+    buildForestGrid(rs, scene, assets);
     countBytes(rs);
     return rs;
 }
@@ -688,6 +760,8 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
         const InstanceDesc& d = scene.instances[i];
         InstanceRecord rec = makeInstance(d, origin);
         rec.geometry = d.group != kNoGroup ? rs.groupGeometry[d.group] : rs.meshLevels[d.species].geometry[size_t(level[i])];
+        // The forest grid's record (built for these instances: a scene with more or fewer takes none).
+        if (d.group == kNoGroup && rs.instanceLights.size() == ni) rec.light = uint32_t(i + 1);
         rs.instances.push_back(rec);
         boxes[i] = instanceBox(d, rs.geometryBounds[rec.geometry], origin);
         st.instancedTriangles += rs.geometryTriangles[rec.geometry];

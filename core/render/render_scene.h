@@ -7,6 +7,7 @@
 #include "core/base/progress.h"
 #include "core/grid/grid.h"
 #include "core/image/image.h"
+#include "core/lb/forest_grid.h"
 #include "core/mesh/triangle_mesh.h"
 #include "core/render/prune.h"
 #include "core/render/render_view.h"
@@ -21,6 +22,23 @@ struct SpeciesAssets {
     std::vector<ImageRgba> cutout;      // per material: coverage in the alpha channel, empty = opaque
     LightingGrid lighting;              // species frame; empty rgb = none (indirect light as in open sky)
     glm::vec3 lightingNorm{1.0f};       // photon density of unobstructed space per channel (divides the grid)
+    lb::ForestSpecies forest;           // its density grid as the forest-level grid sees it (biomass 0: not known,
+                                        // the species takes no part in the forest grid)
+};
+
+// The forest-level LB grid of a frame (the scene's lighting.forest_grid, core/lb/forest_grid.h).
+struct ForestGridStats {
+    const char* mode = "off";            // the scene's setting: off, auto, on
+    bool solved = false;                 // built and solved
+    bool applied = false;                // its factors scale the instances' LB lighting
+    bool skipped = false;                // auto: exposure uniform (factors' spread under uniformSpread), not applied
+    size_t plants = 0;                   // top-level instances of species with a density grid
+    int resolution = 0;
+    glm::ivec3 dims{0};
+    double spacing = 0.0, seconds = 0.0; // metres; build + solve
+    float spread = 0.0f;                 // (max - min) / max over the factors and face factors
+    float minFactor = 1.0f, medianFactor = 1.0f, maxFactor = 1.0f;   // over instances (median: channel mean)
+    float minFaceFactor = 1.0f, maxFaceFactor = 1.0f;
 };
 
 // Sizes in bytes of what the traversal reads, for the performance notes.
@@ -39,6 +57,7 @@ struct AccelStats {
     size_t terrainSamplesX = 0, terrainSamplesZ = 0;
     size_t landscapeBytes = 0;           // the landscape's cells, kd-tree, tiles' trees and plants
     LandscapeStats landscape;            // cells, tiles, potentially visible instances and triangles, build time
+    ForestGridStats forestGrid;          // the forest-level LB grid
 };
 
 // The pruned levels of detail a scene build makes meshes for: those the scene's camera gives some
@@ -78,7 +97,9 @@ public:
 // Step 1: the camera-independent part. One BVH (or, for accel kdtree, one kd-tree) per species and per
 // pruned level (in parallel; with render.pruneDistance > 0 the levels `lod` asks for, core/render/prune.h),
 // one BVH per instance group of scene.groups over its instances in the group's frame (groups nest at most
-// kMaxLevels - 1 deep), textures, cut-outs and lighting grids. assets[i] belongs to scene.species[i].
+// kMaxLevels - 1 deep), textures, cut-outs and lighting grids, and with lighting.forest_grid on (or auto
+// where exposure differs) the forest-level grid's factors per top-level instance (instanceLights; placeTopLevel
+// points each instance at its record). assets[i] belongs to scene.species[i].
 // Throws Error on inconsistent input (missing species or group, a cycle or too deep nesting of groups).
 RenderScene buildSceneGeometry(const Scene& scene, const std::vector<SpeciesAssets>& assets, LodLevels lod = LodLevels::Used,
                                Progress* progress = nullptr);

@@ -64,9 +64,23 @@ struct InstanceRecord {
     uint32_t geometry;       // RenderView::geometries[geometry]: a mesh (a species or one of its pruned
                              // levels of detail) or an instance group
     float scale;             // parent metres per geometry metre
-    uint32_t pad[2];
+    uint32_t light;          // 1 + index into RenderView::instanceLights (the forest grid's factors); 0 = none
+                             // (factor 1: group members, landscape plants, scenes without the forest grid)
+    uint32_t pad;
 };
 static_assert(sizeof(InstanceRecord) == 64);
+
+// The forest-level LB grid's factors of one top-level instance (core/lb/forest_grid.h), scaling its
+// species' LB lighting: `factor` (per channel) at the crown centre, blended towards face[k] (surfaces facing
+// +x, -x, +y, -y, +z, -z, world axes) on the crown's side that way (core/render/shade.h forestFactor).
+// 128 bytes.
+struct InstanceLightRecord {
+    glm::vec3 centre;        // crown centre, species frame
+    float invRadius;         // 1 / (half the crown box's largest extent), species frame
+    glm::vec4 factor;        // xyz: per channel
+    glm::vec4 face[6];       // xyz: per channel
+};
+static_assert(sizeof(InstanceLightRecord) == 128);
 
 // What an instance can point to. A new kind (height-field terrain, volume grid) adds an enumerator, its
 // fields in GeometryRecord and one case in traceGeometry (core/render/trace.h).
@@ -174,6 +188,7 @@ struct CameraRecord {
     X(Scene, Both, AlphaMaskRecord, alphaMasks, None)                                                          \
     X(Scene, Both, uint32_t, alphaBits, None)                                                                  \
     X(Scene, Both, float, lighting, None)                  /* normalized LB photon density, 3 per node */     \
+    X(Scene, Both, InstanceLightRecord, instanceLights, None) /* the forest grid's per-instance factors */    \
     X(Scene, Both, float, terrainHeights, Terrain)         /* the terrain's samples (core/terrain) */          \
     X(Scene, Both, glm::vec2, terrainRanges, Terrain)      /* its min/max pyramid */                           \
     X(Scene, Both, LandNode, landNodes, Landscape)         /* the landscape's 2D kd-tree over cells */         \

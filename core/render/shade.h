@@ -83,6 +83,28 @@ SYLVA_HD inline glm::vec3 sampleLighting(const RenderView& v, const SpeciesRecor
     return out;
 }
 
+// The forest-level grid's factor on instance `in`'s species lighting at species-frame point lp (1 where the
+// instance has none): its per-channel factor at the crown centre, blended towards the mix of its face
+// factors along the world direction d from the centre (weights d.x^2, d.y^2, d.z^2, the face of each sign)
+// as lp moves out to the crown box's half extent, so the side of a crown facing open ground keeps its light.
+// Continuous in lp; per instance, read by every backend (the species grid stays one per species).
+SYLVA_HD inline glm::vec3 forestFactor(const RenderView& v, const InstanceRecord& in, const glm::vec3& lp)
+{
+    if (in.light == 0u) return glm::vec3(1.0f);
+    const InstanceLightRecord& r = v.instanceLights[in.light - 1u];
+    const glm::vec3 centre(r.factor);
+    const glm::vec3 o = lp - r.centre;
+    const glm::vec3 w = toWorldNormal(in, o);   // R o / scale: the world direction
+    const float wl = glm::length(w);
+    if (!(wl > 0.0f)) return centre;
+    const glm::vec3 d = w / wl;
+    const glm::vec3 d2 = d * d;
+    const glm::vec3 cube = d2.x * glm::vec3(r.face[d.x >= 0.0f ? 0 : 1]) + d2.y * glm::vec3(r.face[d.y >= 0.0f ? 2 : 3]) +
+                           d2.z * glm::vec3(r.face[d.z >= 0.0f ? 4 : 5]);
+    const float t = fminf(glm::length(o) * r.invRadius, 1.0f);
+    return centre + t * (cube - centre);
+}
+
 // Is the distant light toward unit `dir` visible from camera-relative point p (already offset off its
 // surface)? The alpha-tested any-hit query; always with shadows off.
 SYLVA_HD inline bool directionVisible(const RenderView& v, const glm::vec3& p, const glm::vec3& dir)
@@ -207,7 +229,7 @@ SYLVA_HD inline SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, c
     s.specular = m.specular;
     s.shininess = m.shininess;
     s.extent = in.scale * fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));
-    s.lighting = sampleLighting(v, sp, lp);
+    s.lighting = sampleLighting(v, sp, lp) * forestFactor(v, in, lp);
     return s;
 }
 

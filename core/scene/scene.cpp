@@ -46,6 +46,17 @@ bool parseDirectLight(const std::string& name, DirectLight* out)
     return true;
 }
 
+const char* forestGridModeName(ForestGridMode m) { return m == ForestGridMode::On ? "on" : m == ForestGridMode::Auto ? "auto" : "off"; }
+
+bool parseForestGridMode(const std::string& name, ForestGridMode* out)
+{
+    if (name == "off") *out = ForestGridMode::Off;
+    else if (name == "auto") *out = ForestGridMode::Auto;
+    else if (name == "on") *out = ForestGridMode::On;
+    else return false;
+    return true;
+}
+
 const char* accelName(AccelKind kind) { return kind == AccelKind::KdTree ? "kdtree" : "bvh"; }
 
 bool parseAccel(const std::string& name, AccelKind* out)

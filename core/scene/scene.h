@@ -149,9 +149,16 @@ struct CameraDesc {
 // the grid adds only scattered light to the drawn sun.
 enum class DirectLight { Seed, Once };
 
+// The forest-level LB grid (issue 18 item 1, core/lb/forest_grid.h): Off = every instance of a species lit
+// alike (as before); On = each top-level instance's species lighting scaled by the grid's factors; Auto = as
+// On where exposure differs (factors spread by 2% or more), else skipped (said in render --stats).
+enum class ForestGridMode { Off, Auto, On };
+
 // The scene's lighting beyond sun and sky (the `lighting` block).
 struct LightingDesc {
     DirectLight direct = DirectLight::Seed;
+    ForestGridMode forestGrid = ForestGridMode::Off;
+    int forestGridResolution = 16;       // forest grid nodes along the plants' longest horizontal extent
     bool operator==(const LightingDesc&) const = default;   // the scene file writes the block only when it differs
 };
 
@@ -197,6 +204,8 @@ const char* renderModeName(RenderMode mode);      // "full", "local", "ambient",
 bool parseRenderMode(const std::string& name, RenderMode* out);
 const char* directLightName(DirectLight d);       // "seed", "once"
 bool parseDirectLight(const std::string& name, DirectLight* out);
+const char* forestGridModeName(ForestGridMode m); // "off", "auto", "on"
+bool parseForestGridMode(const std::string& name, ForestGridMode* out);
 const char* accelName(AccelKind kind);            // "bvh", "kdtree"
 bool parseAccel(const std::string& name, AccelKind* out);
 

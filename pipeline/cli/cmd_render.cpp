@@ -58,6 +58,8 @@ Scene sceneForArgs(const Args& args, std::string* stem)
         scene.terrain.cells = int(parseInteger("--cells", args.get("--cells"), 1, 65536));
         if (scene.terrain.tiles.plants.empty()) throw UsageError("option --cells: the scene's terrain has no tiles (terrain.tiles)");
     }
+    if (args.has("--forest-grid") && !parseForestGridMode(args.get("--forest-grid"), &scene.lighting.forestGrid))
+        throw UsageError("option --forest-grid: expected off, auto or on, got '" + args.get("--forest-grid") + "'");
     if (args.has("--sun") && args.has("--sun-at")) throw UsageError("give either --sun or --sun-at, not both");
     if (args.has("--sun")) {
         if (args.get("--sun").find(',') == std::string::npos) throw UsageError("option --sun: expected X,Y,Z");
@@ -113,6 +115,7 @@ void printStats(const AccelStats& st, const RenderTimings& timings, const Render
         std::printf("landscape: %zu cells, %zu tiles of %zu-%zu plants, %.3g potentially visible instances, %.3g triangles, %.1f MB, built in %.2f s\n",
                     st.landscape.cells, st.landscape.tiles, st.landscape.plantsPerTileMin, st.landscape.plantsPerTileMax, st.landscape.instances,
                     st.landscape.triangles, double(st.landscapeBytes) / 1e6, st.landscape.buildSeconds);
+    std::fputs(forestGridLine(st.forestGrid).c_str(), stdout);
     if (r.mode == RenderMode::Ambient) std::printf("ambient constant %.4f\n", ambient);
 }
 
@@ -251,6 +254,8 @@ Command renderCommand()
              {"--cells", "N", "plant cells along the terrain's longer side (terrain.cells; the scene needs terrain.tiles)"},
              {"--sun", "X,Y,Z", "direction toward the sun (+Y up, any length), replacing the scene's"},
              kSunAt,
+             {"--forest-grid", "off|auto|on", "the forest-level LB grid (default: the scene's lighting.forest_grid; auto: only where "
+                                              "exposure differs)"},
              {"--alpha-distance", "M", "skip leaf cut-out tests beyond M metres from the camera (0: off, default)"},
              {"--prune-distance", "M", "prune leaves of plants beyond M metres, area-preserving (0: off, default)"},
              {"--volume-tracer", "lb|single|combined", "every volume's tracer, replacing its scene's `tracer` (default lb, the "

@@ -184,6 +184,7 @@ std::vector<SpeciesAssets> loadSpeciesAssets(const Scene& scene, GridCache* cach
         SpeciesGrids grids = gridsForMesh(scene, sp, out[s].mesh, cache, &sub, log, backend);
         out[s].lighting = std::move(grids.lighting);
         out[s].lightingNorm = grids.lightingNorm;
+        out[s].forest = lb::forestSpecies(grids.density);   // its share of the forest-level grid (lighting.forest_grid)
     }
     return out;
 }
@@ -218,6 +219,8 @@ RenderScene prepareRenderScene(const Scene& scene, GridCache* cache, Progress* p
     // Volumes: their LB lighting through the cache, like a species' (pipeline/render/volume_job.h).
     const Scene lit = scene.volumes.empty() ? Scene{} : lightSceneVolumes(scene, cache, modeNeedsLighting(scene.render.mode), nullptr, log, backend);
     RenderScene rs = buildRenderScene(scene.volumes.empty() ? scene : lit, assets, sunRadiance(scene.sun), &buildProgress);
+    const ForestGridStats& fg = rs.stats().forestGrid;
+    if (log && fg.solved) log->stages.push_back(fg.applied ? "forest grid" : "forest grid skipped (exposure uniform)");
     if (log) log->stages.push_back("build");
     timings.build = secondsSince(t0);
     return rs;

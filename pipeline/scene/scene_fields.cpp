@@ -637,6 +637,18 @@ const Table<LightingDesc>& sceneLightingTable()
                  "crowns); `once`: the grid less its uncollided sunlight, so it adds only scattered light "
                  "([ACCURACY.md](ACCURACY.md))")
             .summarized([](const LightingDesc& l) { return std::string("direct light ") + directLightName(l.direct); });
+        b.enumeration("forest_grid", &LightingDesc::forestGrid, parseForestGridMode, forestGridModeName, "forest grid", "off, auto, on")
+            .doc("string",
+                 "the forest-level LB grid (seed 000 section 3): `off` (default: every instance of a species lit alike), `on` "
+                 "(each instance's species lighting scaled by the grid's factors: stand interiors darker, the open side of an "
+                 "edge tree lit), `auto` (as `on` where the factors spread by 2% or more, else skipped; `render --stats` says which)")
+            .summarized([](const LightingDesc& l) { return std::string("forest grid ") + forestGridModeName(l.forestGrid); });
+        b.integer("forest_grid_resolution", &LightingDesc::forestGridResolution, 4, 512)
+            .doc("integer", "forest grid nodes along the plants' longest horizontal extent, 4 .. 512; build + solve time in "
+                                "[PERFORMANCE.md](PERFORMANCE.md)")
+            .summarized([](const LightingDesc& l) {
+                return l.forestGrid == ForestGridMode::Off ? std::string() : "forest grid resolution " + std::to_string(l.forestGridResolution);
+            });
         return b.table;
     }();
     return table;

@@ -2,6 +2,7 @@
 #include "pipeline/services/render_stats.h"
 
 #include <algorithm>
+#include <cstdio>
 
 namespace sylva {
 
@@ -12,6 +13,24 @@ AccelSummary summarizeAccel(const AccelStats& st)
     s.bytesPerInstancedTriangle = s.totalBytes / std::max(1.0, st.instancedTriangles);
     s.bytesPerInstance = double(st.tlasBytes + st.instanceBytes) / double(std::max<size_t>(1, st.instances));
     return s;
+}
+
+std::string forestGridLine(const ForestGridStats& f)
+{
+    if (std::string(f.mode) == "off") return "";
+    char line[400];
+    if (!f.solved) {
+        std::snprintf(line, sizeof line, "forest grid (%s): no instance of a species with a density grid, %s\n", f.mode,
+                      f.skipped ? "skipped" : "not built");
+        return line;
+    }
+    std::snprintf(line, sizeof line,
+                  "forest grid (%s): resolution %d, %dx%dx%d nodes of %.3g m, %zu instances, built and solved in %.3f s; factors "
+                  "%.3f / %.3f / %.3f (min / median / max over instances), per face %.3f-%.3f, spread %.1f%%; %s\n",
+                  f.mode, f.resolution, f.dims.x, f.dims.y, f.dims.z, f.spacing, f.plants, f.seconds, double(f.minFactor),
+                  double(f.medianFactor), double(f.maxFactor), double(f.minFaceFactor), double(f.maxFaceFactor), 100.0 * double(f.spread),
+                  f.applied ? "applied" : "skipped (exposure uniform: spread under 2%)");
+    return line;
 }
 
 } // namespace sylva

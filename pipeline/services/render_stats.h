@@ -1,6 +1,8 @@
 // The acceleration structures' sizes in the units `sylva render --stats` prints.
 #pragma once
 
+#include <string>
+
 #include "core/render/render_scene.h"
 
 namespace sylva {
@@ -11,5 +13,10 @@ struct AccelSummary {
     double bytesPerInstance = 0.0;            // (top level + instance records) / instances (at least 1)
 };
 AccelSummary summarizeAccel(const AccelStats& stats);
+
+// `sylva render --stats`'s line on the forest-level LB grid (lighting.forest_grid): mode, resolution and
+// dims, build + solve time, the factors' min / median / max over instances, and whether it was applied or
+// skipped (auto, exposure uniform); empty when the scene has it off.
+std::string forestGridLine(const ForestGridStats& stats);
 
 } // namespace sylva

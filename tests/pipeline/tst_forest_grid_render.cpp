@@ -1,0 +1,188 @@
+// The forest-level LB grid in the picture (issue 18 item 1): a square stand of shrubs rendered from above
+// with lighting.forest_grid on, auto and off. The species has no LB grid of its own (its indirect light is
+// the open-sky value 1), so each pixel's indirect light is albedo x the forest factor x the sun: the
+// oracle per instance is its pixels traced once more with the grid off. Interior instances must come out
+// darker than edge instances with the grid on, and every instance of the species alike with it off.
+#include <QTest>
+
+#include <cmath>
+#include <map>
+
+#include "core/render/render_cpu.h"
+#include "core/render/render_scene.h"
+#include "core/render/shade.h"
+#include "small_forest.h"
+
+using namespace sylva;
+
+namespace {
+
+constexpr int kSide = 6;   // kSide x kSide shrubs
+
+// The shrub's forest-grid view: its mesh bounds filled at density 0.5 (what a voxelized dense crown gives).
+lb::ForestSpecies shrubForest(const TriangleMesh& mesh)
+{
+    glm::dvec3 lo(1e30), hi(-1e30);
+    for (const glm::vec3& p : mesh.positions) lo = glm::min(lo, glm::dvec3(p)), hi = glm::max(hi, glm::dvec3(p));
+    lb::ForestSpecies s;
+    s.boxMin = lo;
+    s.boxMax = hi;
+    const glm::dvec3 e = hi - lo;
+    s.biomass = 0.5 * e.x * e.y * e.z;
+    s.spacing = std::max({e.x, e.y, e.z}) / 24.0;
+    return s;
+}
+
+Scene stand(const lb::ForestSpecies& f, double gap)
+{
+    Scene s;
+    s.species.resize(1);
+    s.species[0].name = "shrub";
+    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    const double w = std::max(f.boxMax.x - f.boxMin.x, f.boxMax.z - f.boxMin.z);
+    const double step = w * gap;
+    for (int a = 0; a < kSide; ++a)
+        for (int b = 0; b < kSide; ++b) {
+            InstanceDesc d;
+            d.position = {(a - 0.5 * (kSide - 1)) * step, 0.0, (b - 0.5 * (kSide - 1)) * step};
+            s.instances.push_back(d);
+        }
+    const double h = f.boxMax.y;
+    s.camera.position = {0.0, h + 3.2 * step * kSide, -0.35 * step * kSide};
+    s.camera.target = {0.0, 0.0, 0.0};
+    s.camera.fovY = 30.0f;
+    s.sun.direction = {0.3f, 1.0f, 0.2f};
+    s.render.width = 96;
+    s.render.height = 96;
+    s.render.spp = 1;
+    s.render.mode = RenderMode::Lb;
+    s.lighting.forestGridResolution = 32;
+    return s;
+}
+
+bool edge(size_t i) { return i / kSide == 0 || i / kSide == kSide - 1 || i % kSide == 0 || i % kSide == kSide - 1; }
+
+// Mean luminance of each top-level instance's pixels (the instance the pixel's ray hits first).
+std::map<uint32_t, double> perInstance(const RenderScene& rs, const Film& film)
+{
+    const RenderView v = rs.view();
+    std::map<uint32_t, double> sum, count;
+    for (int y = 0; y < film.height; ++y)
+        for (int x = 0; x < film.width; ++x) {
+            Hit hit{};
+            if (!intersectStage(v, cameraRay(v, float(x) + 0.5f, float(y) + 0.5f), hit) || hit.prim == kGroundPrim || hit.depth != 0) continue;
+            const glm::vec3 c = film.pixels[size_t(y) * size_t(film.width) + size_t(x)].indirect;
+            sum[hit.inst] += 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+            count[hit.inst] += 1.0;
+        }
+    for (auto& [k, s] : sum) s /= count[k];
+    return sum;
+}
+
+} // namespace
+
+class TestForestGridRender : public QObject {
+    Q_OBJECT
+    std::vector<SpeciesAssets> m_assets;
+
+private Q_SLOTS:
+    void initTestCase()
+    {
+        m_assets = test::oneShrub();
+        m_assets[0].forest = shrubForest(m_assets[0].mesh);
+    }
+
+    void interiorDarkerWithTheGridOn()
+    {
+        Scene s = stand(m_assets[0].forest, 0.9);   // crowns overlapping a little: a closed stand
+        s.lighting.forestGrid = ForestGridMode::Off;
+        const RenderScene off = buildRenderScene(s, m_assets, glm::vec3(1.0f));
+        s.lighting.forestGrid = ForestGridMode::On;
+        const RenderScene on = buildRenderScene(s, m_assets, glm::vec3(1.0f));
+        const ForestGridStats& st = on.stats().forestGrid;
+        QVERIFY(st.solved && st.applied && !st.skipped);
+        QCOMPARE(st.plants, size_t(kSide * kSide));
+        QVERIFY(!off.stats().forestGrid.solved && off.instanceLights.empty());
+        const std::map<uint32_t, double> a = perInstance(off, renderFilm(off.view())), b = perInstance(on, renderFilm(on.view()));
+        double edgeOn = 0.0, innerOn = 0.0, edgeOff = 0.0, innerOff = 0.0;
+        int edges = 0, inners = 0;
+        for (const auto& [i, lum] : b) {
+            QVERIFY(a.count(i));
+            if (edge(i)) edgeOn += lum, edgeOff += a.at(i), ++edges;
+            else innerOn += lum, innerOff += a.at(i), ++inners;
+        }
+        QVERIFY2(edges >= 12 && inners >= 8, qPrintable(QString("%1 edge, %2 interior instances seen").arg(edges).arg(inners)));
+        edgeOn /= edges, innerOn /= inners, edgeOff /= edges, innerOff /= inners;
+        qInfo("mean luminance: grid on edge %.4f interior %.4f (%.3f); off edge %.4f interior %.4f; factors %.3f/%.3f/%.3f", edgeOn, innerOn,
+              innerOn / edgeOn, edgeOff, innerOff, double(st.minFactor), double(st.medianFactor), double(st.maxFactor));
+        QVERIFY(innerOn < 0.98 * edgeOn);   // the stand's interior darker by more than auto's 2% uniform spread
+        QVERIFY(innerOn < innerOff && edgeOn <= edgeOff * 1.05);
+        // Off: the open-sky value everywhere (albedo x 1 x sun), edge and interior alike to the albedo's texture.
+        QVERIFY(std::fabs(innerOff - edgeOff) < 0.05 * edgeOff);
+    }
+
+    // Per pixel, the indirect light with the grid on is the one with it off times forestFactor, whose
+    // records hold the solve's factors: the renderer applies exactly what the grid gave.
+    void pixelsCarryTheFactors()
+    {
+        Scene s = stand(m_assets[0].forest, 0.9);
+        s.render.width = s.render.height = 48;
+        s.lighting.forestGrid = ForestGridMode::Off;
+        const RenderScene off = buildRenderScene(s, m_assets, glm::vec3(1.0f));
+        s.lighting.forestGrid = ForestGridMode::On;
+        const RenderScene on = buildRenderScene(s, m_assets, glm::vec3(1.0f));
+        const Film fa = renderFilm(off.view()), fb = renderFilm(on.view());
+        const RenderView v = on.view();
+        const ForestGridStats& st = on.stats().forestGrid;
+        int checked = 0;
+        for (int y = 0; y < fa.height; ++y)
+            for (int x = 0; x < fa.width; ++x) {
+                Hit hit{};
+                const Ray ray = cameraRay(v, float(x) + 0.5f, float(y) + 0.5f);
+                const size_t k = size_t(y) * size_t(fa.width) + size_t(x);
+                if (!intersectStage(v, ray, hit) || hit.prim == kGroundPrim) {
+                    QCOMPARE(fb.pixels[k].indirect, fa.pixels[k].indirect);   // the ground: no factor
+                    continue;
+                }
+                const InstanceRecord in = hitInstance(v, hit);
+                const glm::vec3 lp = toLocalPoint(in, ray.org) + hit.t * toLocalDir(in, ray.dir);
+                const glm::vec3 f = forestFactor(v, in, lp);
+                for (int c = 0; c < 3; ++c) {
+                    QVERIFY(f[c] >= std::min(st.minFactor, st.minFaceFactor) - 1e-6f && f[c] <= std::max(st.maxFactor, st.maxFaceFactor) + 1e-6f);
+                    QVERIFY(std::fabs(fb.pixels[k].indirect[c] - fa.pixels[k].indirect[c] * f[c]) <= 1e-5f + 1e-5f * fa.pixels[k].indirect[c]);
+                }
+                ++checked;
+            }
+        QVERIFY(checked > 200);
+    }
+
+    // Auto on a stand whose plants stand far apart (off each other's lattice lines, as tst_forest_grid's
+    // separated forest): the skip branch, the picture equal to the grid off; on the closed stand auto applies.
+    void autoSkipsUniformExposure()
+    {
+        Scene s = stand(m_assets[0].forest, 0.9);
+        s.render.width = s.render.height = 32;
+        s.lighting.forestGrid = ForestGridMode::Auto;
+        QVERIFY(buildRenderScene(s, m_assets, glm::vec3(1.0f)).stats().forestGrid.applied);
+        const lb::ForestSpecies& f = m_assets[0].forest;
+        const double w = std::max(f.boxMax.x - f.boxMin.x, f.boxMax.z - f.boxMin.z);
+        s.instances.clear();
+        for (int a = 0; a < 2; ++a)
+            for (int b = 0; b < 2; ++b) {
+                InstanceDesc d;
+                d.position = {w * (6.0 * a + 2.5 * b), 0.0, w * (6.0 * b - 2.5 * a)};
+                s.instances.push_back(d);
+            }
+        const RenderScene autoScene = buildRenderScene(s, m_assets, glm::vec3(1.0f));
+        const ForestGridStats& st = autoScene.stats().forestGrid;
+        QVERIFY2(st.solved && st.skipped && !st.applied, qPrintable(QString("spread %1").arg(double(st.spread))));
+        QVERIFY(st.spread < 0.02f);
+        QVERIFY(autoScene.instanceLights.empty());
+        s.lighting.forestGrid = ForestGridMode::Off;
+        const Film a = renderFilm(autoScene.view()), b = renderFilm(buildRenderScene(s, m_assets, glm::vec3(1.0f)).view());
+        for (size_t k = 0; k < a.pixels.size(); ++k) QCOMPARE(a.pixels[k].indirect, b.pixels[k].indirect);
+    }
+};
+
+QTEST_APPLESS_MAIN(TestForestGridRender)
+#include "tst_forest_grid_render.moc"
