@@ -119,7 +119,7 @@ void RenderWorker::run()
         }
         Progress progress;
         progress.setCallback([this, &progress](double, const std::string&) {
-            if (interrupted()) progress.cancel();
+            if (m_abort.load() || (m_restart.load() && !m_shieldPass.load())) progress.cancel();
         });
         try {
             process(req, progress);
@@ -225,13 +225,14 @@ void RenderWorker::process(const Request& req, Progress& progress)
         ++m_frameUpdates;
         if (interrupted()) throw Cancelled();
     }
+    bool relit = false;
     if (!(m_frameRelight == req.relight)) {
         // A sun change relit from the species' bases: the composed grids into the kept frame (not
         // interrupted: a frame half relit would have to be built again).
         applyRelighting(m_frame->rs, req.assets, req.relight);
         m_frameRelight = req.relight;
-        if (req.relight.active()) ++m_relitFrames;
-        if (interrupted()) throw Cancelled();
+        relit = req.relight.active();
+        if (relit) ++m_relitFrames;
     }
     const glm::vec3 sun = sunRadiance(scene.sun);
     // Progressive refinement (issue 16 item 5): the schedule's frames (while the camera moves every request
@@ -244,8 +245,13 @@ void RenderWorker::process(const Request& req, Progress& progress)
         placeViewFrame(*m_frame, scene, sun, pw, ph, passes[p].spp);
         RenderView view = m_frame->rs.view();
         if (refine.frames > 0) view.skyLightCount = 0;   // moving: the sun alone
+        // The first pass of a relit frame runs to its end even when the next sun is already asked for:
+        // a sun drag shows every relit sun it can (one preview each) instead of restarting before any.
+        const bool shield = relit && p == 0;
+        m_shieldPass = shield;
         Film film = renderFilm(view, &progress);
-        if (interrupted()) throw Cancelled();
+        m_shieldPass = false;
+        if (m_abort.load() || (interrupted() && !shield)) throw Cancelled();
         const QImage img = picture(film, scene, req.compare);
         const bool last = p + 1 == passes.size() && refine.frames == 0;
         m_lastFilm = std::move(film);

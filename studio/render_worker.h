@@ -136,6 +136,7 @@ private:
     Relighting m_frameRelight;            // the relighting m_frame's lighting array holds (inactive: the assets')
     SkyDesc m_frameSky;                   // the sky m_frame was built with
     std::atomic<int> m_relitFrames{0};
+    std::atomic<bool> m_shieldPass{false};   // the pass in progress is not restarted by a new request
     Scene m_frameScene;                   // the scene m_frame's camera-independent part holds
     std::atomic<int> m_frameBuilds{0}, m_frameUpdates{0};
     std::optional<Scene> m_lastScene;     // what m_lastFilm shows
