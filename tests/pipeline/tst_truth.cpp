@@ -13,6 +13,7 @@
 #include "core/render/render_scene.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/scene/scene_file.h"
 #include "pipeline/study/blender_scene.h"
 #include "pipeline/study/flip.h"
 #include "pipeline/study/study.h"
@@ -239,6 +240,48 @@ private Q_SLOTS:
     }
 
     // The study's truth part without Blender or with --quick is skipped and the report says so.
+    // lighting.direct once: each species' grid is the full LB solve less the uncollided one (the same LB with
+    // scattering off, solved here on its own), so open space outside the crown holds no light (the seed's sum
+    // holds the unobstructed value there), and the renderer's weights are (1 + t) / 4 on leaves, 1 / 4 on bark.
+    void directOnceSubtractsTheUncollidedSun()
+    {
+        Scene s = parseScene(R"({"version": 1, "species": [{"name": "shrub", "grow": {"species": "shrub", "seed": 2, "triangles": 2000},
+            "lighting": {"preset": "leaf", "grid": 12}}], "instances": [{"species": "shrub", "position": [0, 0, 0]}],
+            "lighting": {"direct": "once"}})", ".", "once.sylva.json");
+        QVERIFY(s.lighting.direct == DirectLight::Once);
+        QVERIFY(sceneToJson(s, ".").find("\"direct\": \"once\"") != std::string::npos);
+        Scene seed = s;
+        seed.lighting.direct = DirectLight::Seed;
+        QVERIFY(sceneToJson(seed, ".").find("\"lighting\": {\"direct") == std::string::npos);   // the default is not written
+        const std::vector<SpeciesAssets> once = loadSpeciesAssets(s, nullptr, true);
+        const std::vector<SpeciesAssets> sum = loadSpeciesAssets(seed, nullptr, true);
+        const SpeciesGrids g = loadSpeciesGrids(seed, 0, nullptr);
+        const LightingGrid unc = lightingFor(g.density, lb::uncollidedParams(g.params), nullptr);
+        const std::vector<float>& a = once[0].lighting.rgb;
+        QCOMPARE(a.size(), sum[0].lighting.rgb.size());
+        double openSeed = 0.0, openOnce = 0.0;
+        int open = 0;
+        for (size_t i = 0; i < a.size(); ++i) {
+            const float want = std::max(0.0f, sum[0].lighting.rgb[i] - unc.rgb[i]);
+            QVERIFY2(std::fabs(a[i] - want) <= 1e-5f * std::max(1.0f, std::fabs(want)), qPrintable(QString("node value %1: %2 vs %3").arg(i).arg(a[i]).arg(want)));
+            if (g.density.density[i / 3] == 0.0f && std::fabs(unc.rgb[i] / once[0].lightingNorm[int(i % 3)] - 1.0f) < 1e-3f) {
+                openSeed += sum[0].lighting.rgb[i] / sum[0].lightingNorm[int(i % 3)];
+                openOnce += a[i] / once[0].lightingNorm[int(i % 3)];
+                ++open;
+            }
+        }
+        QVERIFY(open > 0);
+        QVERIFY2(openOnce / open < 0.2 && openSeed / open > 0.8, qPrintable(QString("unshadowed empty nodes: once %1, seed %2").arg(openOnce / open).arg(openSeed / open)));
+        const lb::ScatteredWeights w = lb::scatteredWeights(s.species[0].lighting);
+        const LeafOptics lo = leafOptics(s.species[0].lighting);
+        for (int c = 0; c < 3; ++c) QVERIFY(std::fabs(w.leaf[c] - (1.0f + lo.ratio[c]) / 4.0f) < 1e-6f);
+        QCOMPARE(w.bark, 0.25f);
+        const RenderScene rs = buildRenderScene(s, once, sunRadiance(s.sun));
+        QVERIFY(std::fabs(rs.species[0].leafIndirect.y - w.leaf.y) < 1e-6f && rs.species[0].barkIndirect == 0.25f);
+        const RenderScene rsSeed = buildRenderScene(seed, sum, sunRadiance(seed.sun));
+        QVERIFY(rsSeed.species[0].leafIndirect == glm::vec3(1.0f) && rsSeed.species[0].barkIndirect == 1.0f);
+    }
+
     void truthPartSkipsWithQuick()
     {
         QTemporaryDir tmp;
