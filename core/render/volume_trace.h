@@ -274,6 +274,7 @@ SYLVA_HD inline VolumeSegment marchVolume(const VolumeArrays& vv, const VolumeIn
     const glm::vec3 sunSource = phase * 3.14159265358979f * sunRadiance;   // sigma_s rho T_sun x this
     const glm::vec3 lbSource = 0.25f * indirectScale * sunRadiance;         // sigma_s rho phi x this (phi / 4 pi x pi)
     const glm::vec3 sigmaA = g.sigmaT - g.sigmaS;
+    const bool grey = g.sigmaT.x == g.sigmaT.y && g.sigmaT.y == g.sigmaT.z;
     walkBricks(vv, g, o, d, t0, t1, [&](float m, float ta, float tb) {
         if (m <= 0.0f) return true;
         const float len = (tb - ta) * speed;
@@ -288,10 +289,17 @@ SYLVA_HD inline VolumeSegment marchVolume(const VolumeArrays& vv, const VolumeIn
             const float r = trilinear1(rho, at);
             if (!(r > 0.0f)) continue;
             const glm::vec3 sigT = g.sigmaT * r, sigS = g.sigmaS * r;
-            const glm::vec3 stepT = glm::exp(-sigT * dl);
-            // (1 - e^-x) / sigma_t: the in-step weight of a source per unit length (dl when sigma_t -> 0)
-            glm::vec3 w;
-            for (int ch = 0; ch < 3; ++ch) w[ch] = sigT[ch] > 1e-6f ? (1.0f - stepT[ch]) / sigT[ch] : dl;
+            // (1 - e^-x) / sigma_t: the in-step weight of a source per unit length (dl when sigma_t -> 0).
+            // One exponential when the channels share sigma_t (cloud, smoke, pmma): the same bits as three.
+            glm::vec3 stepT, w;
+            if (grey) {
+                const float e = expf(-sigT.x * dl);
+                stepT = glm::vec3(e);
+                w = glm::vec3(sigT.x > 1e-6f ? (1.0f - e) / sigT.x : dl);
+            } else {
+                stepT = glm::exp(-sigT * dl);
+                for (int ch = 0; ch < 3; ++ch) w[ch] = sigT[ch] > 1e-6f ? (1.0f - stepT[ch]) / sigT[ch] : dl;
+            }
             const glm::vec3 tw = s.transmittance * w;
             s.albedo += tw * sigS;
             glm::vec3 tSun(1.0f);
