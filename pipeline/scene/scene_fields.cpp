@@ -634,8 +634,9 @@ const Table<LightingDesc>& sceneLightingTable()
         b.enumeration("direct", &LightingDesc::direct, parseDirectLight, directLightName, "direct light", "seed, once")
             .doc("string",
                  "`seed`: the grid as solved is added to the shadow-rayed sun (the seed's sum: direct light counted twice inside "
-                 "crowns); `once`: the grid less its uncollided sunlight, so it adds only scattered light "
-                 "([ACCURACY.md](ACCURACY.md))")
+                 "crowns; the default, closer to Cycles under the constant sky); `once`: the grid less its uncollided sunlight, "
+                 "weighed as light from all directions (leaves kd x (1 + t) / 4, bark kd / 4), so it adds only scattered light "
+                 "(closer to Cycles under a Preetham or map sky: [ACCURACY.md](ACCURACY.md))")
             .summarized([](const LightingDesc& l) { return std::string("direct light ") + directLightName(l.direct); });
         b.enumeration("forest_grid", &LightingDesc::forestGrid, parseForestGridMode, forestGridModeName, "forest grid", "off, auto, on")
             .doc("string",
