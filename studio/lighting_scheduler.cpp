@@ -184,6 +184,9 @@ bool LightingScheduler::hasBases(const Scene& scene) const
 std::optional<Relighting> LightingScheduler::relightingFor(const Scene& scene) const
 {
     if (m_viewport->backend() != QLatin1String("cpu")) return std::nullopt;   // the device frame is built per set of assets
+    // Direct light counted once: the grid is the solve minus its uncollided part, which the bases (full
+    // solves) do not separate; the lighting job makes those grids.
+    if (scene.lighting.direct != DirectLight::Seed) return std::nullopt;
     Relighting r;
     r.sun = scene.sun.direction;
     for (const SpeciesDesc& sp : scene.species) {
