@@ -22,25 +22,14 @@
 #include "studio/camera_nav.h"
 #include "studio/scene_item_pages.h"
 
+#include "studio/form_widgets.h"
+
 namespace sylva {
+using namespace widgets;
 namespace {
 
 const char* kAxis[3] = {"x", "y", "z"};
 
-void setValue(QDoubleSpinBox* box, double v)
-{
-    const QSignalBlocker block(box);
-    box->setValue(v);
-}
-
-QWidget* row(std::initializer_list<QWidget*> widgets)
-{
-    auto* w = new QWidget;
-    auto* l = new QHBoxLayout(w);
-    l->setContentsMargins(0, 0, 0, 0);
-    for (QWidget* x : widgets) l->addWidget(x);
-    return w;
-}
 
 } // namespace
 
@@ -64,18 +53,6 @@ PropertyPanel::PropertyPanel(SceneDocument* doc, QWidget* parent) : QWidget(pare
     showItem({});
 }
 
-QDoubleSpinBox* PropertyPanel::spin(const QString& name, double lo, double hi, int decimals, double step)
-{
-    auto* s = new QDoubleSpinBox;
-    s->setObjectName(name);
-    s->setRange(lo, hi);
-    s->setDecimals(decimals);
-    s->setSingleStep(step);
-    s->setKeyboardTracking(false);
-    s->setAccelerated(true);
-    s->setMinimumWidth(64);   // not the width of the widest value: three share a row
-    return s;
-}
 
 void PropertyPanel::apply(QObject* editor, const QString& text, const std::function<void(Scene&)>& change)
 {

@@ -55,7 +55,6 @@ private:
     void refresh();
     // Applies `change` to a copy of the scene and pushes it; edits of one editor in a row merge.
     void apply(QObject* editor, const QString& text, const std::function<void(Scene&)>& change);
-    QDoubleSpinBox* spin(const QString& name, double lo, double hi, int decimals, double step);
 
     SceneDocument* m_doc;
     OutlinerItem m_item;

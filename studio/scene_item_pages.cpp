@@ -15,20 +15,12 @@
 
 #include "core/terrain/height_field.h"
 
+#include "studio/form_widgets.h"
+
 namespace sylva {
+using namespace widgets;
 namespace {
 
-void setValue(QDoubleSpinBox* box, double v)
-{
-    const QSignalBlocker block(box);
-    box->setValue(v);
-}
-
-void setValue(QSpinBox* box, int v)
-{
-    const QSignalBlocker block(box);
-    box->setValue(v);
-}
 
 QSpinBox* intSpin(const QString& name, int lo, int hi)
 {
@@ -53,18 +45,6 @@ SceneItemPages::SceneItemPages(SceneDocument* doc, Apply apply, QWidget* parent)
     addWidget(m_volumePage = buildVolumePage());
 }
 
-QDoubleSpinBox* SceneItemPages::spin(const QString& name, double lo, double hi, int decimals, double step)
-{
-    auto* s = new QDoubleSpinBox;
-    s->setObjectName(name);
-    s->setRange(lo, hi);
-    s->setDecimals(decimals);
-    s->setSingleStep(step);
-    s->setKeyboardTracking(false);
-    s->setAccelerated(true);
-    s->setMinimumWidth(64);
-    return s;
-}
 
 QWidget* SceneItemPages::buildTerrainPage()
 {

@@ -46,7 +46,6 @@ private:
     QWidget* buildDensityPage();
     QWidget* buildVolumePage();
     void rebuildPlantRows(const Scene& scene);
-    QDoubleSpinBox* spin(const QString& name, double lo, double hi, int decimals, double step);
 
     SceneDocument* m_doc;
     Apply m_apply;

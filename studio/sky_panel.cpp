@@ -28,23 +28,12 @@
 #include "core/sky/virtual_lights.h"
 #include "studio/camera_nav.h"
 
+#include "studio/form_widgets.h"
+
 namespace sylva {
+using namespace widgets;
 namespace {
 
-void setValue(QDoubleSpinBox* box, double v)
-{
-    const QSignalBlocker block(box);
-    box->setValue(v);
-}
-
-QWidget* row(std::initializer_list<QWidget*> widgets)
-{
-    auto* w = new QWidget;
-    auto* l = new QHBoxLayout(w);
-    l->setContentsMargins(0, 0, 0, 0);
-    for (QWidget* x : widgets) l->addWidget(x);
-    return w;
-}
 
 QFormLayout* form(QWidget* w)
 {
@@ -259,18 +248,6 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
 
 QString SkyPanel::status() const { return m_status->text(); }
 
-QDoubleSpinBox* SkyPanel::spin(const char* name, double lo, double hi, int decimals, double step)
-{
-    auto* s = new QDoubleSpinBox;
-    s->setObjectName(QString::fromLatin1(name));
-    s->setRange(lo, hi);
-    s->setDecimals(decimals);
-    s->setSingleStep(step);
-    s->setKeyboardTracking(false);
-    s->setAccelerated(true);
-    s->setMinimumWidth(64);
-    return s;
-}
 
 void SkyPanel::apply(QObject* editor, const QString& text, const std::function<void(Scene&)>& change)
 {

@@ -63,7 +63,6 @@ private:
     void apply(QObject* editor, const QString& text, const std::function<void(Scene&)>& change);
     // The sun by date and place from the controls, into s (direction computed by NOAA's algorithm).
     void applyPlace(QObject* editor, const std::function<void(sky::SunPlace&)>& change);
-    QDoubleSpinBox* spin(const char* name, double lo, double hi, int decimals, double step);
     void chooseMap();
 
     SceneDocument* m_doc;
