@@ -58,12 +58,7 @@ void PropertyPanel::apply(QObject* editor, const QString& text, const std::funct
 {
     Scene s = m_doc->scene();
     change(s);
-    // Edits of one editor less than a second apart (arrow keys held, a dial dragged) are one undo step.
-    MergeState& m = m_mergeKeys[editor];
-    const qint64 now = QDateTime::currentMSecsSinceEpoch();
-    if (m.key == 0 || now - m.lastMs > 1000) m.key = SceneDocument::newMergeKey();
-    m.lastMs = now;
-    m_doc->edit(s, text, m.key);
+    m_doc->edit(s, text, m_merger.keyFor(editor));
 }
 
 QWidget* PropertyPanel::buildEmptyPage()
@@ -255,7 +250,7 @@ QWidget* PropertyPanel::buildGroundPage()
 
 void PropertyPanel::showItem(const OutlinerItem& item)
 {
-    if (!(item == m_item)) m_mergeKeys.clear();   // a new item starts new undo steps
+    if (!(item == m_item)) m_merger.clear();   // a new item starts new undo steps
     m_item = item;
     refresh();
 }

@@ -84,11 +84,7 @@ private:
     QCheckBox* m_groundEnabled;
     QDoubleSpinBox* m_groundHeight;
 
-    struct MergeState {
-        int key = 0;
-        qint64 lastMs = 0;
-    };
-    std::map<QObject*, MergeState> m_mergeKeys;
+    EditMerger m_merger;
 };
 
 } // namespace sylva

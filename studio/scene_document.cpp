@@ -3,6 +3,7 @@
 
 #include <atomic>
 
+#include <QDateTime>
 #include <QFileInfo>
 
 #include "core/base/error.h"
@@ -85,6 +86,15 @@ int SceneDocument::newMergeKey()
 {
     static std::atomic<int> next{1};
     return next.fetch_add(1);
+}
+
+int EditMerger::keyFor(const QObject* editor)
+{
+    State& m = m_keys[editor];
+    const qint64 now = QDateTime::currentMSecsSinceEpoch();
+    if (m.key == 0 || now - m.lastMs > 1000) m.key = SceneDocument::newMergeKey();
+    m.lastMs = now;
+    return m.key;
 }
 
 void SceneDocument::edit(const Scene& afterIn, const QString& text, int mergeKey)

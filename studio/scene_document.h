@@ -6,6 +6,8 @@
 #include <QUndoCommand>
 #include <QUndoStack>
 
+#include <map>
+
 #include "core/scene/scene.h"
 
 namespace sylva {
@@ -99,6 +101,21 @@ private:
     Scene m_before, m_after;
     int m_mergeKey;
     int m_epoch;
+};
+
+// The merge key of an editor's edit: edits of one editor less than a second apart (arrow keys held, a
+// dial dragged) are one undo step; a pause or another editor starts the next.
+class EditMerger {
+public:
+    int keyFor(const QObject* editor);
+    void clear() { m_keys.clear(); }
+
+private:
+    struct State {
+        int key = 0;
+        qint64 lastMs = 0;
+    };
+    std::map<const QObject*, State> m_keys;
 };
 
 } // namespace sylva

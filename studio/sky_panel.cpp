@@ -253,11 +253,7 @@ void SkyPanel::apply(QObject* editor, const QString& text, const std::function<v
 {
     Scene s = m_doc->scene();
     change(s);
-    MergeState& m = m_mergeKeys[editor];
-    const qint64 now = QDateTime::currentMSecsSinceEpoch();
-    if (m.key == 0 || now - m.lastMs > 1000) m.key = SceneDocument::newMergeKey();
-    m.lastMs = now;
-    m_doc->edit(s, text, m.key);
+    m_doc->edit(s, text, m_merger.keyFor(editor));
 }
 
 void SkyPanel::applyPlace(QObject* editor, const std::function<void(sky::SunPlace&)>& change)

@@ -85,11 +85,7 @@ private:
     QLabel* m_status;
     QWidget *m_preethamRows, *m_mapRows, *m_lightRows;
 
-    struct MergeState {
-        int key = 0;
-        qint64 lastMs = 0;
-    };
-    std::map<QObject*, MergeState> m_mergeKeys;
+    EditMerger m_merger;
 };
 
 } // namespace sylva
