@@ -14,6 +14,8 @@
 #include <QTemporaryDir>
 #include <QTest>
 
+#include "core/lb/lb_params.h"
+#include "core/scene/scene.h"
 #include "studio/autosave_controller.h"
 #include "studio/export_controller.h"
 #include "studio/inspector_controller.h"
@@ -29,6 +31,27 @@
 namespace sylva::test {
 
 inline QString sharedTree() { return QStringLiteral(SYLVA_SHARED_DATA "/trees/quaternius/OBJ/Tree_1.obj"); }
+
+// Three Tree_1 instances of the shared data in a row, turned 0, 40 and 80 degrees, seen from the front.
+inline Scene treeScene()
+{
+    Scene s;
+    SpeciesDesc sp;
+    sp.name = "Tree_1";
+    sp.meshPath = sharedTree().toStdString();
+    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    sp.grid = 16;
+    s.species.push_back(sp);
+    for (int i = 0; i < 3; ++i) {
+        InstanceDesc in;
+        in.position = {3.0 * i - 3.0, 0.0, 2.0 * i};
+        in.rotationDeg = {0.0f, 40.0f * float(i), 0.0f};
+        s.instances.push_back(in);
+    }
+    s.camera.position = {1.0, 3.0, -14.0};
+    s.camera.target = {0.0, 2.5, 0.0};
+    return s;
+}
 
 // Call first in initTestCase: QSKIP when CMake found no xvfb-run.
 #define SYLVA_SKIP_WITHOUT_X()                                                                                \

@@ -32,26 +32,6 @@ using namespace sylva::test;
 
 namespace {
 
-Scene treeScene()
-{
-    Scene s;
-    SpeciesDesc sp;
-    sp.name = "Tree_1";
-    sp.meshPath = sharedTree().toStdString();
-    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-    sp.grid = 16;
-    s.species.push_back(sp);
-    for (int i = 0; i < 3; ++i) {
-        InstanceDesc in;
-        in.position = {3.0 * i - 3.0, 0.0, 2.0 * i};
-        in.rotationDeg = {0.0f, 40.0f * float(i), 0.0f};
-        s.instances.push_back(in);
-    }
-    s.camera.position = {1.0, 3.0, -14.0};
-    s.camera.target = {0.0, 2.5, 0.0};
-    return s;
-}
-
 // The sky sampled over the sphere (a 32 x 16 map of skyToMap): equal skies, equal pixels.
 std::vector<float> skyPixels(const sky::Sky& s) { return sky::skyToMap(s, 32).rgb; }
 

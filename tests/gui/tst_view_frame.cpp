@@ -16,30 +16,12 @@
 #include "studio/asset_store.h"
 #include "studio/render_worker.h"
 #include "pipeline/render/view_frame.h"
+#include "studio_test_util.h"
 
 using namespace sylva;
+using namespace sylva::test;
 
 namespace {
-
-Scene treeScene()
-{
-    Scene s;
-    SpeciesDesc sp;
-    sp.name = "Tree_1";
-    sp.meshPath = SYLVA_SHARED_DATA "/trees/quaternius/OBJ/Tree_1.obj";
-    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-    sp.grid = 16;
-    s.species.push_back(sp);
-    for (int i = 0; i < 3; ++i) {
-        InstanceDesc in;
-        in.position = {3.0 * i - 3.0, 0.0, 2.0 * i};
-        in.rotationDeg = {0.0f, 40.0f * float(i), 0.0f};
-        s.instances.push_back(in);
-    }
-    s.camera.position = {1.0, 3.0, -14.0};
-    s.camera.target = {0.0, 2.5, 0.0};
-    return s;
-}
 
 // Pixels whose parts differ by more than a rounding error.
 int differingPixels(const Film& a, const Film& b)
