@@ -194,21 +194,34 @@ struct LoadedEntry {
 // The entry is read under a shared flock, which eviction respects; a hit sets its modification time
 // (its last use, for the least-recently-used eviction).
 std::optional<LoadedEntry> loadEntry(const std::string& path, uint32_t kind, const CacheKey::Digest& key, std::string* whyMissed,
-                                     const std::function<void(const std::string&)>& lockedHook)
+                                     const std::function<void(const std::string&)>& lockedHook,
+                                     const std::function<void(const std::string&)>& openedHook)
 {
     auto miss = [&](const std::string& why) -> std::optional<LoadedEntry> {
         if (whyMissed) *whyMissed = why;
         return std::nullopt;
     };
-    std::error_code ec;
-    if (!fs::exists(path, ec)) return miss("no cache entry " + path);
+    // Shared lock for the read; eviction takes the exclusive one, unlinks, then lets go. The file
+    // opened may have lost its name before the lock was held: evicted, or replaced by a concurrent
+    // store's rename. Open the name again then, so a replaced entry is read in its new version and
+    // only a name that is gone is a miss (a bounded number of times: writers that keep replacing it
+    // make this a miss, never a wait without end).
     QFile file(QString::fromStdString(path));
-    if (!file.open(QIODevice::ReadOnly)) return miss("cannot read cache entry " + path + " (" + file.errorString().toStdString() + "); recomputing");
-    // Shared lock for the read; eviction takes the exclusive one, unlinks, then lets go: an entry
-    // unlinked while this waited is a miss.
-    while (::flock(file.handle(), LOCK_SH) != 0 && errno == EINTR) {}
     struct stat st {};
-    if (::fstat(file.handle(), &st) != 0 || st.st_nlink == 0) return miss("no cache entry " + path + " (evicted)");
+    for (int attempt = 0;; ++attempt) {
+        std::error_code ec;
+        if (!fs::exists(path, ec)) return miss("no cache entry " + path);
+        if (!file.open(QIODevice::ReadOnly)) {
+            if (!fs::exists(path, ec)) return miss("no cache entry " + path);
+            return miss("cannot read cache entry " + path + " (" + file.errorString().toStdString() + "); recomputing");
+        }
+        if (openedHook) openedHook(path);
+        while (::flock(file.handle(), LOCK_SH) != 0 && errno == EINTR) {}
+        if (::fstat(file.handle(), &st) != 0) return miss("cannot read cache entry " + path + " (fstat failed); recomputing");
+        if (st.st_nlink > 0) break;
+        file.close();
+        if (attempt == 15) return miss("no cache entry " + path + " (replaced or evicted while opening it)");
+    }
     if (lockedHook) lockedHook(path);
 
     auto reject = [&](const std::string& problem) -> std::optional<LoadedEntry> {
@@ -397,7 +410,7 @@ std::string GridCache::entryPath(const CacheKey& key, char kind) const
 
 std::optional<DensityGrid> GridCache::loadDensity(const CacheKey& key, std::string* whyMissed)
 {
-    auto entry = loadEntry(entryPath(key, 'd'), kKindDensity, key.digest(), whyMissed, m_readHook);
+    auto entry = loadEntry(entryPath(key, 'd'), kKindDensity, key.digest(), whyMissed, m_readHook, m_openHook);
     if (!entry) return std::nullopt;
     DensityGrid grid;
     grid.geometry = geometryOf(entry->header);
@@ -423,7 +436,7 @@ void GridCache::storeDensity(const CacheKey& key, const DensityGrid& grid)
 
 std::optional<LightingGrid> GridCache::loadLighting(const CacheKey& key, std::string* whyMissed)
 {
-    auto entry = loadEntry(entryPath(key, 'l'), kKindLighting, key.digest(), whyMissed, m_readHook);
+    auto entry = loadEntry(entryPath(key, 'l'), kKindLighting, key.digest(), whyMissed, m_readHook, m_openHook);
     if (!entry) return std::nullopt;
     LightingGrid grid;
     grid.geometry = geometryOf(entry->header);

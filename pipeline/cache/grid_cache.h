@@ -128,6 +128,8 @@ public:
 
     // For tests: called while a load holds an entry's shared lock, before it reads the payload.
     void setReadHookForTests(std::function<void(const std::string& path)> hook) { m_readHook = std::move(hook); }
+    // For tests: called when a load has opened an entry, before it takes the shared lock.
+    void setOpenHookForTests(std::function<void(const std::string& path)> hook) { m_openHook = std::move(hook); }
 
 private:
     void beforeStore(const std::string& path, uint64_t payloadBytes) const;
@@ -135,6 +137,7 @@ private:
     std::string m_dir;
     uint64_t m_maxBytes = 0;
     std::function<void(const std::string&)> m_readHook;
+    std::function<void(const std::string&)> m_openHook;
 };
 
 // The cache size limit from the user's settings (QSettings "Sylva"/"sylva": $XDG_CONFIG_HOME/Sylva/

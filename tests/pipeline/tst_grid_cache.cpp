@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -450,6 +451,39 @@ private Q_SLOTS:
         QVERIFY(got);
         QCOMPARE(got->rgb, makeLighting(dims, 1.0f).rgb);
         QVERIFY(exists(writer.entryPath(a, 'l')));
+    }
+
+    // A load that opened an entry just before a concurrent store renamed a new version over it (the
+    // opened file lost its name) reads the new version: the entry was replaced, not evicted. Only a
+    // name that is gone is a miss.
+    void entryReplacedWhileOpening()
+    {
+        const glm::ivec3 dims(5, 4, 3);
+        const std::string dir = freshDir("replaced");
+        GridCache reader(dir, 0);
+        GridCache writer(dir, 0);
+        const CacheKey key = keyFor("tree.obj", 1.0);
+        writer.storeLighting(key, makeLighting(dims, 1.0f));
+        int opens = 0;
+        reader.setOpenHookForTests([&](const std::string&) {
+            if (++opens == 1) writer.storeLighting(key, makeLighting(dims, 2.0f));
+        });
+        std::string why;
+        const auto got = reader.loadLighting(key, &why);
+        QVERIFY2(got, why.c_str());
+        QCOMPARE(opens, 2);   // the first file opened had been replaced: opened again
+        QCOMPARE(got->rgb, makeLighting(dims, 2.0f).rgb);
+
+        // Evicted while opening (the name removed, none put back): a miss that says so.
+        opens = 0;
+        reader.setOpenHookForTests([&](const std::string& path) {
+            ++opens;
+            std::error_code ec;
+            std::filesystem::remove(path, ec);
+        });
+        QVERIFY(!reader.loadLighting(key, &why));
+        QCOMPARE(opens, 1);
+        QVERIFY2(QString::fromStdString(why).startsWith(QStringLiteral("no cache entry")), why.c_str());
     }
 
     void folderTagAndClean()
