@@ -143,7 +143,12 @@ int runRender(const Args& args)
                          "library is installed, e.g. Debian's libopenmpi-dev)");
 #endif
     if (!useMpi && args.has("--mpi-timeout")) throw UsageError("option --mpi-timeout: applies to --mpi only");
-    auto threads = threadLimit(args);
+    if (!useMpi && args.has("--mpi-scene")) throw UsageError("option --mpi-scene: applies to --mpi only");
+    const std::string mpiScene = args.get("--mpi-scene", "broadcast");
+    if (mpiScene != "broadcast" && mpiScene != "each")
+        throw UsageError("option --mpi-scene: expected broadcast or each, got '" + mpiScene + "'");
+    // Under --mpi the ranks set their own thread limits (rank 0 builds with its node's threads).
+    auto threads = useMpi ? nullptr : threadLimit(args);
     const std::string backend = backendName(args);
     std::string stem;
     const Scene scene = sceneForArgs(args, &stem);
@@ -229,6 +234,8 @@ int runRender(const Args& args)
             }
             return solves;
         };
+    job.broadcastScene = mpiScene == "broadcast";
+    if (args.has("--threads")) job.threads = int(parseInteger("--threads", args.get("--threads"), 1, 1024));
     if (args.has("--mpi-timeout")) job.timeoutSeconds = double(parseInteger("--mpi-timeout", args.get("--mpi-timeout"), 1, 86400));
     return mpi::runRender(job);
 #else
@@ -267,6 +274,8 @@ Command renderCommand()
              {"--stats", "", "print timings and acceleration structure sizes"},
              {"--mpi", "", "trace the frame across the ranks of an MPI job, tiles from a work queue on rank 0: mpirun -np N sylva render --mpi ... (docs/DISTRIBUTED.md)"},
              {"--mpi-timeout", "S", "with --mpi: end the job when a rank stays silent S seconds (default 10)"},
+             {"--mpi-scene", "broadcast|each", "with --mpi: rank 0 builds the frame and broadcasts it to the other ranks (default), or "
+                                               "every rank builds its own from the species assets (docs/DISTRIBUTED.md)"},
              kOutput, kCache, kNoCache, kThreads, kQuiet},
             0, 1, &runRender};
 }

@@ -204,7 +204,7 @@ int runLightSession(const std::function<int(int rank, int ranks)>& body, double 
             // An error on any rank ends every rank: the others would wait for its halos.
             endJob(rankText(rank) + " on " + thisHost() + ": " + e.what());
         }
-    });
+    }, timeoutSeconds);
 }
 
 } // namespace sylva::mpi

@@ -1,11 +1,12 @@
 // `sylva render --mpi`: one frame traced by the ranks of an MPI job (docs/DISTRIBUTED.md). Built only with
 // MPI (SYLVA_ENABLE_MPI); nothing outside pipeline/mpi includes an MPI header.
 //
-// Every rank loads the scene and builds its frame (species assets through the shared grid cache).
 // Rank 0 runs the render exactly as the single-process path does, except that its tracing goes
-// through a FilmRowsTracer that cuts the rows into tiles (mpi_tiles.h: 32 x 32, smaller when a frame
-// has few per rank, quarters at the end of the queue) and hands them from a work queue to the ranks that ask; rank 0 traces tiles too between its
-// messages. A tile is renderFilmRect, shadePixel per pixel, so the picture is bit-identical to a
+// through a FilmRowsTracer: when it starts, rank 0 broadcasts the built frame's arrays (the other
+// ranks wait for them; or, with broadcastScene false, each rank builds its own frame from the species
+// assets in the shared grid cache), then cuts the rows into tiles (mpi_tiles.h: 32 x 32, smaller when a
+// frame has few per rank, quarters at the end of the queue) and hands them from a work queue to the
+// ranks that ask, two ahead; rank 0 traces tiles too between its messages. A tile is renderFilmRect, shadePixel per pixel, so the picture is bit-identical to a
 // single-process CPU render at any rank count. Rank 0 gathers, composes and writes with the
 // single-process writer.
 //
@@ -44,6 +45,12 @@ struct RenderJob {
     double timeoutSeconds = 10.0;
     // Tile edge in pixels (halved down to 8 while the frame has fewer than 4 tiles per rank).
     int tile = 32;
+    // How the other ranks get the frame's scene: rank 0 builds it once and broadcasts its arrays when
+    // it starts tracing (true; `prepare` is not called), or every rank builds its own through `prepare`.
+    bool broadcastScene = true;
+    // Threads per rank (--threads; 0: no limit). With broadcastScene, rank 0 builds the scene with the
+    // threads of every rank on its node, which wait for the scene meanwhile, then traces with these.
+    int threads = 0;
 };
 
 // Runs this rank's part: MPI_Init, the build check, then the work queue (rank 0) or a worker.

@@ -12,9 +12,10 @@ namespace sylva::mpi {
 // than rank 0 are refused, exit 1), body(rank, size, each rank's host), MPI_Finalize. Returns body's
 // code. `command` names the job in messages ("sylva light: error: ..."), `notWritten` what a failed
 // job leaves unwritten ("no picture was written"). Throws Error when the process was not started by
-// mpirun.
+// mpirun. A start (MPI_Init and the build check) that has not finished within 2 x timeoutSeconds + 5 s
+// (a rank hung or never started) ends this process with exit 1 and says so; mpirun stops the others.
 int runSession(const char* command, const char* notWritten,
-               const std::function<int(int rank, int size, const std::vector<std::string>& hosts)>& body);
+               const std::function<int(int rank, int size, const std::vector<std::string>& hosts)>& body, double timeoutSeconds);
 
 // Reports `message` on stderr as the session's error and ends every rank of the job (MPI_Abort, exit 1).
 [[noreturn]] void endJob(const std::string& message);

@@ -238,7 +238,7 @@ RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progres
     SubProgress tracePart(progress, 0.7, 1.0);
     Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
     if (progress && progress->isCancelled()) traceProgress.cancel();
-    out.film = tracer    ? tracer(rs.view(), 0, scene.render.height, &traceProgress)
+    out.film = tracer    ? tracer(rs, 0, scene.render.height, &traceProgress)
                : backend ? backend->render(rs, &traceProgress)
                          : renderFilm(rs.view(), &traceProgress);
     if (log) log->stages.push_back("trace");
@@ -327,7 +327,7 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
             tracePart.report((double(b) + f) / double(bands), "tracing band " + std::to_string(b + 1) + "/" + std::to_string(bands));
         });
         if (progress && progress->isCancelled()) bandProgress.cancel();
-        const Film film = tracer ? tracer(view, y0, y1, &bandProgress) : renderFilmRows(view, y0, y1, &bandProgress);
+        const Film film = tracer ? tracer(rs, y0, y1, &bandProgress) : renderFilmRows(view, y0, y1, &bandProgress);
         buf.resize(film.pixels.size() * floatsPerPixel);
         if (ambientMode) {
             addAmbientSums(film, &indirectSum, &albedoSum);

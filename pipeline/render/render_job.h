@@ -68,8 +68,9 @@ struct RenderOutput {
 // up front (Error naming the size and the memory), before any asset is loaded.
 // tracer: traces the frame's rows in place of the backend (sylva render --mpi hands them to the ranks as tiles).
 inline constexpr size_t kFrameBytesPerPixel = sizeof(SampleParts) + sizeof(glm::vec3);
-// Rows y0 (inclusive) to y1 (exclusive) of a view as a film: renderFilmRows's contract.
-using FilmRowsTracer = std::function<Film(const RenderView& view, int y0, int y1, Progress* progress)>;
+// Rows y0 (inclusive) to y1 (exclusive) of scene.view() as a film: renderFilmRows's contract (the whole
+// scene, not only its view: render --mpi sends the built scene to the other ranks).
+using FilmRowsTracer = std::function<Film(const RenderScene& scene, int y0, int y1, Progress* progress)>;
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr,
                          Backend* backend = nullptr, const FilmRowsTracer& tracer = {});
 
