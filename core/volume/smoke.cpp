@@ -497,7 +497,8 @@ void SmokeSim::project()
     });
     m_stats.divergenceBefore = divergenceNorm();
     // A psi = -D (D: the flux difference of a cell), then u -= grad psi over the open faces.
-    std::vector<double> rhs(d.cell(n.x - 1, n.y - 1, n.z - 1) + 1, 0.0);
+    std::vector<double>& rhs = m_rhs;
+    rhs.assign(d.cell(n.x - 1, n.y - 1, n.z - 1) + 1, 0.0);
     forSlabs(n.x, [&](int i) {
         for (int j = 0; j < n.y; ++j)
             for (int k = 0; k < n.z; ++k) {
@@ -536,7 +537,10 @@ void SmokeSim::advectScalars(float dt)
     const FieldView fu{m_u.data(), {n.x + 1, n.y, n.z}, {0.0f, 0.5f, 0.5f}};
     const FieldView fv{m_v.data(), {n.x, n.y + 1, n.z}, {0.5f, 0.0f, 0.5f}};
     const FieldView fw{m_w.data(), {n.x, n.y, n.z + 1}, {0.5f, 0.5f, 0.0f}};
-    const std::vector<float> oldD = m_density, oldT = m_temperature;
+    m_oldDensity = m_density;   // copies into the kept buffers (no new pages)
+    m_oldTemperature = m_temperature;
+    const std::vector<float>& oldD = m_oldDensity;
+    const std::vector<float>& oldT = m_oldTemperature;
     const FieldView fd{oldD.data(), n, glm::vec3(0.5f)}, ft{oldT.data(), n, glm::vec3(0.5f)};
     const glm::vec3 hi = glm::vec3(n);
     const SmokeInterp interp = m_s.interp;
@@ -569,7 +573,12 @@ void SmokeSim::step(Progress* progress)
     if (progress) progress->throwIfCancelled();
 
     // 1. Forces on a copy of the velocity: buoyancy on the v faces, vorticity confinement on all.
-    std::vector<float> u1 = m_u, v1 = m_v, w1 = m_w;
+    m_u1 = m_u;
+    m_v1 = m_v;
+    m_w1 = m_w;
+    std::vector<float>& u1 = m_u1;
+    std::vector<float>& v1 = m_v1;
+    std::vector<float>& w1 = m_w1;
     forSlabs(n.x, [&](int i) {
         for (int j = 1; j <= n.y; ++j)
             for (int k = 0; k < n.z; ++k) {
@@ -582,8 +591,13 @@ void SmokeSim::step(Progress* progress)
     });
     if (m_s.vorticity > 0.0f) {
         const size_t cells = m_density.size();
-        std::vector<glm::vec3> centre(cells), omega(cells);
-        std::vector<float> mag(cells);
+        // Every cell of the three is written below before it is read.
+        m_centre.resize(cells);
+        m_omega.resize(cells);
+        m_vorticityMag.resize(cells);
+        std::vector<glm::vec3>& centre = m_centre;
+        std::vector<glm::vec3>& omega = m_omega;
+        std::vector<float>& mag = m_vorticityMag;
         forSlabs(n.x, [&](int i) {
             for (int j = 0; j < n.y; ++j)
                 for (int k = 0; k < n.z; ++k)
