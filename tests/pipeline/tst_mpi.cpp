@@ -157,6 +157,28 @@ private Q_SLOTS:
         QVERIFY2(fileBytes(each) == want, qPrintable(QString("--mpi-scene each, mode %1: the picture differs").arg(mode)));
     }
 
+    // The bundled cloud (volume arrays) and landscape (terrain, cells and tiles) at 2 ranks: the broadcast
+    // frame carries every array kind, so the picture is still the single process's to the bit.
+    void volumeAndLandscapeEqualSingleProcess_data()
+    {
+        QTest::addColumn<QString>("name");
+        QTest::newRow("cloud") << "cloud";
+        QTest::newRow("landscape") << "landscape";
+    }
+    void volumeAndLandscapeEqualSingleProcess()
+    {
+        QFETCH(QString, name);
+        const QString sceneFile = QString(SYLVA_SOURCE_DIR) + "/resources/" + name + ".sylva.json";
+        const QStringList common{sceneFile, "--width", "64", "--height", "36", "--quiet"};
+        const QString ref = m_dir.filePath("single_" + name + ".png"), out = m_dir.filePath("mpi2_" + name + ".png");
+        Run r = single(QStringList(common) << "-o" << ref);
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        r = mpirun(2, QStringList(common) << "-o" << out);
+        QVERIFY2(r.code == 0, qPrintable(r.err));
+        QVERIFY(!fileBytes(ref).isEmpty());
+        QVERIFY2(fileBytes(out) == fileBytes(ref), qPrintable(name + ": the picture differs"));
+    }
+
     // The shading parts themselves (the passes' 32-bit float layers: direct, indirect, albedo, sky,
     // normal, depth, alpha) and a frame in bands (the tiles of each band from the queue) at 2 and 3 ranks.
     void passesAndBandsEqualSingleProcess()
