@@ -63,12 +63,14 @@ QDialogButtonBox* okCancel(QDialog* d)
 }
 
 // A scene volume over the grid file `path` (read back as the scene reader does: loadSceneVolumes).
-VolumeDesc loadedVolume(const QString& name, const QString& path, const std::string& preset, const glm::dvec3& position)
+VolumeDesc loadedVolume(const QString& name, const QString& path, const std::string& preset, const glm::dvec3& position,
+                        const QString& temperaturePath = {})
 {
     Scene one;
     VolumeDesc v = defaultVolume();
     v.name = name.toStdString();
     v.grid = QFileInfo(path).absoluteFilePath().toStdString();
+    if (!temperaturePath.isEmpty()) v.temperature = QFileInfo(temperaturePath).absoluteFilePath().toStdString();
     v.preset = preset;
     lb::LbParams optics;
     if (!volumePreset(preset, &optics)) throw Error("volume preset '" + preset + "' is unknown");
@@ -162,11 +164,15 @@ SmokeDialog::SmokeDialog(const SmokeSpec& s, QWidget* parent) : QDialog(parent),
     m_width = dspin("smoke.width", 0.01, 1e4, 3, s.width);
     m_steps = ispin("smoke.steps", 1, 100000, s.steps);
     m_seed = ispin("smoke.seed", 0, 1 << 30, int(s.seed));
+    m_kelvin = dspin("smoke.kelvin", 0.0, 40000.0, 0, double(s.sourceKelvin));
+    m_kelvin->setSpecialValueText(tr("cold (no emission)"));
+    m_kelvin->setToolTip(tr("Hot smoke: the sources' temperature in kelvin, drawn as blackbody emission (1000 K and up glow)"));
     form->addRow(tr("Name"), m_name);
     form->addRow(tr("Cells"), triple(m_cells[0], m_cells[1], m_cells[2]));
     form->addRow(tr("Width (m)"), m_width);
     form->addRow(tr("Steps (0.02 s each)"), m_steps);
     form->addRow(tr("Seed"), m_seed);
+    form->addRow(tr("Source temperature (K)"), m_kelvin);
     form->addRow(tr("Floor centre (m)"), triple(m_position[0], m_position[1], m_position[2]));
     form->addRow(okCancel(this));
 }
@@ -182,6 +188,7 @@ SmokeSpec SmokeDialog::spec() const
     s.width = float(m_width->value());
     s.steps = m_steps->value();
     s.seed = uint64_t(m_seed->value());
+    s.sourceKelvin = float(m_kelvin->value());
     return s;
 }
 
@@ -291,8 +298,11 @@ Job* VolumeTools::simulateSmoke(const SmokeSpec& spec)
     try {
         if (!(spec.width > 0.0f)) throw Error("smoke: the width must be > 0");
         if (spec.steps < 1) throw Error("smoke: at least one step");
+        if (!(spec.sourceKelvin >= 0.0f) || spec.sourceKelvin > 40000.0f) throw Error("smoke: the source temperature must be 0 .. 40000 K");
         volume::setSmokeDomain(settings, spec.width);
-        settings.sources.push_back({volume::defaultSmokeSource(settings, spec.width), 1.0f, 1.0f, glm::vec3(0.0f)});
+        const bool hot = spec.sourceKelvin > 0.0f;
+        if (hot) settings.buoyancyTemperature /= spec.sourceKelvin;   // per kelvin: the same rise as unit temperature
+        settings.sources.push_back({volume::defaultSmokeSource(settings, spec.width), 1.0f, hot ? spec.sourceKelvin : 1.0f, glm::vec3(0.0f)});
         volume::validateSmoke(settings);
     } catch (const std::exception& e) {
         fail(tr("Smoke failed"), QString::fromStdString(e.what()));
@@ -300,19 +310,22 @@ Job* VolumeTools::simulateSmoke(const SmokeSpec& spec)
     }
     const QString name = uniqueName(spec.name.isEmpty() ? QStringLiteral("smoke") : spec.name);
     auto result = std::make_shared<DensityGrid>();
+    auto temperature = std::make_shared<DensityGrid>();
+    const bool hot = spec.sourceKelvin > 0.0f;
     const int steps = spec.steps;
     const glm::dvec3 position = spec.position;
     return m_jobs->start(
         tr("Simulate smoke"),
-        [settings, steps, result](Job&, Progress& progress) {
+        [settings, steps, result, temperature, hot](Job&, Progress& progress) {
             volume::SmokeSim sim(settings);
             for (int n = 1; n <= steps; ++n) {
                 sim.step(&progress);
                 progress.report(double(n) / double(steps), "step " + std::to_string(n) + "/" + std::to_string(steps));
             }
             *result = sim.densityGrid();
+            if (hot) *temperature = sim.temperatureGrid();
         },
-        [this, name, position, result, steps, spec](Job* job) {
+        [this, name, position, result, temperature, hot, steps, spec](Job* job) {
             if (job->state() == Job::State::Cancelled) {
                 log(tr("smoke %1 cancelled: nothing added").arg(name));
                 return;
@@ -324,7 +337,12 @@ Job* VolumeTools::simulateSmoke(const SmokeSpec& spec)
             try {
                 const QString path = gridPathFor(name);
                 writeDensityFile(path.toStdString(), *result);
-                VolumeDesc v = loadedVolume(name, path, "smoke", position);
+                QString temperaturePath;
+                if (hot) {
+                    temperaturePath = gridPathFor(name + QStringLiteral("_temperature"));
+                    writeDensityFile(temperaturePath.toStdString(), *temperature);
+                }
+                VolumeDesc v = loadedVolume(name, path, "smoke", position, temperaturePath);
                 log(tr("smoke %1: %2 x %3 x %4 cells, %5 steps in %6 s -> %7")
                         .arg(name)
                         .arg(spec.cells.x)

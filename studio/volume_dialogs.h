@@ -49,6 +49,10 @@ struct SmokeSpec {
     uint64_t seed = 1;
     glm::dvec3 position{0.0};
     QString name = QStringLiteral("smoke");
+    // Hot smoke (> 0): the sources' temperature in kelvin. The job then also writes the temperature
+    // grid (kelvin: blackbody emission, RENDERING.md) and the volume references it; the buoyancy per
+    // kelvin is the default's per unit over this, so the plume rises as cold smoke of unit temperature.
+    float sourceKelvin = 0.0f;
 };
 
 class SmokeDialog : public QDialog {
@@ -62,7 +66,7 @@ private:
     SmokeSpec m_initial;
     QLineEdit* m_name;
     QSpinBox *m_cells[3], *m_steps, *m_seed;
-    QDoubleSpinBox* m_width;
+    QDoubleSpinBox *m_width, *m_kelvin;
     QDoubleSpinBox* m_position[3];
 };
 

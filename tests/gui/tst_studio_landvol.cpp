@@ -327,6 +327,27 @@ private Q_SLOTS:
         float peak = 0.0f;
         for (float x : v.data->density.density) peak = std::max(peak, x);
         QVERIFY(peak > 0.1f && peak <= 1.0f);
+        QVERIFY(v.temperature.empty() && v.data->temperature.empty());   // cold smoke: no emission
+        const std::vector<float> coldDensity = v.data->density.density;
+        w->document()->undoStack()->undo();
+        QVERIFY(w->document()->scene().volumes.empty());
+
+        // Hot smoke: the same plume (buoyancy per kelvin scaled) with a temperature grid in kelvin that the
+        // volume references: the sources' cells at 1500 K, and no value above it.
+        SmokeSpec hot = small;
+        hot.name = "fire";
+        hot.sourceKelvin = 1500.0f;
+        QVERIFY(waitForJob(t->simulateSmoke(hot), 30000));
+        QCOMPARE(int(w->document()->scene().volumes.size()), 1);
+        const VolumeDesc& f = w->document()->scene().volumes[0];
+        QVERIFY(!f.temperature.empty() && QFileInfo::exists(QString::fromStdString(f.temperature)));
+        QCOMPARE(f.data->temperature.size(), f.data->density.density.size());
+        const float hottest = *std::max_element(f.data->temperature.begin(), f.data->temperature.end());
+        QVERIFY2(std::abs(hottest - 1500.0f) < 1e-3f, qPrintable(QString::number(double(hottest))));
+        QCOMPARE(f.data->density.density.size(), coldDensity.size());
+        float worst = 0.0f;
+        for (size_t i = 0; i < coldDensity.size(); ++i) worst = std::max(worst, std::abs(f.data->density.density[i] - coldDensity[i]));
+        QVERIFY2(worst < 1e-4f, qPrintable(QString::number(double(worst))));   // the same rise, up to float rounding
         w->document()->undoStack()->undo();
         QVERIFY(w->document()->scene().volumes.empty());
     }
