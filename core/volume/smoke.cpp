@@ -355,13 +355,16 @@ struct SmokeSim::Solver {
             return {0, 0.0};
         }
         apply(l0, x.data(), q.data());
-        tbb::parallel_for(size_t(0), n, [&](size_t i) { r[i] = l0.fluid[i] ? rhs[i] - q[i] : 0.0; });
+        HostExec().forEach(n, [&](size_t i) { r[i] = l0.fluid[i] ? rhs[i] - q[i] : 0.0; });
         double rnorm = std::sqrt(dot(r, r));
         if (rnorm <= tol * bnorm) return {0, rnorm / bnorm};
+        // z = V-cycle(r): the finest level reads r as its b and leaves its x in z (swapped in and out,
+        // not copied: two 16 MB copies an iteration at 128^3; vcycle clears x before it writes it).
         auto precondition = [&]() {
-            std::copy(r.begin(), r.end(), l0.b.begin());
+            std::swap(l0.b, r);
             vcycle(0);
-            std::copy(l0.x.begin(), l0.x.end(), z.begin());
+            std::swap(l0.b, r);
+            std::swap(l0.x, z);
         };
         precondition();
         s = z;
@@ -371,17 +374,20 @@ struct SmokeSim::Solver {
             ++it;
             apply(l0, s.data(), q.data());
             const double alpha = rho / dot(s, q);
-            tbb::parallel_for(size_t(0), n, [&](size_t i) {
+            // The update and |r|^2 in one pass (the sum in dot's chunk order: the same bits).
+            double rr = 0.0;
+            HostExec().sum<1>(n, [&](size_t i, double* t) {
                 x[i] += alpha * s[i];
                 r[i] -= alpha * q[i];
-            });
-            rnorm = std::sqrt(dot(r, r));
+                t[0] = r[i] * r[i];
+            }, &rr);
+            rnorm = std::sqrt(rr);
             if (rnorm <= tol * bnorm) break;
             precondition();
             const double rhoNew = dot(r, z);
             const double beta = rhoNew / rho;
             rho = rhoNew;
-            tbb::parallel_for(size_t(0), n, [&](size_t i) { s[i] = z[i] + beta * s[i]; });
+            HostExec().forEach(n, [&](size_t i) { s[i] = z[i] + beta * s[i]; });
         }
         return {it, rnorm / bnorm};
     }
