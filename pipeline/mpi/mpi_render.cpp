@@ -579,19 +579,15 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
                 busy = true;
             }
             if (p.done) continue;
-            if (p.wanted == 0) {
-                // A rank waiting for the scene (rank 0 still building it) hears from rank 0 meanwhile.
-                if (!queue.sceneSent() && since(p.pinged) > kHeartbeatSeconds) {
-                    check(MPI_Send(nullptr, 0, MPI_BYTE, r, kHeartbeat, MPI_COMM_WORLD), "Send");
-                    p.pinged = Clock::now();
-                }
-                continue;
-            }
-            if (rendered) {
+            if (p.wanted > 0 && rendered) {
                 check(MPI_Send(nullptr, 0, MPI_BYTE, r, kDone, MPI_COMM_WORLD), "Send");
                 p.wanted = 0;
                 p.done = true;
-            } else if (since(p.pinged) > kHeartbeatSeconds) {
+                continue;
+            }
+            // A rank waiting on rank 0 (for a tile, or for the scene while rank 0 builds it) hears from it.
+            const bool waiting = p.wanted > 0 || !queue.sceneSent();
+            if (waiting && since(p.pinged) > kHeartbeatSeconds) {
                 check(MPI_Send(nullptr, 0, MPI_BYTE, r, kHeartbeat, MPI_COMM_WORLD), "Send");
                 p.pinged = Clock::now();
             }
