@@ -109,10 +109,12 @@ int main(int argc, char** argv)
             iterations /= std::max(1, reps);
             const double cpuPerStep = (cpuSeconds() - cpu0) / std::max(1, reps);
             // Bytes a step must move at least (each array read or written once per pass): forces and
-            // vorticity ~ 120 B/cell, the two advections ~ 64 B/cell, each CG iteration ~ 200 B/cell (operator,
-            // V-cycle of 4 Jacobi sweeps with residual and transfers on the finest level, 2 dots, 3 updates).
+            // vorticity ~ 120 B/cell, the two advections ~ 64 B/cell, each CG iteration ~ 250 B/cell: the
+            // double vectors ~ 100 (operator with x.q, the fused update writing the V-cycle's float input,
+            // r.z, the direction update) and the float V-cycle ~ 150 (on the finest level 8 red-black
+            // sweeps of 13 B, residual, transfers; the coarser levels an eighth of it each).
             const double cells = double(n) * n * n;
-            const double bytes = cells * (184.0 + 200.0 * iterations);
+            const double bytes = cells * (184.0 + 250.0 * iterations);
             const double floor = copySeconds(size_t(bytes));
             const char* name = interp == volume::SmokeInterp::Linear ? "linear" : "cubic";
             std::printf("smoke step %d^3 (%s): %.3f s median of %d (min %.3f), %.2f processor s per step, %.1f pressure iterations; "
