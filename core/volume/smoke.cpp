@@ -44,9 +44,10 @@ struct FieldView {
     float at(int i, int j, int k) const { return data[(size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z) + size_t(k)]; }
 };
 
-// Trilinear interpolation at pos (cell units), clamped to the field. Inlined with its eight loads at
-// offsets from one base index: the advection's back-traces call it four times a face.
-[[gnu::always_inline]] inline float sampleLinear(const FieldView& f, const glm::vec3& pos)
+// Trilinear interpolation at pos (cell units), clamped to the field, of `count` fields that share the
+// view's geometry (f.data and the others): one index computation, eight loads each from one base index.
+template <int count>
+[[gnu::always_inline]] inline void sampleLinearN(const FieldView& f, const float* const (&data)[count], const glm::vec3& pos, float (&out)[count])
 {
     const float sx = std::clamp(pos.x - f.offset.x, 0.0f, float(f.n.x - 1));
     const float sy = std::clamp(pos.y - f.offset.y, 0.0f, float(f.n.y - 1));
@@ -54,13 +55,24 @@ struct FieldView {
     const int i = std::min(int(sx), f.n.x - 2), j = std::min(int(sy), f.n.y - 2), k = std::min(int(sz), f.n.z - 2);
     const float tx = sx - float(i), ty = sy - float(j), tz = sz - float(k);
     const size_t dy = size_t(f.n.z), dx = size_t(f.n.y) * dy;
-    const float* p = f.data + (size_t(i) * size_t(f.n.y) + size_t(j)) * dy + size_t(k);
-    const float c00 = p[0] + tz * (p[1] - p[0]);
-    const float c01 = p[dy] + tz * (p[dy + 1] - p[dy]);
-    const float c10 = p[dx] + tz * (p[dx + 1] - p[dx]);
-    const float c11 = p[dx + dy] + tz * (p[dx + dy + 1] - p[dx + dy]);
-    const float c0 = c00 + ty * (c01 - c00), c1 = c10 + ty * (c11 - c10);
-    return c0 + tx * (c1 - c0);
+    const size_t base = (size_t(i) * size_t(f.n.y) + size_t(j)) * dy + size_t(k);
+    for (int c = 0; c < count; ++c) {
+        const float* p = data[c] + base;
+        const float c00 = p[0] + tz * (p[1] - p[0]);
+        const float c01 = p[dy] + tz * (p[dy + 1] - p[dy]);
+        const float c10 = p[dx] + tz * (p[dx + 1] - p[dx]);
+        const float c11 = p[dx + dy] + tz * (p[dx + dy + 1] - p[dx + dy]);
+        const float c0 = c00 + ty * (c01 - c00), c1 = c10 + ty * (c11 - c10);
+        out[c] = c0 + tx * (c1 - c0);
+    }
+}
+
+[[gnu::always_inline]] inline float sampleLinear(const FieldView& f, const glm::vec3& pos)
+{
+    const float* const data[1] = {f.data};
+    float out[1];
+    sampleLinearN<1>(f, data, pos, out);
+    return out[0];
 }
 
 // Monotonic cubic Hermite through f1 (t = 0) and f2 (t = 1), Fedkiw et al. 2001 eq. (8)-(9): the
@@ -681,8 +693,15 @@ void SmokeSim::advectScalars(float dt)
                                    0.5f * (m_w[d.wIdx(i, j, k)] + m_w[d.wIdx(i, j, k + 1)]));
                 const glm::vec3 mid = glm::clamp(x - 0.5f * scale * v0, glm::vec3(0.0f), hi);
                 const glm::vec3 back = glm::clamp(x - scale * vel(mid), glm::vec3(0.0f), hi);
-                m_density[c] = std::clamp(sample(fd, back, interp), 0.0f, 1.0f);
-                m_temperature[c] = std::max(0.0f, sample(ft, back, interp));
+                float dt2[2];
+                if (interp == SmokeInterp::Linear) {
+                    sampleLinearN<2>(fd, {fd.data, ft.data}, back, dt2);   // the same cells: one index computation
+                } else {
+                    dt2[0] = sampleCubic(fd, back);
+                    dt2[1] = sampleCubic(ft, back);
+                }
+                m_density[c] = std::clamp(dt2[0], 0.0f, 1.0f);
+                m_temperature[c] = std::max(0.0f, dt2[1]);
             }
     });
 }
