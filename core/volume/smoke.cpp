@@ -44,35 +44,49 @@ struct FieldView {
     float at(int i, int j, int k) const { return data[(size_t(i) * size_t(n.y) + size_t(j)) * size_t(n.z) + size_t(k)]; }
 };
 
-// Trilinear interpolation at pos (cell units), clamped to the field, of `count` fields that share the
-// view's geometry (f.data and the others): one index computation, eight loads each from one base index.
-template <int count>
-[[gnu::always_inline]] inline void sampleLinearN(const FieldView& f, const float* const (&data)[count], const glm::vec3& pos, float (&out)[count])
+// One axis of a trilinear sample: the lower sample index and the fraction, clamped to a field of n
+// samples whose first lies at `offset` (cell units).
+struct AxisSample {
+    int i;
+    float t;
+};
+
+[[gnu::always_inline]] inline AxisSample axisSample(float pos, float offset, int n)
 {
-    const float sx = std::clamp(pos.x - f.offset.x, 0.0f, float(f.n.x - 1));
-    const float sy = std::clamp(pos.y - f.offset.y, 0.0f, float(f.n.y - 1));
-    const float sz = std::clamp(pos.z - f.offset.z, 0.0f, float(f.n.z - 1));
-    const int i = std::min(int(sx), f.n.x - 2), j = std::min(int(sy), f.n.y - 2), k = std::min(int(sz), f.n.z - 2);
-    const float tx = sx - float(i), ty = sy - float(j), tz = sz - float(k);
-    const size_t dy = size_t(f.n.z), dx = size_t(f.n.y) * dy;
-    const size_t base = (size_t(i) * size_t(f.n.y) + size_t(j)) * dy + size_t(k);
-    for (int c = 0; c < count; ++c) {
-        const float* p = data[c] + base;
-        const float c00 = p[0] + tz * (p[1] - p[0]);
-        const float c01 = p[dy] + tz * (p[dy + 1] - p[dy]);
-        const float c10 = p[dx] + tz * (p[dx + 1] - p[dx]);
-        const float c11 = p[dx + dy] + tz * (p[dx + dy + 1] - p[dx + dy]);
-        const float c0 = c00 + ty * (c01 - c00), c1 = c10 + ty * (c11 - c10);
-        out[c] = c0 + tx * (c1 - c0);
-    }
+    const float s = std::clamp(pos - offset, 0.0f, float(n - 1));
+    const int i = std::min(int(s), n - 2);
+    return {i, s - float(i)};
 }
 
+// Trilinear interpolation of a field of dims samples (z fastest) at the axis samples x, y, z: eight
+// loads at offsets from one base index.
+[[gnu::always_inline]] inline float gatherLinear(const float* data, const glm::ivec3& dims, AxisSample x, AxisSample y, AxisSample z)
+{
+    const size_t dy = size_t(dims.z), dx = size_t(dims.y) * dy;
+    const float* p = data + (size_t(x.i) * size_t(dims.y) + size_t(y.i)) * dy + size_t(z.i);
+    const float c00 = p[0] + z.t * (p[1] - p[0]);
+    const float c01 = p[dy] + z.t * (p[dy + 1] - p[dy]);
+    const float c10 = p[dx] + z.t * (p[dx + 1] - p[dx]);
+    const float c11 = p[dx + dy] + z.t * (p[dx + dy + 1] - p[dx + dy]);
+    const float c0 = c00 + y.t * (c01 - c00), c1 = c10 + y.t * (c11 - c10);
+    return c0 + x.t * (c1 - c0);
+}
+
+// Trilinear interpolation at pos (cell units), clamped to the field.
 [[gnu::always_inline]] inline float sampleLinear(const FieldView& f, const glm::vec3& pos)
 {
-    const float* const data[1] = {f.data};
-    float out[1];
-    sampleLinearN<1>(f, data, pos, out);
-    return out[0];
+    return gatherLinear(f.data, f.n, axisSample(pos.x, f.offset.x, f.n.x), axisSample(pos.y, f.offset.y, f.n.y),
+                        axisSample(pos.z, f.offset.z, f.n.z));
+}
+
+// The face velocity (u, v, w on the MAC grid of n cells) at pos: each axis clamped once for the field
+// staggered along it and once for the two centred on it, the same values as three sampleLinear calls.
+[[gnu::always_inline]] inline glm::vec3 sampleVelocity(const float* u, const float* v, const float* w, const glm::ivec3& n, const glm::vec3& pos)
+{
+    const AxisSample sx = axisSample(pos.x, 0.0f, n.x + 1), sy = axisSample(pos.y, 0.0f, n.y + 1), sz = axisSample(pos.z, 0.0f, n.z + 1);
+    const AxisSample cx = axisSample(pos.x, 0.5f, n.x), cy = axisSample(pos.y, 0.5f, n.y), cz = axisSample(pos.z, 0.5f, n.z);
+    return glm::vec3(gatherLinear(u, {n.x + 1, n.y, n.z}, sx, cy, cz), gatherLinear(v, {n.x, n.y + 1, n.z}, cx, sy, cz),
+                     gatherLinear(w, {n.x, n.y, n.z + 1}, cx, cy, sz));
 }
 
 // Monotonic cubic Hermite through f1 (t = 0) and f2 (t = 1), Fedkiw et al. 2001 eq. (8)-(9): the
@@ -668,9 +682,6 @@ void SmokeSim::advectScalars(float dt)
     const Dims d{m_s.cells};
     const glm::ivec3 n = d.n;
     const float scale = dt / m_s.cellSize;
-    const FieldView fu{m_u.data(), {n.x + 1, n.y, n.z}, {0.0f, 0.5f, 0.5f}};
-    const FieldView fv{m_v.data(), {n.x, n.y + 1, n.z}, {0.5f, 0.0f, 0.5f}};
-    const FieldView fw{m_w.data(), {n.x, n.y, n.z + 1}, {0.5f, 0.5f, 0.0f}};
     m_oldDensity = m_density;   // copies into the kept buffers (no new pages)
     m_oldTemperature = m_temperature;
     const std::vector<float>& oldD = m_oldDensity;
@@ -688,14 +699,17 @@ void SmokeSim::advectScalars(float dt)
                     continue;
                 }
                 const glm::vec3 x = glm::vec3(i, j, k) + 0.5f;
-                auto vel = [&](const glm::vec3& q) { return glm::vec3(sampleLinear(fu, q), sampleLinear(fv, q), sampleLinear(fw, q)); };
+                auto vel = [&](const glm::vec3& q) { return sampleVelocity(m_u.data(), m_v.data(), m_w.data(), n, q); };
                 const glm::vec3 v0(0.5f * (m_u[d.uIdx(i, j, k)] + m_u[d.uIdx(i + 1, j, k)]), 0.5f * (m_v[d.vIdx(i, j, k)] + m_v[d.vIdx(i, j + 1, k)]),
                                    0.5f * (m_w[d.wIdx(i, j, k)] + m_w[d.wIdx(i, j, k + 1)]));
                 const glm::vec3 mid = glm::clamp(x - 0.5f * scale * v0, glm::vec3(0.0f), hi);
                 const glm::vec3 back = glm::clamp(x - scale * vel(mid), glm::vec3(0.0f), hi);
                 float dt2[2];
                 if (interp == SmokeInterp::Linear) {
-                    sampleLinearN<2>(fd, {fd.data, ft.data}, back, dt2);   // the same cells: one index computation
+                    // The same cells: one index computation for both.
+                    const AxisSample ax = axisSample(back.x, 0.5f, n.x), ay = axisSample(back.y, 0.5f, n.y), az = axisSample(back.z, 0.5f, n.z);
+                    dt2[0] = gatherLinear(fd.data, n, ax, ay, az);
+                    dt2[1] = gatherLinear(ft.data, n, ax, ay, az);
                 } else {
                     dt2[0] = sampleCubic(fd, back);
                     dt2[1] = sampleCubic(ft, back);
@@ -825,7 +839,7 @@ void SmokeSim::step(Progress* progress)
         const FieldView fw{w1.data(), {n.x, n.y, n.z + 1}, {0.5f, 0.5f, 0.0f}};
         const glm::vec3 hi = glm::vec3(n);
         const SmokeInterp interp = m_s.interp;
-        auto vel = [&](const glm::vec3& q) { return glm::vec3(sampleLinear(fu, q), sampleLinear(fv, q), sampleLinear(fw, q)); };
+        auto vel = [&](const glm::vec3& q) { return sampleVelocity(u1.data(), v1.data(), w1.data(), n, q); };
         // RK2 from the velocity at the face itself (its own component and the 4-face averages of the
         // others: what trilinear sampling gives there, without the gathers).
         auto trace = [&](const glm::vec3& x, const glm::vec3& v0) {
