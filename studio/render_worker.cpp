@@ -83,6 +83,7 @@ void RenderWorker::request(const Scene& scene, std::vector<AssetsPtr> assets, QS
     m_request.compare = compare;
     m_request.relight = std::move(relight);
     ++m_request.serial;
+    m_latestRequest = m_request.serial;
     m_hasRequest = true;
     m_sinceRequest.start();
     m_restart = true;
@@ -189,7 +190,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
         if (changedParts(a, b) == ScenePart::None) {
             const QImage img = picture(m_lastFilm, scene, req.compare);
             m_lastScene = scene;
-            Q_EMIT imageReady(img, m_lastPass, true, elapsed());
+            Q_EMIT imageReady(img, m_lastPass, true, elapsed(), req.serial);
             return;
         }
     }
@@ -258,7 +259,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
         m_lastScene = scene;
         m_lastSize = req.size;
         m_lastPass = last ? int(passes.size()) - 1 : -1;
-        Q_EMIT imageReady(img, int(p), last, elapsed());
+        Q_EMIT imageReady(img, int(p), last, elapsed(), req.serial);
     }
     if (refine.frames == 0) return;
     placeViewFrame(*m_frame, scene, sun, w, h, refine.samples);
@@ -278,7 +279,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
         m_lastScene = scene;
         m_lastSize = req.size;
         m_lastPass = last ? int(passes.size()) - 1 : -1;
-        Q_EMIT imageReady(img, int(passes.size()) + f, last, elapsed());
+        Q_EMIT imageReady(img, int(passes.size()) + f, last, elapsed(), req.serial);
     }
 }
 

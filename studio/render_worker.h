@@ -95,12 +95,15 @@ public:
     // How often the frame's camera-independent part was built whole (buildViewFrame), and how often an
     // edit was taken in by updating it in place (viewFrameUpdate: a landscape density, tile or tiling edit,
     // a volume edit) instead: what the studio's tests read to see that an edit rebuilt only its part.
+    // The serial of the newest request (request() counts them from 1).
+    quint64 latestRequest() const { return m_latestRequest.load(); }
     int frameBuilds() const { return m_frameBuilds.load(); }
     int frameUpdates() const { return m_frameUpdates.load(); }
 
 Q_SIGNALS:
-    // pass: index into the schedule; last: the schedule is done; seconds: since the request.
-    void imageReady(const QImage& image, int pass, bool last, double seconds);
+    // pass: index into the schedule; last: the schedule is done; seconds: since the request; serial: the
+    // request the image is for (latestRequest() says whether a newer one was made since).
+    void imageReady(const QImage& image, int pass, bool last, double seconds, quint64 serial);
     void failed(const QString& message);
     // GPU mode: the frame for the requested assets is on the device.
     void gpuFrameReady(const sylva::GpuFramePtr& frame);
@@ -136,6 +139,7 @@ private:
     Relighting m_frameRelight;            // the relighting m_frame's lighting array holds (inactive: the assets')
     SkyDesc m_frameSky;                   // the sky m_frame was built with
     std::atomic<int> m_relitFrames{0};
+    std::atomic<quint64> m_latestRequest{0};
     std::atomic<bool> m_shieldPass{false};   // the pass in progress is not restarted by a new request
     Scene m_frameScene;                   // the scene m_frame's camera-independent part holds
     std::atomic<int> m_frameBuilds{0}, m_frameUpdates{0};

@@ -120,8 +120,11 @@ void Viewport::requestRender()
     m_worker->request(m_scene, m_assets, renderSize(), m_compare, m_relight);
 }
 
-void Viewport::onImage(const QImage& image, int pass, bool last, double seconds)
+void Viewport::onImage(const QImage& image, int pass, bool last, double seconds, quint64 serial)
 {
+    // An image queued before a newer request (an edit while its signal waited in the event loop) is
+    // shown, so a drag still moves the picture, but it is not the current scene's final image.
+    if (serial != m_worker->latestRequest()) last = false;
     m_image = image;
     m_imageDirty = true;
     m_lastPass = pass;

@@ -87,7 +87,7 @@ protected:
 private:
     void cleanupGL();
     void requestRender();
-    void onImage(const QImage& image, int pass, bool last, double seconds);
+    void onImage(const QImage& image, int pass, bool last, double seconds, quint64 serial);
     void setupGpu();
     bool paintGpu();   // false: no GPU frame to show yet
     void disableGpu(const QString& why);
