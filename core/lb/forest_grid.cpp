@@ -42,6 +42,13 @@ namespace {
 // light its neighbours scatter onto it.
 constexpr float kMaxFaceFactor = 4.0f;
 
+// Face factors need the crown to span this many forest-grid cells across (its larger horizontal
+// extent): on coarser lattices a crown is one or two nodes, its faces' ratios are the lattice's, not the
+// stand's, and blending them in made the stand's picture worse than no forest grid at all (`sylva study
+// scene`: image error 0.25-0.34 at 1-1.3 cells a crown against 0.18 without the grid); such plants keep
+// their centre factor on every face.
+constexpr double kMinFaceCells = 3.0;
+
 struct Box {
     glm::dvec3 lo, hi;
     double rhoPerOverlap;   // coarse density per m^3 of overlap with a node's cell
@@ -174,13 +181,44 @@ std::array<glm::vec3, kFaces> sampleFaces(const GridGeometry& g, const std::vect
     return out;
 }
 
-DensityGrid densityOn(const GridGeometry& g, const std::vector<float>& rho)
+// The lattice's density from the splatted optical depth per coarse step x (in density units: the mean
+// fine density x the fine steps a coarse step crosses, summed over plants): the density whose one-step
+// extinction equals the Beer-Lambert transmittance exp(-sigma_t x) of that depth, rho = (1 - exp(-sigma_t
+// x)) / sigma_t, at most 1 (sigma_t: the largest channel's, so rho sigma_t <= 1 in every channel). It is
+// the continuum limit of the fine steps' (1 - rho sigma_t)^m and lets more light through than that
+// product of the mean density would, as clumped foliage does. A plain rho = x takes out x sigma_t per
+// step: the stands' interiors came out about 1.4x too dark against per-instance solves (`sylva study
+// scene`, docs/ACCURACY.md "Scene scale"); this mapping matched them to 0.01 on average.
+DensityGrid densityOn(const GridGeometry& g, const std::vector<float>& depth, double sigmaT)
 {
     DensityGrid d;
     d.geometry = g;
-    d.density = rho;
-    for (float& v : d.density) v = std::min(v, 1.0f);
+    d.density = depth;
+    for (float& v : d.density)
+        v = sigmaT > 0.0 ? float(std::min(1.0, -std::expm1(-sigmaT * double(v)) / sigmaT)) : std::min(v, 1.0f);
     return d;
+}
+
+double largestExtinction(const LbParams& p)
+{
+    double s = 0.0;
+    for (const ChannelParams& c : p.channels) s = std::max(s, double(c.sigmaA) + double(c.sigmaS));
+    return s;
+}
+
+// kAutoCellsPerCrown nodes across the median crown (its larger horizontal extent), within [4,
+// kAutoMaxResolution].
+int autoResolution(const std::vector<ForestPlant>& plants, const std::vector<ForestSpecies>& species, const glm::dvec3& extent)
+{
+    std::vector<double> crowns;
+    for (const ForestPlant& p : plants) {
+        const ForestSpecies& s = species[size_t(p.species)];
+        if (s.biomass > 0.0) crowns.push_back(double(p.scale) * std::max(s.boxMax.x - s.boxMin.x, s.boxMax.z - s.boxMin.z));
+    }
+    std::nth_element(crowns.begin(), crowns.begin() + std::ptrdiff_t(crowns.size() / 2), crowns.end());
+    const double crown = crowns[crowns.size() / 2];
+    const double want = crown > 0.0 ? std::max(extent.x, extent.z) * kAutoCellsPerCrown / crown + 2.0 : 4.0;
+    return int(std::clamp(std::ceil(want), 4.0, double(kAutoMaxResolution)));
 }
 
 } // namespace
@@ -189,8 +227,8 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
                                  const LbParams& params, const ForestGridSettings& settings)
 {
     const auto t0 = std::chrono::steady_clock::now();
-    if (settings.resolution < 4 || settings.resolution > 512)
-        throw Error("forest grid: resolution " + std::to_string(settings.resolution) + " is outside [4, 512]");
+    if (settings.resolution != kAutoResolution && (settings.resolution < 4 || settings.resolution > 512))
+        throw Error("forest grid: resolution " + std::to_string(settings.resolution) + " is outside [4, 512] (0: automatic)");
     ForestGridResult r;
     r.factors.assign(plants.size(), glm::vec3(1.0f));
     glm::dvec3 lo(1e300), hi(-1e300);
@@ -207,7 +245,8 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
         return r;
     }
     const glm::dvec3 extent = hi - lo;
-    const double h = std::max({extent.x, extent.z, 1e-6}) / double(settings.resolution - 2);
+    r.resolution = settings.resolution != kAutoResolution ? settings.resolution : autoResolution(plants, species, extent);
+    const double h = std::max({extent.x, extent.z, 1e-6}) / double(r.resolution - 2);
     GridGeometry g;
     g.spacing = h;
     g.dims = glm::max(glm::ivec3(glm::ceil(extent / h)) + 3, glm::ivec3(3));
@@ -226,7 +265,9 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
     p.steps = 2 * g.longestEdge();
     p.stepsPerEdge = 2;
     r.steps = p.steps;
-    const DensityGrid forest = densityOn(g, r.density);
+    const double sigmaT = largestExtinction(p);
+    const DensityGrid forest = densityOn(g, r.density, sigmaT);
+    r.density = forest.density;
     std::vector<float> forestFaces;
     r.lighting = g.nodeCount() <= kSmallNodes ? solveSmall(g, forest.density, p, p.steps, &forestFaces) : solveLighting(forest, p);
     r.faceFactors.assign(plants.size(), std::array<glm::vec3, kFaces>{});
@@ -257,8 +298,9 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
         LbParams pa = p;
         pa.steps = std::min(p.steps, 4 * lg.longestEdge());
         // Small windows (most, at forest resolutions) through the scalar loop, large ones through the solver.
-        const DensityGrid ld = densityOn(lg, rho);
-        const bool directions = !forestFaces.empty() && lg.nodeCount() <= kSmallNodes;
+        const DensityGrid ld = densityOn(lg, rho, sigmaT);
+        const bool directions = !forestFaces.empty() && lg.nodeCount() <= kSmallNodes &&
+                                std::max(b.hi.x - b.lo.x, b.hi.z - b.lo.z) >= kMinFaceCells * h;
         std::vector<float> aloneFaces;
         const LightingGrid alone = lg.nodeCount() <= 4096 || directions ? solveSmall(lg, ld.density, pa, pa.steps, directions ? &aloneFaces : nullptr)
                                                                          : solveLighting(ld, pa);
@@ -299,8 +341,8 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
 std::string forestGridSummary(const ForestGridResult& r)
 {
     char line[256];
-    std::snprintf(line, sizeof line, "forest grid %dx%dx%d (%.3g m), %d steps, %.3f s: factors %.3f / %.3f / %.3f (min / median / max), "
-                  "per face %.3f-%.3f%s", r.geometry.dims.x, r.geometry.dims.y, r.geometry.dims.z, r.geometry.spacing, r.steps, r.seconds,
+    std::snprintf(line, sizeof line, "forest grid %d: %dx%dx%d (%.3g m), %d steps, %.3f s: factors %.3f / %.3f / %.3f (min / median / max), "
+                  "per face %.3f-%.3f%s", r.resolution, r.geometry.dims.x, r.geometry.dims.y, r.geometry.dims.z, r.geometry.spacing, r.steps, r.seconds,
                   r.minFactor, r.medianFactor, r.maxFactor, r.minFaceFactor, r.maxFaceFactor, r.uniform ? " (exposure uniform)" : "");
     return line;
 }

@@ -6,9 +6,10 @@
 // Density: each instance spreads its species' biomass B (sum of the species grid's densities x its
 // cell volume, x scale^3) evenly over its crown box (the species grid's occupied bounds, scaled and
 // moved); a coarse node gets the overlap of that box with its cell, as mean density over the cell x
-// (coarse spacing / the species grid's spacing): a coarse step crosses that many fine cells, so the
-// extinction per step matches the fine grid's on average (capped at 1). Continuous in the instance's
-// position and scale.
+// (coarse spacing / the species grid's spacing): a coarse step crosses that many fine cells. That optical
+// depth x (summed over plants) becomes the node's density rho = (1 - exp(-sigma_t x)) / sigma_t, so one
+// coarse step lets through the Beer-Lambert transmittance of the depth (at most 1; sigma_t the largest
+// channel's; ForestGridResult::density holds rho). Continuous in the instance's position and scale.
 // Factor: the forest grid's light at the instance's crown centre divided by the light there on the same
 // lattice with that instance alone (its own shading is already in its species grid): exactly 1 for an
 // isolated plant, < 1 where other plants shade it (> 1 where they scatter more light in than they take).
@@ -44,14 +45,24 @@ struct ForestPlant {
     int species = 0;
 };
 
+// ForestGridSettings::resolution 0: kAutoCellsPerCrown nodes across the median crown, at most
+// kAutoMaxResolution along the extent. `sylva study scene` (docs/ACCURACY.md "Scene scale"): on its stand the
+// grid improves the picture over none from about 4 cells a crown (face factors need 3, see forest_grid.cpp);
+// the cap keeps the default forest (8 m crowns over 220 m: 1.0 cells a crown) under 1 s on 2 cores
+// (bench_forest_grid: 0.85 s at 32, 1.5-1.6 s at 48 on a slow day).
+inline constexpr int kAutoResolution = 0;
+inline constexpr double kAutoCellsPerCrown = 4.0;
+inline constexpr int kAutoMaxResolution = 32;
+
 struct ForestGridSettings {
-    int resolution = 32;            // nodes along the longest horizontal extent (>= 4)
+    int resolution = kAutoResolution;   // nodes along the longest horizontal extent (4 .. 512), or kAutoResolution
     float uniformSpread = 0.02f;    // auto: factors within this (max - min) / max count as uniform exposure
 };
 
 struct ForestGridResult {
+    int resolution = 0;             // nodes along the longest horizontal extent as used (automatic: as chosen)
     GridGeometry geometry;
-    std::vector<float> density;     // coarse node density, z fastest
+    std::vector<float> density;     // coarse node density as solved (rho above), z fastest
     LightingGrid lighting;          // the forest grid's solve (unit intensity boundary)
     std::vector<glm::vec3> factors; // per plant, per channel
     // Per plant and face (kFaceNormals), per channel: the irradiance on a surface facing that way in the

@@ -284,6 +284,7 @@ void buildForestGrid(RenderScene& rs, const Scene& scene, const std::vector<Spec
     settings.resolution = scene.lighting.forestGridResolution;
     const lb::ForestGridResult r = lb::solveForestGrid(plants, species, p, settings);
     st.solved = true;
+    st.resolution = r.resolution;
     st.dims = r.geometry.dims;
     st.spacing = r.geometry.spacing;
     st.seconds = r.seconds;

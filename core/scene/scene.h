@@ -158,7 +158,8 @@ enum class ForestGridMode { Off, Auto, On };
 struct LightingDesc {
     DirectLight direct = DirectLight::Seed;
     ForestGridMode forestGrid = ForestGridMode::Off;
-    int forestGridResolution = 16;       // forest grid nodes along the plants' longest horizontal extent
+    int forestGridResolution = 0;        // forest grid nodes along the plants' longest horizontal extent; 0 =
+                                         // automatic (4 across the median crown, at most 32: lb::kAutoResolution)
     bool operator==(const LightingDesc&) const = default;   // the scene file writes the block only when it differs
 };
 

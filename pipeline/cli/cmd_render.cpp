@@ -60,6 +60,11 @@ Scene sceneForArgs(const Args& args, std::string* stem)
     }
     if (args.has("--forest-grid") && !parseForestGridMode(args.get("--forest-grid"), &scene.lighting.forestGrid))
         throw UsageError("option --forest-grid: expected off, auto or on, got '" + args.get("--forest-grid") + "'");
+    if (args.has("--forest-grid-resolution")) {
+        const long long n = parseInteger("--forest-grid-resolution", args.get("--forest-grid-resolution"), 0, 512);
+        if (n > 0 && n < 4) throw UsageError("option --forest-grid-resolution: expected 0 (automatic) or 4 .. 512, got " + std::to_string(n));
+        scene.lighting.forestGridResolution = int(n);
+    }
     if (args.has("--sun") && args.has("--sun-at")) throw UsageError("give either --sun or --sun-at, not both");
     if (args.has("--sun")) {
         if (args.get("--sun").find(',') == std::string::npos) throw UsageError("option --sun: expected X,Y,Z");
@@ -263,6 +268,8 @@ Command renderCommand()
              kSunAt,
              {"--forest-grid", "off|auto|on", "the forest-level LB grid (default: the scene's lighting.forest_grid; auto: only where "
                                               "exposure differs)"},
+             {"--forest-grid-resolution", "N", "forest grid nodes along the plants' longest horizontal extent, 4 .. 512, or 0: "
+                                               "automatic, 4 across the median crown, at most 32 (default: the scene's)"},
              {"--alpha-distance", "M", "skip leaf cut-out tests beyond M metres from the camera (0: off, default)"},
              {"--prune-distance", "M", "prune leaves of plants beyond M metres, area-preserving (0: off, default)"},
              {"--volume-tracer", "lb|single|combined", "every volume's tracer, replacing its scene's `tracer` (default lb, the "

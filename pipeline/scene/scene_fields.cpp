@@ -644,11 +644,15 @@ const Table<LightingDesc>& sceneLightingTable()
                  "(each instance's species lighting scaled by the grid's factors: stand interiors darker, the open side of an "
                  "edge tree lit), `auto` (as `on` where the factors spread by 2% or more, else skipped; `render --stats` says which)")
             .summarized([](const LightingDesc& l) { return std::string("forest grid ") + forestGridModeName(l.forestGrid); });
-        b.integer("forest_grid_resolution", &LightingDesc::forestGridResolution, 4, 512)
-            .doc("integer", "forest grid nodes along the plants' longest horizontal extent, 4 .. 512; build + solve time in "
-                                "[PERFORMANCE.md](PERFORMANCE.md)")
+        b.integer("forest_grid_resolution", &LightingDesc::forestGridResolution, 0, 512)
+            .doc("integer", "forest grid nodes along the plants' longest horizontal extent, 4 .. 512, or 0 (the default): "
+                                "automatic, 4 nodes across the median crown and at most 32 (the picture improves over no forest "
+                                "grid from about 4 cells a crown: [ACCURACY.md](ACCURACY.md) \"Scene scale\"); build + solve "
+                                "time in [PERFORMANCE.md](PERFORMANCE.md)")
             .summarized([](const LightingDesc& l) {
-                return l.forestGrid == ForestGridMode::Off ? std::string() : "forest grid resolution " + std::to_string(l.forestGridResolution);
+                if (l.forestGrid == ForestGridMode::Off) return std::string();
+                return l.forestGridResolution == 0 ? std::string("forest grid resolution automatic")
+                                                   : "forest grid resolution " + std::to_string(l.forestGridResolution);
             });
         return b.table;
     }();

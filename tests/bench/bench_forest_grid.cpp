@@ -43,7 +43,17 @@ int main(int argc, char** argv)
     p.sun = scene.sun.direction;
     std::printf("forest grid on the default forest: %zu instances, %zu species (%zu group placements left out)\n", plants.size(),
                 species.size(), grouped);
-    for (int res : {16, 32, 64}) {
+    // Crown width in forest-grid cells: the study's stand (docs/ACCURACY.md "Scene scale") needs about 3 for the
+    // forest grid to beat none.
+    std::vector<double> crowns;
+    for (const lb::ForestPlant& pl : plants) {
+        const lb::ForestSpecies& sp = species[size_t(pl.species)];
+        crowns.push_back(double(pl.scale) * std::max(sp.boxMax.x - sp.boxMin.x, sp.boxMax.z - sp.boxMin.z));
+    }
+    std::sort(crowns.begin(), crowns.end());
+    const double crown = crowns.empty() ? 0.0 : crowns[crowns.size() / 2];
+    std::printf("median crown width %.2f m\n", crown);
+    for (int res : {lb::kAutoResolution, 16, 32, 48, 64}) {
         std::vector<double> t, cpu;
         lb::ForestGridResult r;
         for (int k = 0; k < reps; ++k) {
@@ -55,11 +65,13 @@ int main(int argc, char** argv)
         std::sort(t.begin(), t.end());
         std::sort(cpu.begin(), cpu.end());
         // CPU time (all threads) as well: on the shared VM the wall clock stretches with the load.
-        std::printf("  resolution %2d: %s (median %.3f s wall, %.3f s CPU)\n", res, lb::forestGridSummary(r).c_str(), t[t.size() / 2],
-                    cpu[cpu.size() / 2]);
-        std::printf("forest_grid_%d_cpu_s=%.4f\n", res, cpu[cpu.size() / 2]);
-        std::printf("forest_grid_%d_s=%.4f\nforest_grid_%d_min_factor=%.4f\nforest_grid_%d_max_factor=%.4f\n", res, t[t.size() / 2], res,
-                    double(r.minFactor), res, double(r.maxFactor));
+        const std::string key = res == lb::kAutoResolution ? std::string("auto") : std::to_string(res);
+        std::printf("  resolution %s: %s (median %.3f s wall, %.3f s CPU; %.1f cells a median crown)\n", key.c_str(),
+                    lb::forestGridSummary(r).c_str(), t[t.size() / 2], cpu[cpu.size() / 2], crown / r.geometry.spacing);
+        std::printf("forest_grid_%s_resolution=%d\n", key.c_str(), r.resolution);
+        std::printf("forest_grid_%s_cpu_s=%.4f\n", key.c_str(), cpu[cpu.size() / 2]);
+        std::printf("forest_grid_%s_s=%.4f\nforest_grid_%s_min_factor=%.4f\nforest_grid_%s_max_factor=%.4f\n", key.c_str(), t[t.size() / 2], key.c_str(),
+                    double(r.minFactor), key.c_str(), double(r.maxFactor));
     }
     return 0;
 }

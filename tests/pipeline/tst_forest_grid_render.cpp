@@ -1,5 +1,7 @@
-// The forest-level LB grid in the picture (issue 18 item 1): a square stand of shrubs rendered from above
-// with lighting.forest_grid on, auto and off. The species has no LB grid of its own (its indirect light is
+// The forest-level LB grid in the picture (issue 18 item 1): a square stand of shrubs under a low sun, seen
+// from the sun's side (the sunward faces: the front row open to the sun, the rows behind it in its shade; from
+// above, the crowns' tops are lit alike in a stand and the face factors keep them so), with
+// lighting.forest_grid on, auto and off. The species has no LB grid of its own (its indirect light is
 // the open-sky value 1), so each pixel's indirect light is albedo x the forest factor x the sun: the
 // oracle per instance is its pixels traced once more with the grid off. Interior instances must come out
 // darker than edge instances with the grid on, and every instance of the species alike with it off.
@@ -48,10 +50,10 @@ Scene stand(const lb::ForestSpecies& f, double gap)
             s.instances.push_back(d);
         }
     const double h = f.boxMax.y;
-    s.camera.position = {0.0, h + 3.2 * step * kSide, -0.35 * step * kSide};
+    s.camera.position = {0.0, h + 1.1 * step * kSide, -1.5 * step * kSide};
     s.camera.target = {0.0, 0.0, 0.0};
     s.camera.fovY = 30.0f;
-    s.sun.direction = {0.3f, 1.0f, 0.2f};
+    s.sun.direction = {0.2f, 0.45f, -1.0f};
     s.render.width = 96;
     s.render.height = 96;
     s.render.spp = 1;
