@@ -13,6 +13,7 @@ bool parsePart(const std::string& name, Part* out)
     if (name == "lb") *out = Part::Lb;
     else if (name == "voxel") *out = Part::Voxel;
     else if (name == "render") *out = Part::Render;
+    else if (name == "scene") *out = Part::Scene;
     else if (name == "truth") *out = Part::Truth;
     else return false;
     return true;
@@ -26,12 +27,13 @@ Result run(const Options& options)
     std::filesystem::create_directories(dir + "/accuracy", ec);
     if (ec) throw Error(dir + "/accuracy: cannot create the folder: " + ec.message());
     const std::string lbPath = dir + "/accuracy/lb.json", voxelPath = dir + "/accuracy/voxel.json",
-                      renderPath = dir + "/accuracy/render.json";
+                      renderPath = dir + "/accuracy/render.json", scenePath = dir + "/accuracy/scene.json";
     auto wants = [&](Part p) { return std::find(options.parts.begin(), options.parts.end(), p) != options.parts.end(); };
 
     LbData lb;
     VoxelData voxel;
     RenderData render;
+    SceneData scene;
     ReportInput input;
     if (wants(Part::Lb)) {
         lb = measureLb(options);
@@ -54,6 +56,13 @@ Result run(const Options& options)
         input.render = &render;
     } else if (loadRender(renderPath, &render)) {
         input.render = &render;
+    }
+    if (wants(Part::Scene)) {
+        scene = measureScene(options);
+        saveScene(scenePath, scene);
+        input.scene = &scene;
+    } else if (loadScene(scenePath, &scene)) {
+        input.scene = &scene;
     }
     if (wants(Part::Truth)) measureTruth(options);   // writes accuracy/truth.md, which the report includes
     Result result;

@@ -314,6 +314,111 @@ bool loadRender(const std::string& path, RenderData* d)
     return true;
 }
 
+void saveScene(const std::string& path, const SceneData& d)
+{
+    QJsonObject root;
+    root["run"] = runToJson(d.run);
+    root["stand_scene"] = qs(d.standScene);
+    root["width"] = d.width;
+    root["height"] = d.height;
+    root["spp"] = d.spp;
+    root["species_grid"] = d.speciesGrid;
+    root["crown_width"] = d.crownWidth;
+    root["species_dims"] = qs(d.speciesDims);
+    root["reference_dims"] = qs(d.referenceDims);
+    root["reference_seconds"] = d.referenceSeconds;
+    root["floor_err"] = d.floorErr;
+    root["isolated_factor"] = d.isolatedFactor;
+    root["oracle_err"] = d.oracleErr;
+    root["reference_interior"] = d.referenceInterior;
+    root["reference_edge"] = d.referenceEdge;
+    root["forest"] = array(d.forest, [](const ForestGridRow& r) {
+        QJsonObject x;
+        x["resolution"] = r.resolution;
+        x["automatic"] = r.automatic;
+        x["dims"] = qs(r.dims);
+        x["cells_per_crown"] = r.cellsPerCrown;
+        x["seconds"] = r.seconds;
+        x["image_err"] = r.imageErr;
+        x["factor_rms"] = r.factorRms;
+        x["factor_max"] = r.factorMax;
+        x["interior"] = r.interior;
+        x["edge"] = r.edge;
+        x["default"] = r.isDefault;
+        return x;
+    });
+    root["suns"] = d.suns;
+    root["basis"] = array(d.basis, [](const BasisRow& r) {
+        QJsonObject x;
+        x["fp16"] = r.fp16;
+        x["directions"] = r.directions;
+        x["basis_seconds"] = r.basisSeconds;
+        x["basis_cpu"] = r.basisCpu;
+        x["direct_seconds"] = r.directSeconds;
+        x["direct_cpu"] = r.directCpu;
+        x["relight_ms"] = r.relightMs;
+        x["megabytes"] = r.megabytes;
+        x["err_median"] = r.errMedian;
+        x["err_max"] = r.errMax;
+        x["default"] = r.isDefault;
+        return x;
+    });
+    save(path, root);
+}
+
+bool loadScene(const std::string& path, SceneData* d)
+{
+    QJsonObject root;
+    if (!load(path, &root)) return false;
+    d->run = runFromJson(root.value("run").toObject());
+    d->standScene = str(root, "stand_scene");
+    d->width = integer(root, "width");
+    d->height = integer(root, "height");
+    d->spp = integer(root, "spp");
+    d->speciesGrid = integer(root, "species_grid");
+    d->crownWidth = num(root, "crown_width");
+    d->speciesDims = str(root, "species_dims");
+    d->referenceDims = str(root, "reference_dims");
+    d->referenceSeconds = num(root, "reference_seconds");
+    d->floorErr = num(root, "floor_err");
+    d->isolatedFactor = num(root, "isolated_factor");
+    d->oracleErr = num(root, "oracle_err");
+    d->referenceInterior = num(root, "reference_interior");
+    d->referenceEdge = num(root, "reference_edge");
+    d->forest = list<ForestGridRow>(root.value("forest"), [](const QJsonObject& x) {
+        ForestGridRow r;
+        r.resolution = integer(x, "resolution");
+        r.automatic = flag(x, "automatic");
+        r.dims = str(x, "dims");
+        r.cellsPerCrown = num(x, "cells_per_crown");
+        r.seconds = num(x, "seconds");
+        r.imageErr = num(x, "image_err");
+        r.factorRms = num(x, "factor_rms");
+        r.factorMax = num(x, "factor_max");
+        r.interior = num(x, "interior");
+        r.edge = num(x, "edge");
+        r.isDefault = flag(x, "default");
+        return r;
+    });
+    d->suns = integer(root, "suns");
+    d->basis = list<BasisRow>(root.value("basis"), [](const QJsonObject& x) {
+        BasisRow r;
+        r.fp16 = flag(x, "fp16");
+        r.directions = integer(x, "directions");
+        r.basisSeconds = num(x, "basis_seconds");
+        r.basisCpu = num(x, "basis_cpu");
+        r.directSeconds = num(x, "direct_seconds");
+        r.directCpu = num(x, "direct_cpu");
+        r.relightMs = num(x, "relight_ms");
+        r.megabytes = num(x, "megabytes");
+        r.errMedian = num(x, "err_median");
+        r.errMax = num(x, "err_max");
+        r.isDefault = flag(x, "default");
+        return r;
+    });
+    return true;
+}
+
 std::vector<size_t> paretoFront(const std::vector<double>& time, const std::vector<double>& error)
 {
     std::vector<size_t> idx(time.size());

@@ -125,7 +125,54 @@ struct RenderData {
     std::vector<PresetRow> presets;
 };
 
-// JSON files: accuracy/lb.json, accuracy/voxel.json, accuracy/render.json. save* write atomically and
+// ---- Scene scale: the forest-level grid and the relighting basis (issue 18 item 5) ----
+
+// One forest-grid setting on the stand, against the per-instance reference.
+struct ForestGridRow {
+    int resolution = 0;                 // as used; 0: the forest grid off (every instance lit by its species grid alone)
+    bool automatic = false;             // the automatic resolution (lighting.forest_grid_resolution 0)
+    std::string dims;                   // the forest grid's nodes "XxYxZ" ("-" when off)
+    double cellsPerCrown = 0.0;         // the crown's width over the forest grid's spacing
+    double seconds = 0.0;               // the forest grid's build + solve, wall clock (best of the repeats)
+    double imageErr = 0.0;              // relative L2 of the LB pass's luminance against the reference render
+    double factorRms = 0.0, factorMax = 0.0;   // per instance: |applied factor - the reference's factor| (green)
+    double interior = 1.0, edge = 1.0;  // mean green factor of the stand's interior / edge instances
+    bool isDefault = false;             // the scene default's resolution setting (lighting.forest_grid_resolution)
+};
+
+// One basis storage: building it, relighting from it, and its error against direct solves.
+struct BasisRow {
+    bool fp16 = false;
+    int directions = 0;                 // basis solves (lattice directions)
+    double basisSeconds = 0.0, basisCpu = 0.0;   // solving every basis grid
+    double directSeconds = 0.0, directCpu = 0.0; // one direct RGB solve, median over the suns
+    double relightMs = 0.0;             // composing one sun's lighting from the basis, median over the suns
+    double megabytes = 0.0;             // the basis held as fp32 grids
+    double errMedian = 0.0, errMax = 0.0;   // relative L2 of the relit grid against the direct solve, over the suns
+    bool isDefault = false;             // the species default's storage
+};
+
+struct SceneData {
+    RunInfo run;
+    std::string standScene;             // one line: the stand
+    int width = 0, height = 0, spp = 0;
+    int speciesGrid = 0;                // the species grid's nodes on its longest edge
+    double crownWidth = 0.0;            // the crown box's larger horizontal extent, metres
+    std::string speciesDims;
+    std::string referenceDims;          // the reference's LB grid over the whole stand
+    double referenceSeconds = 0.0;      // its solve (0 when it came from the cache)
+    double floorErr = 0.0;              // the lone tree solved alone in the reference's domain vs its species grid
+                                        // (relative L2 over its crown): what the larger domain changes
+    double isolatedFactor = 1.0;        // the lone tree's reference factor (green): light its neighbours scatter onto it
+    double oracleErr = 0.0;             // image error with each instance scaled by its reference factor: the best a
+                                        // factor per instance can do
+    double referenceInterior = 1.0, referenceEdge = 1.0;   // mean reference factor, interior / edge instances
+    std::vector<ForestGridRow> forest;
+    int suns = 0;                       // random suns the basis is checked with
+    std::vector<BasisRow> basis;
+};
+
+// JSON files: accuracy/lb.json, accuracy/voxel.json, accuracy/render.json, accuracy/scene.json. save* write atomically and
 // throw Error; load* return false when the file is missing and throw Error when it is unreadable.
 void saveLb(const std::string& path, const LbData& d);
 bool loadLb(const std::string& path, LbData* d);
@@ -133,6 +180,8 @@ void saveVoxel(const std::string& path, const VoxelData& d);
 bool loadVoxel(const std::string& path, VoxelData* d);
 void saveRender(const std::string& path, const RenderData& d);
 bool loadRender(const std::string& path, RenderData* d);
+void saveScene(const std::string& path, const SceneData& d);
+bool loadScene(const std::string& path, SceneData* d);
 
 // Indices of the points on the Pareto front of (time, error), both smaller-is-better, by ascending time.
 std::vector<size_t> paretoFront(const std::vector<double>& time, const std::vector<double>& error);

@@ -24,6 +24,9 @@ void markDefaults(LbData& data);
 LbData measureLb(const Options& options);
 VoxelData measureVoxel(const Options& options);
 RenderData measureRender(const Options& options);
+// The forest-level grid against per-instance solves on a stand, and the relighting basis against direct
+// solves (study_scene.cpp).
+SceneData measureScene(const Options& options);
 // Sylva against Cycles (study_truth.cpp): writes outDir/accuracy/truth.md, truth/*.png and truth_time.svg;
 // false (and a log line) when skipped: no `blender` (SYLVA_BLENDER overrides the program) or --quick.
 bool measureTruth(const Options& options);
@@ -33,6 +36,7 @@ struct ReportInput {
     const LbData* lb = nullptr;
     const VoxelData* voxel = nullptr;
     const RenderData* render = nullptr;
+    const SceneData* scene = nullptr;
 };
 
 // Writes outDir/ACCURACY.md and, with gnuplot, outDir/accuracy/*.png (result.plots, result.plotNote).
@@ -43,6 +47,16 @@ std::string treeMeshPath(const Options& options);
 
 // Value of a grid's channel c at a world position: trilinear between nodes, clamped to the grid.
 float sampleWorld(const LightingGrid& g, const glm::dvec3& world, int c);
+
+// Relative L2 of linear luminance, image a against reference b: sqrt(sum (L_a - L_b)^2 / sum L_b^2).
+double imageError(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b);
+
+// Pictures for the report (study_truth.cpp): the exposure of Reinhard's mapping for a reference picture (the
+// same for every picture compared with it, so they differ as their linear pictures do), the mapping with it
+// (sRGB-encoded), and an sRGB picture as PNG (throws Error).
+float exposureOf(const std::vector<glm::vec3>& reference);
+std::vector<glm::vec3> toneMap(const std::vector<glm::vec3>& linear, float scale);
+void writePng(const std::string& path, const std::vector<glm::vec3>& srgb, int w, int h);
 
 // Wall-clock seconds (steady clock) and the process's CPU seconds, all threads (user + system). The
 // machine is shared: CPU time is what a measurement costs whatever else runs; wall time is what a user

@@ -10,9 +10,7 @@
 #include "pipeline/study/study_parts.h"
 
 namespace sylva::study {
-namespace {
 
-// Relative L2 of linear luminance (the "full" picture with its sky), image a against reference b.
 double imageError(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b)
 {
     double diff = 0.0, norm = 0.0;
@@ -23,6 +21,8 @@ double imageError(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>&
     }
     return norm > 0.0 ? std::sqrt(diff / norm) : 0.0;
 }
+
+namespace {
 
 struct Traced {
     std::vector<glm::vec3> image;

@@ -481,6 +481,130 @@ std::string renderSections(const RenderData& d, Plotter& pl)
     return s.str();
 }
 
+// ---------------------------------------------------------------- scene scale
+
+std::string resolutionName(const ForestGridRow& r)
+{
+    if (r.resolution == 0) return "off";
+    return r.automatic ? "auto (" + std::to_string(r.resolution) + ")" : std::to_string(r.resolution);
+}
+
+std::string sceneSection(const SceneData& d, Plotter& pl)
+{
+    std::ostringstream s;
+    s << "## Scene scale: the forest-level grid and the relighting basis\n\n";
+    s << "### The forest-level grid against per-instance solves\n\n";
+    s << "The stand: " << d.standScene << ". **Reference**: every instance lit by its own LB grid, cut out of one LB solve over the "
+         "whole stand (" << d.referenceDims << " nodes at the species grid's spacing, every tree's density at its place, solved to a "
+         "relative change per step under 1e-4 in fp32" << (d.referenceSeconds > 0.0 ? ", " + secs(d.referenceSeconds) + " s" : std::string(", from the grid cache"))
+      << "): what a solve per instance with its neighbours around it gives. The trees stand at whole multiples of the grid spacing, "
+         "unrotated and unscaled, so each cut-out is the stand grid's own nodes. Each row renders the same stand with the one "
+         "species grid (" << d.speciesDims << ", solved to the same tolerance: its step count is the LB section's knob, not "
+         "this one's) and `lighting.forest_grid` off or on at a resolution "
+         "(nodes along the plants' longest horizontal extent); image error = relative L2 of the LB pass's luminance against the "
+         "reference render (the same rays, so only the lighting differs). Factor: per instance, the green channel's "
+         "density-weighted mean over the crown relative to the species grid's; the reference's is its cut-out's, a row's the "
+         "factor the forest grid applies at the crown centre (the face factors blend in on the crown's sides, in the picture "
+         "only). Time: the forest grid's build and solve, wall clock, the best of two.\n\n";
+    s << "The reference's factors: interior trees " << f("%.3f", d.referenceInterior) << ", edge trees " << f("%.3f", d.referenceEdge)
+      << ", the lone tree " << f("%.3f", d.isolatedFactor) << " (above 1: light the stand scatters onto it). The reference holds: "
+         "the lone tree solved alone in the reference's domain differs from its species grid by " << f("%.1e", d.floorErr)
+      << " (relative L2 over its crown). The best any factor per instance can do, each instance's species grid scaled by its "
+         "reference factor, leaves an image error of " << err(d.oracleErr) << ": the rest is the shading's variation inside a crown "
+         "(a tree's stand side darker than its open side), which the face factors only partly hold.\n\n";
+    s << "| reference (per-instance solves) | forest grid off | forest grid at the default resolution |\n| --- | --- | --- |\n"
+         "| ![reference](accuracy/scene_stand_reference.png) | ![off](accuracy/scene_stand_off.png) | "
+         "![default](accuracy/scene_stand_default.png) |\n\n";
+    s << "![forest grid resolution against image error](accuracy/scene_forest_grid.png)\n\n";
+    s << "| forest grid | nodes | cells a crown | build + solve (s) | image error | factor error, rms | factor error, max | factor interior | "
+         "factor edge | |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    std::vector<double> t, e;
+    for (const ForestGridRow& r : d.forest) {
+        t.push_back(r.seconds);
+        e.push_back(r.imageErr);
+    }
+    const std::vector<size_t> front = paretoFront(t, e);
+    const std::set<size_t> onFront(front.begin(), front.end());
+    const ForestGridRow* offRow = nullptr;
+    long defaultRow = -1;
+    std::string data, autoData;
+    for (size_t i = 0; i < d.forest.size(); ++i) {
+        const ForestGridRow& r = d.forest[i];
+        std::string mark = onFront.count(i) ? "front" : "";
+        if (r.isDefault) mark += mark.empty() ? "**default** resolution" : ", **default** resolution";
+        if (r.resolution == 0) mark += mark.empty() ? "**default** mode" : ", **default** mode";
+        s << "| " << resolutionName(r) << " | " << r.dims << " | " << (r.resolution > 0 ? f("%.1f", r.cellsPerCrown) : std::string("-")) << " | "
+          << (r.resolution > 0 ? secs(r.seconds) : std::string("-")) << " | " << err(r.imageErr) << " | " << f("%.3f", r.factorRms) << " | "
+          << f("%.3f", r.factorMax) << " | " << f("%.3f", r.interior) << " | " << f("%.3f", r.edge) << " | " << mark << " |\n";
+        if (r.resolution == 0) offRow = &r;
+        else (r.automatic ? autoData : data) += f("%.3f", r.cellsPerCrown) + " " + err(r.imageErr) + "\n";
+        if (r.isDefault) defaultRow = long(i);
+    }
+    s << "\nPareto front (build + solve time, image error): ";
+    for (size_t k = 0; k < front.size(); ++k) {
+        const ForestGridRow& r = d.forest[front[k]];
+        s << (k ? "; " : "") << resolutionName(r) << " (" << secs(r.seconds) << " s, " << err(r.imageErr) << ")";
+    }
+    s << ".\n";
+    if (defaultRow >= 0) {
+        const ForestGridRow& r = d.forest[size_t(defaultRow)];
+        const ForestGridRow* best = &r;
+        for (const ForestGridRow& x : d.forest)
+            if (x.resolution > 0 && x.imageErr < best->imageErr) best = &x;
+        s << "The default resolution, " << resolutionName(r) << " (" << f("%.1f", r.cellsPerCrown) << " cells a crown), is "
+          << (onFront.count(size_t(defaultRow)) ? "on the front" : "off the front");
+        if (offRow && offRow->imageErr > 0.0)
+            s << ": it removes " << f("%.0f", 100.0 * (1.0 - r.imageErr / offRow->imageErr)) << "% of the picture's error without a forest "
+              << "grid (" << err(offRow->imageErr) << " -> " << err(r.imageErr) << ") in " << secs(r.seconds) << " s";
+        if (best != &r)
+            s << "; the lowest error, " << err(best->imageErr) << ", is at " << resolutionName(*best) << " (" << secs(best->seconds) << " s)";
+        s << ". What counts is the cells a crown spans, not the resolution: below about 3 the face factors are off (the lattice's "
+             "shapes, not the stand's), the centre factors alone move the picture little, and from about 4 the grid takes off a sixth of "
+             "the error. The automatic resolution asks for 4 (at most 32 nodes along the extent: the default forest's 8 m crowns over 220 m "
+             "get 1.0, within the 1 s the forest grid may take there: PERFORMANCE.md). The mode stays off by default so that scenes written before the forest grid render the same "
+             "picture; `lighting.forest_grid: auto` turns it on where exposure differs.\n\n";
+    }
+    if (!data.empty()) {
+        const std::string file = pl.dataFile("scene_forest.dat", data);
+        std::string cmd = "set logscale x\nset xlabel 'forest grid cells across a crown'\n"
+                          "set ylabel 'image error vs per-instance solves'\nset yrange [0:*]\nplot '" + file +
+                          "' using 1:2 with linespoints pt 7 ps 1.3 lc rgb '#1b9e77' title 'forest grid on'";
+        if (!autoData.empty())
+            cmd += ", '" + pl.dataFile("scene_forest_auto.dat", autoData) +
+                   "' using 1:2 with points pt 6 ps 3 lw 2 lc rgb 'red' title 'automatic resolution (default)'";
+        if (offRow) cmd += ", " + err(offRow->imageErr) + " with lines dt 2 lc rgb '#d95f02' title 'forest grid off'";
+        cmd += ", " + err(d.oracleErr) + " with lines dt 3 lc rgb '#7570b3' title 'reference factor per instance'";
+        pl.plot("scene_forest_grid.png", cmd + "\n");
+    }
+
+    s << "### Relighting from a basis against direct solves\n\n";
+    s << "The stand's species grid (" << d.speciesDims << ") in the product's default solve (fixed steps, 1 x the longest "
+         "edge), solved once per unit boundary along each moving lattice direction "
+         "(`lightingBasisFor`), then lit for " << d.suns << " random suns (elevation 5-85 degrees) by the weighted sum of the basis "
+         "(`relight`) and by a direct solve with the same storage and steps; error = relative L2 of the relit grid against the direct "
+         "one over every node and channel. Times: wall clock (CPU time in brackets); relight and direct solve the median over the "
+         "suns. \"Pays after\": the sun changes after which the basis costs less than solving each sun.\n\n";
+    s << "| storage | basis solves | build the basis (s) | direct solve (s) | relight (ms) | memory (MB, fp32 grids) | error, median | "
+         "error, max | pays after | |\n| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";
+    for (const BasisRow& r : d.basis) {
+        const double pays = r.directSeconds > 0.0 ? std::ceil(r.basisSeconds / r.directSeconds) : 0.0;
+        s << "| " << storageName(r.fp16) << " | " << r.directions << " | " << secs(r.basisSeconds) << " (" << secs(r.basisCpu) << ") | "
+          << secs(r.directSeconds) << " (" << secs(r.directCpu) << ") | " << f("%.1f", r.relightMs) << " | " << f("%.1f", r.megabytes)
+          << " | " << f("%.1e", r.errMedian) << " | " << f("%.1e", r.errMax) << " | " << f("%.0f", pays) << " suns | "
+          << (r.isDefault ? "**default**" : "") << " |\n";
+    }
+    s << "\nThe basis is exact in the model (the LB update is linear in the boundary): fp32's error is float rounding, fp16's the "
+         "rounding of its stored distributions, both far below the LB's transport error (the LB section). The species' default "
+         "storage is marked";
+    for (const BasisRow& r : d.basis)
+        if (r.isDefault && r.relightMs > 0.0)
+            s << ": a relight costs " << f("%.1f", r.relightMs) << " ms against a direct solve's " << secs(r.directSeconds) << " s ("
+              << f("%.0f", 1e3 * r.directSeconds / r.relightMs) << "x less)";
+    s << ", so the studio's sun dial and time slider relight from the basis once it is built (*Render > Build Relighting Basis*, "
+         "`sylva light --basis`).\n\n";
+    return s.str();
+}
+
 // ---------------------------------------------------------------- presets
 
 std::string presetSection(const LbData* lb, const RenderData* render)
@@ -546,7 +670,7 @@ void writeReport(const Options& options, const ReportInput& in, Result& result)
           "and what each speed knob costs in accuracy and buys in time. The yardstick is a Monte Carlo reference solver "
           "(`core/reference/mc_reference.h`, `sylva reference`): it solves the volumetric radiative transfer on the same density "
           "grid with the same optics, is slow, and is exact in the limit of many paths, with a standard error per node.\n\n";
-    md << "**This file is generated** by `sylva study all` (`pipeline/study/`; `sylva study lb|voxel|render` reruns one part and "
+    md << "**This file is generated** by `sylva study all` (`pipeline/study/`; `sylva study lb|voxel|render|scene` reruns one part and "
           "rewrites the file from the stored numbers of the others, `accuracy/*.json`; `--quick` is the small version CI runs). "
           "The sections \"The reference solver\" and \"Normalization\" are written by hand and carried over word for word; edit "
           "them here, everything else in the code.\n\n";
@@ -571,6 +695,7 @@ void writeReport(const Options& options, const ReportInput& in, Result& result)
     }
     if (in.voxel) runLine("voxelization", in.voxel->run);
     if (in.render) runLine("rendering", in.render->run);
+    if (in.scene) runLine("scene scale", in.scene->run);
     md << "\n";
 
     for (const char* name : kKeptSections) {
@@ -585,6 +710,8 @@ void writeReport(const Options& options, const ReportInput& in, Result& result)
     if (in.render) md << renderSections(*in.render, pl);
     else md << "## Rendering\n\nNot measured yet: `sylva study render`.\n\n";
     md << presetSection(in.lb, in.render);
+    if (in.scene) md << sceneSection(*in.scene, pl);
+    else md << "## Scene scale: the forest-level grid and the relighting basis\n\nNot measured yet: `sylva study scene`.\n\n";
     {   // the ground truth against Cycles, written by `sylva study truth` (measureTruth) and kept until rerun
         std::ifstream truth(dir + "/accuracy/truth.md");
         if (truth) md << truth.rdbuf();

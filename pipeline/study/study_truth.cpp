@@ -114,8 +114,8 @@ double relL2Rgb(const Image& a, const Image& b)
     return n > 0.0 ? std::sqrt(d / n) : 0.0;
 }
 
-// Reinhard with the exposure of the reference picture (the same mapping for both, so FLIP sees the
-// difference of the linear pictures), sRGB-encoded.
+} // namespace
+
 float exposureOf(const Image& ref) { return toneMapScale(logAverageLuminance(&ref[0].x, ref.size(), 3)); }
 Image toneMap(const Image& im, float scale)
 {
@@ -133,6 +133,8 @@ void writePng(const std::string& path, const Image& srgb, int w, int h)
     }
     writeImage(path, img, 3);
 }
+
+namespace {
 
 // A heat map of values in [0, 1]: black, red, yellow, white.
 Image heat(const std::vector<float>& v)

@@ -1,11 +1,16 @@
 // `sylva study lb --quick` end to end (CI smoke test, label slow): the report, its kept sections, the plots or
-// the note that they were skipped, and `sylva study report` from the stored numbers.
+// the note that they were skipped, and `sylva study report` from the stored numbers; `sylva study scene --quick`.
 #include <QDir>
 #include <QFile>
+#include <QJsonArray>
+#include <QJsonDocument>
+#include <QJsonObject>
 #include <QProcess>
 #include <QStandardPaths>
 #include <QTemporaryDir>
 #include <QTest>
+
+#include <cmath>
 
 namespace {
 
@@ -95,6 +100,56 @@ private Q_SLOTS:
 
         // Bad usage.
         QCOMPARE(sylva({"study", "everything"}).code, 2);
+    }
+
+    // `sylva study scene --quick`: the forest-level grid against per-instance solves on a stand, and the
+    // relighting basis against direct solves. What must hold whatever the numbers: the reference is sound
+    // (a lone tree alone in its domain equals its species grid), the stand's interior is darker than its
+    // edge in the reference and with the forest grid, the forest grid at 32 moves the factors and the
+    // picture towards the reference, and relighting equals a direct solve to float (fp32) or fp16 rounding.
+    void quickSceneStudy()
+    {
+        QTemporaryDir dir;
+        QVERIFY(dir.isValid());
+        const Run r = sylva({"study", "scene", "--quick", "--out", dir.path()});
+        QVERIFY2(r.code == 0, qPrintable(r.err + r.out));
+        const QString md = readAll(dir.filePath("ACCURACY.md"));
+        QVERIFY(md.contains("## Scene scale: the forest-level grid and the relighting basis"));
+        QVERIFY(md.contains("**default** resolution"));
+        QVERIFY(md.contains("sylva study lb"));   // the LB part, not measured here, says how to measure it
+        for (const char* png : {"scene_stand_reference.png", "scene_stand_off.png", "scene_stand_default.png"}) {
+            QFile f(dir.filePath(QString("accuracy/") + png));
+            QVERIFY2(f.open(QIODevice::ReadOnly), png);
+            QVERIFY(f.read(8) == QByteArray("\x89PNG\r\n\x1a\n", 8));
+        }
+        QFile json(dir.filePath("accuracy/scene.json"));
+        QVERIFY(json.open(QIODevice::ReadOnly));
+        const QJsonObject d = QJsonDocument::fromJson(json.readAll()).object();
+        QVERIFY2(d.value("floor_err").toDouble() < 1e-2, qPrintable(QString::number(d.value("floor_err").toDouble())));
+        const double refInterior = d.value("reference_interior").toDouble(), refEdge = d.value("reference_edge").toDouble();
+        QVERIFY(refInterior > 0.3 && refInterior < refEdge && refEdge < 1.0);
+        QVERIFY(d.value("isolated_factor").toDouble() > 0.98);   // no tree shades the lone one (its neighbours light it)
+        QJsonObject off, at32;
+        for (const QJsonValue& v : d.value("forest").toArray()) {
+            const QJsonObject row = v.toObject();
+            if (row.value("resolution").toInt() == 0) off = row;
+            if (row.value("resolution").toInt() == 32) at32 = row;
+        }
+        QVERIFY(!off.isEmpty() && !at32.isEmpty());
+        QCOMPARE(off.value("interior").toDouble(), 1.0);
+        QVERIFY(at32.value("interior").toDouble() < at32.value("edge").toDouble());
+        QVERIFY(std::fabs(at32.value("interior").toDouble() - refInterior) < 0.05);
+        QVERIFY(at32.value("factor_rms").toDouble() < 0.5 * off.value("factor_rms").toDouble());
+        QVERIFY(at32.value("image_err").toDouble() < off.value("image_err").toDouble());
+        int storages = 0;
+        for (const QJsonValue& v : d.value("basis").toArray()) {
+            const QJsonObject row = v.toObject();
+            QCOMPARE(row.value("directions").toInt(), 18);
+            QVERIFY(row.value("err_max").toDouble() < (row.value("fp16").toBool() ? 1e-3 : 1e-5));
+            QVERIFY(row.value("relight_ms").toDouble() > 0.0);
+            ++storages;
+        }
+        QCOMPARE(storages, 2);
     }
 };
 
