@@ -36,6 +36,23 @@ double cpuNow()
     return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
+RunInfo startRun(const Options& o)
+{
+    RunInfo r;
+    r.quick = o.quick;
+    r.date = today();
+    r.machine = machineDescription();
+    r.loadBefore = loadAverage();
+    r.seconds = secondsNow();
+    return r;
+}
+
+void finishRun(RunInfo& run)
+{
+    run.seconds = secondsNow() - run.seconds;
+    run.loadAfter = loadAverage();
+}
+
 std::string treeMeshPath(const Options& options)
 {
     if (!options.treeMesh.empty()) return options.treeMesh;
@@ -186,12 +203,8 @@ LightingGrid resampled(const LightingGrid& lb, const GridGeometry& fine)
 
 LbData measureLb(const Options& o)
 {
-    const double t0 = secondsNow();
     LbData data;
-    data.run.quick = o.quick;
-    data.run.date = today();
-    data.run.machine = machineDescription();
-    data.run.loadBefore = loadAverage();
+    data.run = startRun(o);
     const std::vector<int> grids = o.quick ? std::vector<int>{32, 64} : std::vector<int>{32, 64, 128};
     const int fine = grids.back();
     const uint64_t pathsAt32 = o.quick ? 2'000'000 : 8'000'000;   // paths grow with the grid: noise ~ flat
@@ -314,8 +327,7 @@ LbData measureLb(const Options& o)
     else if (!ran256) data.note = "256 left out: " + note256;
     else data.note = "256 (fp16 with the default steps and tol 1e-3 only; no reference at 256: its error is against 128) " +
                      std::string(note256.empty() ? "ran for every case." : "ran where it fits: " + note256);
-    data.run.seconds = secondsNow() - t0;
-    data.run.loadAfter = loadAverage();
+    finishRun(data.run);
     markDefaults(data);
     return data;
 }

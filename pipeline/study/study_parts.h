@@ -64,6 +64,11 @@ void writePng(const std::string& path, const std::vector<glm::vec3>& srgb, int w
 double secondsNow();
 double cpuNow();
 
+// A part's RunInfo: startRun fills in the date, machine, --quick and the load now (and holds the start
+// time in `seconds`); finishRun makes `seconds` the wall time since then and records the load at the end.
+RunInfo startRun(const Options& o);
+void finishRun(RunInfo& run);
+
 inline void say(const Options& o, const std::string& line)
 {
     if (o.log) o.log(line);

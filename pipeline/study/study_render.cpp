@@ -83,12 +83,8 @@ Scene smallScene(int width, int height)
 
 RenderData measureRender(const Options& o)
 {
-    const double t0 = secondsNow();
     RenderData data;
-    data.run.quick = o.quick;
-    data.run.date = today();
-    data.run.machine = machineDescription();
-    data.run.loadBefore = loadAverage();
+    data.run = startRun(o);
     const int reps = o.quick ? 1 : 2;
 
     // Samples per pixel against a many-sample render of a small scene.
@@ -233,8 +229,7 @@ RenderData measureRender(const Options& o)
             data.presets.push_back(row);
         }
     }
-    data.run.seconds = secondsNow() - t0;
-    data.run.loadAfter = loadAverage();
+    finishRun(data.run);
     return data;
 }
 

@@ -172,12 +172,8 @@ double median(std::vector<double> v)
 
 SceneData measureScene(const Options& o)
 {
-    const double t0 = secondsNow();
     SceneData data;
-    data.run.quick = o.quick;
-    data.run.date = today();
-    data.run.machine = machineDescription();
-    data.run.loadBefore = loadAverage();
+    data.run = startRun(o);
     char line[300];
 
     // ---- the forest-level grid against per-instance lighting on a stand ----
@@ -358,8 +354,7 @@ SceneData measureScene(const Options& o)
         say(o, line);
         data.basis.push_back(row);
     }
-    data.run.seconds = secondsNow() - t0;
-    data.run.loadAfter = loadAverage();
+    finishRun(data.run);
     return data;
 }
 

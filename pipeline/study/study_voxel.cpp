@@ -44,12 +44,8 @@ double interiorTotal(const DensityGrid& d)
 
 VoxelData measureVoxel(const Options& o)
 {
-    const double t0 = secondsNow();
     VoxelData data;
-    data.run.quick = o.quick;
-    data.run.date = today();
-    data.run.machine = machineDescription();
-    data.run.loadBefore = loadAverage();
+    data.run = startRun(o);
     data.referenceSubcells = 12;
     const int grid = o.quick ? 32 : 64;
     const std::vector<int> subcells{3, 4, 6, 8};
@@ -107,8 +103,7 @@ VoxelData measureVoxel(const Options& o)
             data.rows.push_back(row);
         }
     }
-    data.run.seconds = secondsNow() - t0;
-    data.run.loadAfter = loadAverage();
+    finishRun(data.run);
     return data;
 }
 
