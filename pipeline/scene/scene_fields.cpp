@@ -649,6 +649,10 @@ const Table<LightingDesc>& sceneLightingTable()
                                 "automatic, 4 nodes across the median crown and at most 32 (the picture improves over no forest "
                                 "grid from about 4 cells a crown: [ACCURACY.md](ACCURACY.md) \"Scene scale\"); build + solve "
                                 "time in [PERFORMANCE.md](PERFORMANCE.md)")
+            .thenCheck([](JsonReader& r, const QJsonObject&, const KeyPath& path, LightingDesc& l) {
+                if (l.forestGridResolution > 0 && l.forestGridResolution < 4)
+                    r.fail(path.field("forest_grid_resolution"), "expected 0 (automatic) or 4 .. 512, got " + std::to_string(l.forestGridResolution));
+            })
             .summarized([](const LightingDesc& l) {
                 if (l.forestGrid == ForestGridMode::Off) return std::string();
                 return l.forestGridResolution == 0 ? std::string("forest grid resolution automatic")

@@ -627,6 +627,10 @@ private Q_SLOTS:
         QTest::newRow("ground enabled") << with({"ground", "enabled"}, 1) << "ground.enabled: expected true or false";
         QTest::newRow("sky negative") << with({"sky", "color"}, QJsonArray{0.5, -1, 0}) << "sky.color[1]: must lie in [0, inf]";
         QTest::newRow("sky unknown") << with({"sky", "colour"}, QJsonArray{0.5, 1, 0}) << "sky.colour: unknown field";
+        QTest::newRow("forest grid resolution 2") << with({"lighting", "forest_grid_resolution"}, 2)
+                                                  << "lighting.forest_grid_resolution: expected 0 (automatic) or 4 .. 512, got 2";
+        QTest::newRow("forest grid resolution big") << with({"lighting", "forest_grid_resolution"}, 513)
+                                                    << "lighting.forest_grid_resolution: must lie in [0, 512], got 513";
     }
 
     void malformed()
