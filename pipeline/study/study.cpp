@@ -26,44 +26,29 @@ Result run(const Options& options)
     std::error_code ec;
     std::filesystem::create_directories(dir + "/accuracy", ec);
     if (ec) throw Error(dir + "/accuracy: cannot create the folder: " + ec.message());
-    const std::string lbPath = dir + "/accuracy/lb.json", voxelPath = dir + "/accuracy/voxel.json",
-                      renderPath = dir + "/accuracy/render.json", scenePath = dir + "/accuracy/scene.json";
     auto wants = [&](Part p) { return std::find(options.parts.begin(), options.parts.end(), p) != options.parts.end(); };
+    // A part asked for is measured and stored in DIR/accuracy/<name>.json; any other is read from there when
+    // stored. Either way the report gets it (null: neither).
+    auto part = [&](Part p, const char* name, auto& data, auto measure, auto save, auto load) -> decltype(&data) {
+        const std::string path = dir + "/accuracy/" + name + ".json";
+        if (wants(p)) {
+            data = measure(options);
+            save(path, data);
+            return &data;
+        }
+        return load(path, &data) ? &data : nullptr;
+    };
 
     LbData lb;
     VoxelData voxel;
     RenderData render;
     SceneData scene;
     ReportInput input;
-    if (wants(Part::Lb)) {
-        lb = measureLb(options);
-        saveLb(lbPath, lb);
-        input.lb = &lb;
-    } else if (loadLb(lbPath, &lb)) {
-        markDefaults(lb);   // the report follows the current default, not the one at measuring time
-        input.lb = &lb;
-    }
-    if (wants(Part::Voxel)) {
-        voxel = measureVoxel(options);
-        saveVoxel(voxelPath, voxel);
-        input.voxel = &voxel;
-    } else if (loadVoxel(voxelPath, &voxel)) {
-        input.voxel = &voxel;
-    }
-    if (wants(Part::Render)) {
-        render = measureRender(options);
-        saveRender(renderPath, render);
-        input.render = &render;
-    } else if (loadRender(renderPath, &render)) {
-        input.render = &render;
-    }
-    if (wants(Part::Scene)) {
-        scene = measureScene(options);
-        saveScene(scenePath, scene);
-        input.scene = &scene;
-    } else if (loadScene(scenePath, &scene)) {
-        input.scene = &scene;
-    }
+    input.lb = part(Part::Lb, "lb", lb, measureLb, saveLb, loadLb);
+    if (input.lb && !wants(Part::Lb)) markDefaults(lb);   // the report follows the current default, not the one at measuring time
+    input.voxel = part(Part::Voxel, "voxel", voxel, measureVoxel, saveVoxel, loadVoxel);
+    input.render = part(Part::Render, "render", render, measureRender, saveRender, loadRender);
+    input.scene = part(Part::Scene, "scene", scene, measureScene, saveScene, loadScene);
     if (wants(Part::Truth)) measureTruth(options);   // writes accuracy/truth.md, which the report includes
     Result result;
     writeReport(options, input, result);
