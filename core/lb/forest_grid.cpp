@@ -36,6 +36,32 @@ ForestSpecies forestSpecies(const DensityGrid& d)
     return s;
 }
 
+double plantExtinctionVolume(const ForestSpecies& s, float scale)
+{
+    const double k = double(scale);
+    return s.spacing > 0.0 ? s.biomass * k * k * k / (s.spacing * k) : 0.0;
+}
+
+void splatDepth(const glm::dvec3& lo, const glm::dvec3& hi, double extinctionVolume, const GridGeometry& g, std::vector<float>& depth)
+{
+    const glm::dvec3 e = hi - lo;
+    const double volume = e.x * e.y * e.z;
+    if (!(volume > 0.0) || !(extinctionVolume > 0.0)) return;
+    const double h = g.spacing;
+    // mean density over a cell = biomass x overlap / (volume x h^3); x (h / fine spacing) = the depth a coarse step crosses.
+    const double perOverlap = extinctionVolume / (volume * h * h);
+    const glm::ivec3 i0 = glm::max(glm::ivec3(glm::floor((lo - g.origin) / h - 0.5)), glm::ivec3(0));
+    const glm::ivec3 i1 = glm::min(glm::ivec3(glm::ceil((hi - g.origin) / h + 0.5)), g.dims - 1);
+    for (int i = i0.x; i <= i1.x; ++i)
+        for (int j = i0.y; j <= i1.y; ++j)
+            for (int k = i0.z; k <= i1.z; ++k) {
+                const glm::dvec3 c = g.origin + h * glm::dvec3(i, j, k);
+                const glm::dvec3 o = glm::max(glm::min(hi, c + 0.5 * h) - glm::max(lo, c - 0.5 * h), glm::dvec3(0.0));
+                const double overlap = o.x * o.y * o.z;
+                if (overlap > 0.0) depth[g.index(i, j, k)] += float(perOverlap * overlap);
+            }
+}
+
 namespace {
 
 // Face factors are capped here: a face the plant alone barely lights can take a large ratio from a little
@@ -52,36 +78,19 @@ constexpr double kMinFaceCells = 3.0;
 
 struct Box {
     glm::dvec3 lo, hi;
-    double rhoPerOverlap;   // coarse density per m^3 of overlap with a node's cell
+    double extinctionVolume;   // biomass / the fine spacing (splatDepth)
 };
 
-Box plantBox(const ForestPlant& p, const ForestSpecies& s, double h)
+Box plantBox(const ForestPlant& p, const ForestSpecies& s)
 {
     Box b;
     b.lo = p.position + double(p.scale) * s.boxMin;
     b.hi = p.position + double(p.scale) * s.boxMax;
-    const glm::dvec3 e = b.hi - b.lo;
-    const double volume = e.x * e.y * e.z;
-    const double biomass = s.biomass * double(p.scale) * double(p.scale) * double(p.scale);
-    // mean density over a cell = biomass x overlap / (volume x h^3); x (h / fine spacing).
-    b.rhoPerOverlap = volume > 0.0 ? biomass / (volume * h * h * s.spacing * double(p.scale)) : 0.0;
+    b.extinctionVolume = plantExtinctionVolume(s, p.scale);
     return b;
 }
 
-void splat(const Box& b, const GridGeometry& g, std::vector<float>& rho)
-{
-    const double h = g.spacing;
-    const glm::ivec3 lo = glm::max(glm::ivec3(glm::floor((b.lo - g.origin) / h - 0.5)), glm::ivec3(0));
-    const glm::ivec3 hi = glm::min(glm::ivec3(glm::ceil((b.hi - g.origin) / h + 0.5)), g.dims - 1);
-    for (int i = lo.x; i <= hi.x; ++i)
-        for (int j = lo.y; j <= hi.y; ++j)
-            for (int k = lo.z; k <= hi.z; ++k) {
-                const glm::dvec3 c = g.origin + h * glm::dvec3(i, j, k);
-                const glm::dvec3 o = glm::max(glm::min(b.hi, c + 0.5 * h) - glm::max(b.lo, c - 0.5 * h), glm::dvec3(0.0));
-                const double overlap = o.x * o.y * o.z;
-                if (overlap > 0.0) rho[g.index(i, j, k)] += float(b.rhoPerOverlap * overlap);
-            }
-}
+void splat(const Box& b, const GridGeometry& g, std::vector<float>& depth) { splatDepth(b.lo, b.hi, b.extinctionVolume, g, depth); }
 
 glm::vec3 sample(const LightingGrid& l, const glm::dvec3& p)
 {
@@ -104,8 +113,10 @@ glm::vec3 sample(const LightingGrid& l, const glm::dvec3& p)
 // full solver's setup (page-aligned copies, thread pool per step) costs far more than the steps.
 // faces (when given): per node and channel the irradiance on the six axis-aligned faces (kFaceNormals order),
 // sum over directions m of f_m x max(0, -c_m . N) / |c_m|: the light arriving at a surface facing N.
+// solid (when given): per node, nonzero = opaque black (the ground under a landscape): it holds no light
+// and sends none, whatever arrives is absorbed.
 LightingGrid solveSmall(const GridGeometry& g, const std::vector<float>& rho, const LbParams& p, int steps,
-                        std::vector<float>* faces = nullptr)
+                        std::vector<float>* faces = nullptr, const std::vector<uint8_t>* solid = nullptr)
 {
     const std::vector<float> bc = boundaryOf(p);
     const size_t nodes = g.nodeCount();
@@ -124,8 +135,9 @@ LightingGrid solveSmall(const GridGeometry& g, const std::vector<float>& rho, co
         for (int i = 0; i < g.dims.x; ++i)
             for (int j = 0; j < g.dims.y; ++j)
                 for (int k = 0; k < g.dims.z; ++k) {
-                    const bool onB = boundary(i, j, k) || p.warmStart;
-                    float* f = &a[g.index(i, j, k) * kDirections];
+                    const size_t n = g.index(i, j, k);
+                    const bool onB = (boundary(i, j, k) || p.warmStart) && !(solid && (*solid)[n]);
+                    float* f = &a[n * kDirections];
                     for (int m = 0; m < kDirections; ++m) f[m] = onB ? bc[size_t(m)] : 0.0f;
                 }
         b = a;
@@ -136,7 +148,8 @@ LightingGrid solveSmall(const GridGeometry& g, const std::vector<float>& rho, co
                         const size_t n = g.index(i, j, k);
                         float f[kDirections];
                         for (int m = 0; m < kDirections; ++m) f[m] = a[n * kDirections + size_t(m)];
-                        if (rho[n] > 0.0f) collideNode(f, rho[n], om, p.zeroF0);
+                        if (solid && (*solid)[n]) std::fill(f, f + kDirections, 0.0f);
+                        else if (rho[n] > 0.0f) collideNode(f, rho[n], om, p.zeroF0);
                         else if (p.zeroF0) f[0] = 0.0f;
                         for (int m = 0; m < kDirections; ++m) {
                             const int ti = i + kC[m][0], tj = j + kC[m][1], tk = k + kC[m][2];
@@ -258,7 +271,7 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
     for (size_t i = 0; i < plants.size(); ++i) {
         const ForestSpecies& s = species[size_t(plants[i].species)];
         if (!(s.biomass > 0.0)) continue;
-        boxes[i] = plantBox(plants[i], s, h);
+        boxes[i] = plantBox(plants[i], s);
         splat(boxes[i], g, r.density);
     }
     LbParams p = params;
@@ -337,6 +350,68 @@ ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const s
     r.uniform = most <= 0.0f || (most - least) / most < settings.uniformSpread;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
+}
+
+LightingGrid solveGroundedLattice(const GridGeometry& g, std::vector<float> depth, const std::vector<uint8_t>& solid,
+                                  const LbParams& params, int* stepsOut)
+{
+    const size_t nodes = g.nodeCount();
+    if (depth.size() != nodes || solid.size() != nodes) throw Error("grounded lattice: the depth and solid arrays must have one value per node");
+    const auto column = [&](int i, int k, int j) { return g.index(i, j, k); };
+    // A column's foliage is a layer on its ground, far thinner than a node: all of its depth lies in the
+    // column's first open node (split over two nodes, the lower one saw only what the upper one let through,
+    // and a dense canopy's lower node went black). The top layer is always open.
+    std::vector<int> firstOpen(size_t(g.dims.x) * size_t(g.dims.z), g.dims.y - 1);
+    for (int i = 0; i < g.dims.x; ++i)
+        for (int k = 0; k < g.dims.z; ++k) {
+            int& open = firstOpen[size_t(i) * size_t(g.dims.z) + size_t(k)];
+            for (int j = g.dims.y - 1; j >= 0 && !solid[column(i, k, j)]; --j) open = j;
+            float sum = 0.0f;
+            for (int j = 0; j < g.dims.y; ++j) sum += depth[column(i, k, j)], depth[column(i, k, j)] = 0.0f;
+            depth[column(i, k, open)] = sum;
+        }
+    LbParams p = params;
+    p.tolerance = 0.0;
+    p.steps = 2 * g.longestEdge();
+    if (stepsOut) *stepsOut = p.steps;
+    // Outdoors nothing travels upward out of the ground: the boundary's directions that climb (the part of a
+    // sun's lobe below the horizon) are dropped, as the ground beyond the lattice would absorb them. Then an
+    // empty lattice over flat ground holds the boundary distribution at every open node (its sum the
+    // unobstructed light), and a plant on open level ground gets 1.
+    // The sun as a beam (the lobe's directions far from it cast terrain shadows the sun does not: on a gentle
+    // ramp under a high sun the lobe's level directions lost 17% to the rising ground, tst_landscape_light);
+    // a given boundary (a sky) as it is.
+    std::vector<float> bc = p.boundary.empty() ? beamDistribution(p.sun) : p.boundary;
+    for (int m = 0; m < kDirections; ++m)
+        if (kC[m][1] > 0) bc[size_t(m)] = 0.0f;
+    p.boundary = bc;
+    // The canopy only takes light out: its extinction is all absorbed. A node hundreds of metres tall spreads a
+    // canopy tens of metres thick over its height, diluting its sideways extinction by that ratio, so light it
+    // scattered sideways stayed in the layer for the lattice's width: 1.45 x the unobstructed light inside a
+    // dense stand (tst_landscape_light, before). Light plants scatter onto each other stays the species grids'
+    // and the instances' forest grid's. A node's value is the light arriving at it (the distribution streamed
+    // in, before its own collision): its own canopy's shading, which the species grids hold, is not in it.
+    for (ChannelParams& c : p.channels) c.sigmaA += c.sigmaS, c.sigmaS = 0.0f;
+    const DensityGrid d = densityOn(g, depth, largestExtinction(p));
+    LightingGrid light = solveSmall(g, d.density, p, p.steps, nullptr, &solid);
+    double freeSum = 0.0;
+    for (int m = p.zeroF0 ? 1 : 0; m < kDirections; ++m) freeSum += double(bc[size_t(m)]);
+    for (size_t n = 0; n < nodes; ++n)
+        for (int c = 0; c < 3; ++c) {
+            const double free = freeSum * double(p.intensity[c]);
+            float& v = light.rgb[n * 3 + size_t(c)];
+            v = free > 0.0 ? float(double(v) / free) : 1.0f;
+        }
+    // Every node of a column holds the light arriving at its canopy (its first open node): what a plant
+    // anywhere in the column reads.
+    for (int i = 0; i < g.dims.x; ++i)
+        for (int k = 0; k < g.dims.z; ++k) {
+            const size_t o = column(i, k, firstOpen[size_t(i) * size_t(g.dims.z) + size_t(k)]);
+            const glm::vec3 v(light.rgb[o * 3], light.rgb[o * 3 + 1], light.rgb[o * 3 + 2]);
+            for (int j = 0; j < g.dims.y; ++j)
+                for (int c = 0; c < 3; ++c) light.rgb[column(i, k, j) * 3 + size_t(c)] = v[c];
+        }
+    return light;
 }
 
 std::string forestGridSummary(const ForestGridResult& r)

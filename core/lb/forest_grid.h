@@ -16,6 +16,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,15 @@ struct ForestSpecies {
     double spacing = 1.0;                  // its density grid's spacing (m)
 };
 ForestSpecies forestSpecies(const DensityGrid& density);
+
+// A plant's biomass over its fine spacing, both scaled: what splatDepth spreads (m^2 of density).
+double plantExtinctionVolume(const ForestSpecies& s, float scale);
+
+// Adds the optical depth of foliage spread evenly over the box [lo, hi] to the coarse lattice g (z fastest): a
+// node gets its cell's overlap with the box as the mean fine density over the cell x (coarse spacing / fine
+// spacing), the fine steps a coarse step crosses. extinctionVolume: plantExtinctionVolume, summed over the
+// plants the box stands for. Continuous in the box; nothing for an empty box.
+void splatDepth(const glm::dvec3& lo, const glm::dvec3& hi, double extinctionVolume, const GridGeometry& g, std::vector<float>& depth);
 
 struct ForestPlant {
     glm::dvec3 position{0.0};   // of the species' origin, world metres
@@ -87,6 +97,21 @@ inline constexpr size_t kSmallNodes = size_t(1) << 17;
 // the forest grid and 4 x its window's for each plant's own solve (both converge: an isolated plant gets 1).
 ForestGridResult solveForestGrid(const std::vector<ForestPlant>& plants, const std::vector<ForestSpecies>& species,
                                  const LbParams& params, const ForestGridSettings& settings = {});
+
+// The landscape's lattice (core/terrain/landscape_light.h fills its inputs), 2.5D: per node the optical depth
+// of the plants that grow there (splatDepth) and whether it lies under the ground (solid: opaque black,
+// absorbing what arrives). A column's foliage is a layer on its ground, far thinner than a node: all of its
+// depth goes into the column's first open node. Solved with params' optics and boundary through the forest
+// grid's scalar loop for 2 x the longest edge (any size: it keeps the solid nodes), the boundary's
+// upward-travelling directions dropped (the ground beyond the lattice absorbs them) and the foliage's
+// extinction all absorbed, no scattering (see forest_grid.cpp). Returns per column and channel the light
+// arriving at its first open node (before that node's own foliage acts: a plant's own canopy, which its
+// species grid holds, is not in it) over the empty lattice's (the boundary's unobstructed value), in every
+// node of the column: 1 on open level ground, < 1 in a valley or on a slope the terrain shades and inside
+// a stand whose neighbours take the light from the side. *steps (when given): the steps run. Throws Error
+// when the arrays' sizes differ from the lattice's.
+LightingGrid solveGroundedLattice(const GridGeometry& g, std::vector<float> depth, const std::vector<uint8_t>& solid,
+                                  const LbParams& params, int* steps = nullptr);
 
 // One line for stats: resolution, dims, time, factor range, and whether exposure is uniform.
 std::string forestGridSummary(const ForestGridResult& r);

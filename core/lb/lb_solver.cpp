@@ -727,6 +727,34 @@ std::vector<float> boundaryDistribution(const glm::vec3& sun)
     return bc;
 }
 
+std::vector<float> beamDistribution(const glm::vec3& sun)
+{
+    std::vector<float> bc(kDirections, 0.0f);
+    if (!(glm::dot(sun, sun) > 0.0f)) return bc;
+    const glm::dvec3 t = -glm::normalize(glm::dvec3(sun));
+    glm::dvec3 u[kDirections];
+    for (int m = 1; m < kDirections; ++m) u[m] = glm::normalize(glm::dvec3(kC[m][0], kC[m][1], kC[m][2]));
+    // Every triple whose cone holds t (Cramer's rule, weights >= 0); the tightest: the least weighted angle.
+    double best = 1e300;
+    int pick[3] = {0, 0, 0};
+    double weight[3] = {0.0, 0.0, 0.0};
+    for (int a = 1; a < kDirections; ++a)
+        for (int b = a + 1; b < kDirections; ++b)
+            for (int c = b + 1; c < kDirections; ++c) {
+                const glm::dmat3 M(u[a], u[b], u[c]);
+                const double det = glm::determinant(M);
+                if (std::fabs(det) < 1e-9) continue;
+                const glm::dvec3 w = glm::inverse(M) * t;
+                if (w.x < -1e-12 || w.y < -1e-12 || w.z < -1e-12) continue;
+                const double spread = w.x * (1.0 - glm::dot(u[a], t)) + w.y * (1.0 - glm::dot(u[b], t)) + w.z * (1.0 - glm::dot(u[c], t));
+                if (spread < best - 1e-12) best = spread, pick[0] = a, pick[1] = b, pick[2] = c, weight[0] = w.x, weight[1] = w.y, weight[2] = w.z;
+            }
+    const double sum = std::max(weight[0], 0.0) + std::max(weight[1], 0.0) + std::max(weight[2], 0.0);
+    for (int k = 0; k < 3; ++k)
+        if (pick[k] > 0 && sum > 0.0) bc[size_t(pick[k])] = float(std::max(weight[k], 0.0) / sum);
+    return bc;
+}
+
 std::vector<float> boundaryOf(const LbParams& params)
 {
     return params.boundary.empty() ? boundaryDistribution(params.sun) : params.boundary;

@@ -33,6 +33,12 @@ void advance(const DensityGrid& density, const LbParams& params, std::vector<flo
 
 // Boundary value f_m = max(0, n_m . d) for unit intensity, d = -normalize(sun) (LB_MODEL.md "Boundary condition").
 std::vector<float> boundaryDistribution(const glm::vec3& sun);
+// The sun as a beam rather than the model's cosine lobe: its travel direction -normalize(sun) as a
+// non-negative sum of the three lattice directions (unit vectors) of the tightest cone holding it (fewer
+// where it lies on a cone's face or edge), weights summing to 1. For pure transport without scattering (the
+// landscape's lattice, forest_grid.h), where the lobe's directions far from the sun would cast shadows the
+// sun does not. Zero sun: all 0.
+std::vector<float> beamDistribution(const glm::vec3& sun);
 // The boundary a solve with these parameters uses, for unit intensity: params.boundary, or the sun's.
 std::vector<float> boundaryOf(const LbParams& params);
 

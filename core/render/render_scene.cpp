@@ -15,6 +15,7 @@
 #include "core/render/tonemap.h"
 #include "core/sky/sky_light.h"
 #include "core/terrain/height_field.h"
+#include "core/terrain/landscape_light.h"
 
 namespace sylva {
 glm::dmat3 rotationDeg(const glm::vec3& deg)
@@ -246,11 +247,72 @@ static void setSky(RenderScene& rs, const SkyDesc& d)
 
 namespace {
 
+// The first species with a density grid (its optics light the forest grid), -1 when none has one.
+int forestOptics(const std::vector<lb::ForestSpecies>& species)
+{
+    for (size_t s = 0; s < species.size(); ++s)
+        if (species[s].biomass > 0.0) return int(s);
+    return -1;
+}
+
+// The forest grid's optics and sun: species `optics`' LB settings with the scene's sun.
+lb::LbParams forestGridParams(const Scene& scene, int optics)
+{
+    lb::LbParams p = scene.species[size_t(optics)].lighting;
+    p.sun = scene.sun.direction;
+    return p;
+}
+
+// The terrain-frame height above which the ground is snow (> any height: none), and the cosine below which
+// a normal is rock: the shader's colour rule and the landscape's masks (RenderView::terrainSnowY, terrainRockCos).
+float terrainSnowY(const TerrainDesc& t) { return t.snowLine > 0.0f ? float(double(t.snowLine) - t.origin.y) : 3.0e38f; }
+float terrainRockCos(const TerrainDesc& t) { return float(std::cos(double(t.rockSlope) * 3.14159265358979323846 / 180.0)); }
+
+// The forest grid's share over the landscape's plants (core/terrain/landscape_light.h): the lattice of which
+// plants grow now, applied unless off or (auto) exposure is uniform over the cells with plants.
+void buildLandscapeLight(RenderScene& rs, const Scene& scene)
+{
+    LandscapeLightStats& st = rs.m_stats.landscapeLight;
+    st = LandscapeLightStats{};
+    rs.landLight.clear();
+    rs.base.landLightLayout = LandLightLayout{};
+    const ForestGridMode mode = scene.lighting.forestGrid;
+    if (mode == ForestGridMode::Off || rs.landCells.empty()) return;
+    const int optics = forestOptics(rs.forestSpecies);
+    if (optics < 0) {
+        st.skipped = mode == ForestGridMode::Auto;
+        return;
+    }
+    const TerrainDesc& t = scene.terrain;
+    LandscapeLightSettings settings;
+    settings.resolution = scene.lighting.forestGridResolution;
+    LandscapeLight l = solveLandscapeLight(*t.field, rs.base.land, rs.landCells, rs.tileRecords, rs.tilePlants, terrainSnowY(t), terrainRockCos(t),
+                                           rs.forestSpecies, forestGridParams(scene, optics), settings);
+    st.solved = l.cellsWithPlants > 0;
+    st.resolution = l.resolution;
+    st.dims = l.geometry.dims;
+    st.spacing = l.geometry.spacing;
+    st.seconds = l.seconds;
+    st.plantsTested = l.plantsTested;
+    st.plantsGrowing = l.plantsGrowing;
+    st.stride = l.stride;
+    st.cells = l.cellsWithPlants;
+    st.minFactor = l.minFactor;
+    st.medianFactor = l.medianFactor;
+    st.maxFactor = l.maxFactor;
+    st.spread = l.spread;
+    st.skipped = mode == ForestGridMode::Auto && (!st.solved || l.uniform);
+    st.applied = st.solved && !st.skipped;
+    if (!st.applied) return;
+    rs.landLight = std::move(l.nodes);
+    rs.base.landLightLayout = l.layout;
+}
+
 // The forest-level LB grid (core/lb/forest_grid.h) over the scene's top-level instances of species with a
 // density grid, with the scene's sun and the first such species' optics; its factors become instanceLights
 // (one record per scene instance, factor 1 for those outside it). Auto applies them only where exposure
 // differs: factors and face factors spread by at least uniformSpread (2%).
-void buildForestGrid(RenderScene& rs, const Scene& scene, const std::vector<SpeciesAssets>& assets)
+void buildForestGrid(RenderScene& rs, const Scene& scene)
 {
     ForestGridStats& st = rs.m_stats.forestGrid;
     const ForestGridMode mode = scene.lighting.forestGrid;
@@ -259,12 +321,8 @@ void buildForestGrid(RenderScene& rs, const Scene& scene, const std::vector<Spec
     st.resolution = scene.lighting.forestGridResolution;
     rs.instanceLights.clear();
     if (mode == ForestGridMode::Off) return;
-    std::vector<lb::ForestSpecies> species(assets.size());
-    int optics = -1;
-    for (size_t s = 0; s < assets.size(); ++s) {
-        species[s] = assets[s].forest;
-        if (optics < 0 && species[s].biomass > 0.0) optics = int(s);
-    }
+    const std::vector<lb::ForestSpecies>& species = rs.forestSpecies;
+    const int optics = forestOptics(species);
     std::vector<lb::ForestPlant> plants;
     std::vector<size_t> which;   // plant -> scene instance
     for (size_t i = 0; i < scene.instances.size(); ++i) {
@@ -278,8 +336,7 @@ void buildForestGrid(RenderScene& rs, const Scene& scene, const std::vector<Spec
         st.skipped = mode == ForestGridMode::Auto;
         return;
     }
-    lb::LbParams p = scene.species[size_t(optics)].lighting;
-    p.sun = scene.sun.direction;
+    const lb::LbParams p = forestGridParams(scene, optics);
     lb::ForestGridSettings settings;
     settings.resolution = scene.lighting.forestGridResolution;
     const lb::ForestGridResult r = lb::solveForestGrid(plants, species, p, settings);
@@ -671,9 +728,11 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
     rs.m_stats.groups = scene.groups.size();
     rs.m_stats.groupInstances = rs.groupInstances.size();
 
-    buildLandscapeArrays(rs, scene);
+    rs.forestSpecies.clear();
+    for (const SpeciesAssets& a : assets) rs.forestSpecies.push_back(a.forest);
+    buildLandscapeArrays(rs, scene);   // and its share of the forest grid
     buildVolumeGrids(rs, scene);   // volumes (core/render/render_volumes.h)
-    buildForestGrid(rs, scene, assets);
+    buildForestGrid(rs, scene);
     countBytes(rs);
     return rs;
 }
@@ -705,6 +764,7 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
         rs.base.land = lb.layout;
         rs.m_stats.landscape = lb.stats;
     }
+    buildLandscapeLight(rs, scene);
     countBytes(rs);
 }
 
@@ -712,6 +772,8 @@ void setLandscapeDensity(RenderScene& rs, const Scene& scene)
 {
     if (rs.landCells.empty()) return;
     setLandscapeDensity(rs.base.land, scene.terrain.density, scene.terrain.origin.y);
+    buildLandscapeLight(rs, scene);
+    countBytes(rs);
 }
 
 void rebuildVolumeGrids(RenderScene& rs, const Scene& scene)
@@ -796,8 +858,8 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
         b.terrainOrigin = glm::vec3(t.origin - origin);   // camera-relative, in double first
         b.terrainRock = t.rock;
         b.terrainSnow = t.snow;
-        b.terrainRockCos = float(std::cos(double(t.rockSlope) * 3.14159265358979323846 / 180.0));
-        b.terrainSnowY = t.snowLine > 0.0f ? float(double(t.snowLine) - t.origin.y) : 3.0e38f;
+        b.terrainRockCos = terrainRockCos(t);
+        b.terrainSnowY = terrainSnowY(t);
         // The height field's and the landscape's frames are rebased under the camera, in double (seed 002 at
         // UTM coordinates: millions of metres from the world origin, centimetres near the camera).
         const HeightFieldLayout& L = rs.base.terrain;

@@ -41,6 +41,21 @@ struct ForestGridStats {
     float minFaceFactor = 1.0f, maxFaceFactor = 1.0f;
 };
 
+// The forest-level LB grid over the landscape's plants (core/terrain/landscape_light.h), under the same
+// lighting.forest_grid setting.
+struct LandscapeLightStats {
+    bool solved = false;                 // built and solved
+    bool applied = false;                // its factors scale the landscape plants' LB lighting
+    bool skipped = false;                // auto: exposure uniform over the cells with plants
+    int resolution = 0;
+    glm::ivec3 dims{0};
+    double spacing = 0.0, seconds = 0.0; // metres; build + solve
+    double plantsTested = 0.0, plantsGrowing = 0.0;
+    uint32_t stride = 1;
+    size_t cells = 0;                    // cells with growing plants
+    float minFactor = 1.0f, medianFactor = 1.0f, maxFactor = 1.0f, spread = 0.0f;   // over those cells
+};
+
 // Sizes in bytes of what the traversal reads, for the performance notes.
 struct AccelStats {
     size_t tlasBytes = 0, instanceBytes = 0, blasBytes = 0, triangleBytes = 0;   // the structures the run traverses
@@ -58,6 +73,7 @@ struct AccelStats {
     size_t landscapeBytes = 0;           // the landscape's cells, kd-tree, tiles' trees and plants
     LandscapeStats landscape;            // cells, tiles, potentially visible instances and triangles, build time
     ForestGridStats forestGrid;          // the forest-level LB grid
+    LandscapeLightStats landscapeLight;  // its share over the landscape's plants
 };
 
 // The pruned levels of detail a scene build makes meshes for: those the scene's camera gives some
@@ -89,6 +105,8 @@ public:
     std::vector<uint32_t> groupGeometry;       // per scene group: its geometry record
     std::vector<Bounds3> geometryBounds;       // per geometry record: bounds in its frame (instance boxes)
     std::vector<double> geometryTriangles;     // per geometry record: the triangles an instance of it traces
+    std::vector<lb::ForestSpecies> forestSpecies;   // per species: its density grid as the forest grid sees it (the
+                                               // landscape's lattice is solved again after a landscape edit)
     AccelKind accel = AccelKind::Bvh;          // the mesh structures built
     LodLevels lodLevels = LodLevels::Used;
     AccelStats m_stats;
@@ -117,7 +135,8 @@ void placeTopLevel(RenderScene& rs, const Scene& scene, const glm::vec3& sunRadi
 // viewport keeps the species' structures across such edits; the same species list is assumed):
 // buildLandscapeArrays: the landscape's tiling, tile populations and trees, cells and kd-tree (a tile, tiling
 // or cell edit); setLandscapeDensity: only the density rule's layout fields (core/terrain/landscape.h:
-// nothing is built, the rule thins plants while tracing); rebuildVolumeGrids: the volumes' arrays
+// nothing is built, the rule thins plants while tracing); both solve the landscape's forest grid again (it
+// depends on which plants grow) when lighting.forest_grid is not off; rebuildVolumeGrids: the volumes' arrays
 // (buildVolumeGrids). Each throws Error as buildSceneGeometry does for its part.
 void buildLandscapeArrays(RenderScene& rs, const Scene& scene);
 void setLandscapeDensity(RenderScene& rs, const Scene& scene);

@@ -196,6 +196,7 @@ struct CameraRecord {
     X(Scene, Both, TileRecord, tileRecords, Landscape)     /* per Wang tile */                                 \
     X(Scene, Both, TileNode, tileNodes, Landscape)         /* the tiles' 2D trees */                           \
     X(Scene, Both, TilePlant, tilePlants, Landscape)       /* the tiles' plants */                             \
+    X(Scene, Both, glm::vec4, landLight, Landscape)        /* the landscape's forest grid (landLightLayout) */ \
     X(Scene, Both, float, skyMap, None)                    /* the sky's map pixels (RGB, skyModel.map's) */    \
     X(Scene, Both, sky::VirtualLight, skyLights, None)     /* the sky's virtual directional lights */ \
     X(Top, Both, VolumeInstanceRecord, volumeInstances, None) /* placed volumes (camera-relative) */        \
@@ -234,6 +235,7 @@ struct RenderView {
     LandscapeLayout land;
     glm::ivec2 landBaseCell;         // the cell under the camera (clamped to the grid)
     glm::vec3 landBase;              // camera-relative corner of landBaseCell at the terrain frame's y = 0, placed in double
+    LandLightLayout landLightLayout; // of landLight, terrain frame: the forest grid's factor on landscape plants (dims.x 0: none)
     glm::vec3 sunDir;                // toward the sun, normalized
     glm::vec3 sunRadiance;           // blackbody colour (luminance 1) x intensity
     glm::vec3 sky;                   // the constant sky (skyModel.kind Constant), else 0

@@ -229,7 +229,9 @@ SYLVA_HD inline SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, c
     s.specular = m.specular;
     s.shininess = m.shininess;
     s.extent = in.scale * fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));
-    s.lighting = sampleLighting(v, sp, lp) * forestFactor(v, in, lp);
+    // The forest grid's factor: per top-level instance, or for a landscape plant the landscape lattice's at the hit.
+    const glm::vec3 factor = hit.inst == kLandscapeInst ? landLightFactor(v.landLightLayout, v.landLight, s.p - v.terrainOrigin) : forestFactor(v, in, lp);
+    s.lighting = sampleLighting(v, sp, lp) * factor;
     return s;
 }
 

@@ -252,4 +252,32 @@ SYLVA_HD inline bool landPlantGrows(const LandscapeLayout& L, const HeightFieldV
     return landPlantHeight(L, h, cx, cz, p, y, tri) && landPlantKept(L, h, snowY, rockCos, p, y, tri);
 }
 
+// The landscape's share of the forest-level LB grid (core/terrain/landscape_light.h): a lattice over the
+// terrain frame whose node value (per channel, w unused) scales the LB lighting of the plants there.
+// dims.x == 0: none (factor 1). 32 bytes.
+struct LandLightLayout {
+    glm::vec3 origin;                // terrain frame, node (0, 0, 0)
+    float invSpacing;
+    glm::ivec3 dims;
+    uint32_t pad;
+};
+
+// The factor at terrain-frame point p: trilinear over the nodes (z fastest, as GridGeometry::index),
+// clamped to the lattice; the ground's nodes hold the light of the first open node above them.
+SYLVA_HD inline glm::vec3 landLightFactor(const LandLightLayout& L, const glm::vec4* nodes, const glm::vec3& p)
+{
+    if (L.dims.x == 0) return glm::vec3(1.0f);
+    const glm::vec3 g = (p - L.origin) * L.invSpacing;
+    const glm::vec3 c = glm::clamp(g, glm::vec3(0.0f), glm::vec3(L.dims - 1) - 1e-4f);
+    const glm::ivec3 i = glm::ivec3(c);
+    const glm::vec3 f = c - glm::vec3(i);
+    glm::vec3 out(0.0f);
+    for (int corner = 0; corner < 8; ++corner) {
+        const int dx = corner >> 2, dy = (corner >> 1) & 1, dz = corner & 1;
+        const float w = (dx ? f.x : 1.0f - f.x) * (dy ? f.y : 1.0f - f.y) * (dz ? f.z : 1.0f - f.z);
+        out += w * glm::vec3(nodes[(size_t(i.x + dx) * size_t(L.dims.y) + size_t(i.y + dy)) * size_t(L.dims.z) + size_t(i.z + dz)]);
+    }
+    return out;
+}
+
 } // namespace sylva

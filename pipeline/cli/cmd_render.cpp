@@ -120,7 +120,7 @@ void printStats(const AccelStats& st, const RenderTimings& timings, const Render
         std::printf("landscape: %zu cells, %zu tiles of %zu-%zu plants, %.3g potentially visible instances, %.3g triangles, %.1f MB, built in %.2f s\n",
                     st.landscape.cells, st.landscape.tiles, st.landscape.plantsPerTileMin, st.landscape.plantsPerTileMax, st.landscape.instances,
                     st.landscape.triangles, double(st.landscapeBytes) / 1e6, st.landscape.buildSeconds);
-    std::fputs(forestGridLine(st.forestGrid).c_str(), stdout);
+    std::fputs(forestGridLine(st.forestGrid, st.landscapeLight).c_str(), stdout);
     if (r.mode == RenderMode::Ambient) std::printf("ambient constant %.4f\n", ambient);
 }
 

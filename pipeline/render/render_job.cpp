@@ -221,6 +221,8 @@ RenderScene prepareRenderScene(const Scene& scene, GridCache* cache, Progress* p
     RenderScene rs = buildRenderScene(scene.volumes.empty() ? scene : lit, assets, sunRadiance(scene.sun), &buildProgress);
     const ForestGridStats& fg = rs.stats().forestGrid;
     if (log && fg.solved) log->stages.push_back(fg.applied ? "forest grid" : "forest grid skipped (exposure uniform)");
+    const LandscapeLightStats& lg = rs.stats().landscapeLight;
+    if (log && lg.solved) log->stages.push_back(lg.applied ? "landscape forest grid" : "landscape forest grid skipped (exposure uniform)");
     if (log) log->stages.push_back("build");
     timings.build = secondsSince(t0);
     return rs;

@@ -642,13 +642,16 @@ const Table<LightingDesc>& sceneLightingTable()
             .doc("string",
                  "the forest-level LB grid (seed 000 section 3): `off` (default: every instance of a species lit alike), `on` "
                  "(each instance's species lighting scaled by the grid's factors: stand interiors darker, the open side of an "
-                 "edge tree lit), `auto` (as `on` where the factors spread by 2% or more, else skipped; `render --stats` says which)")
+                 "edge tree lit), `auto` (as `on` where the factors spread by 2% or more, else skipped; `render --stats` says which). "
+                 "With a landscape, its tile plants too: one lattice over the terrain whose ground is opaque, valley and shaded-slope "
+                 "plants darker than ridge plants ([RENDERING.md](RENDERING.md))")
             .summarized([](const LightingDesc& l) { return std::string("forest grid ") + forestGridModeName(l.forestGrid); });
         b.integer("forest_grid_resolution", &LightingDesc::forestGridResolution, 0, 512)
             .doc("integer", "forest grid nodes along the plants' longest horizontal extent, 4 .. 512, or 0 (the default): "
                                 "automatic, 4 nodes across the median crown and at most 32 (the picture improves over no forest "
                                 "grid from about 4 cells a crown: [ACCURACY.md](ACCURACY.md) \"Scene scale\"); build + solve "
-                                "time in [PERFORMANCE.md](PERFORMANCE.md)")
+                                "time in [PERFORMANCE.md](PERFORMANCE.md). A landscape's lattice: 0 gives 64 nodes along the terrain's longer "
+                                "side, other values are clamped to 128")
             .thenCheck([](JsonReader& r, const QJsonObject&, const KeyPath& path, LightingDesc& l) {
                 if (l.forestGridResolution > 0 && l.forestGridResolution < 4)
                     r.fail(path.field("forest_grid_resolution"), "expected 0 (automatic) or 4 .. 512, got " + std::to_string(l.forestGridResolution));

@@ -16,7 +16,8 @@ AccelSummary summarizeAccel(const AccelStats& stats);
 
 // `sylva render --stats`'s line on the forest-level LB grid (lighting.forest_grid): mode, resolution and
 // dims, build + solve time, the factors' min / median / max over instances, and whether it was applied or
-// skipped (auto, exposure uniform); empty when the scene has it off.
-std::string forestGridLine(const ForestGridStats& stats);
+// skipped (auto, exposure uniform); and a second line on its share over the landscape's plants
+// (LandscapeLightStats) where the scene has a landscape; empty when the scene has it off.
+std::string forestGridLine(const ForestGridStats& stats, const LandscapeLightStats& landscape);
 
 } // namespace sylva

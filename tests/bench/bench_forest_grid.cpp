@@ -1,6 +1,9 @@
 // The forest-level LB grid on the default forest (issue 18 item 1): build + solve time at a few resolutions,
 // with the factor range it gives. Species densities come from loadSpeciesGrids (through a grid cache in
-// $TMPDIR so reruns skip the per-species solves); only the timed part is the forest grid.
+// $TMPDIR so reruns skip the per-species solves); only the timed part is the forest grid. Then its share over
+// the bundled landscape (resources/landscape.sylva.json: the St Helens DEM, 125^2 cells of Wang tiles): the
+// lattice's build (which plants grow, their canopy per cell, the ground) + solve at a few resolutions,
+// against the scalar loop's node updates (the floor: each node-step reads and writes 19 directions).
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -9,25 +12,68 @@
 #include <string>
 
 #include "core/lb/forest_grid.h"
+#include "core/render/render_scene.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/scene/scene_file.h"
 
 using namespace sylva;
+
+namespace {
+
+void benchLandscape(int reps, GridCache& cache)
+{
+    Scene scene = readSceneFile(std::string(SYLVA_SOURCE_DIR) + "/resources/landscape.sylva.json");
+    scene.lighting.forestGrid = ForestGridMode::On;
+    const std::vector<SpeciesAssets> assets = loadSpeciesAssets(scene, &cache, true);
+    RenderScene rs = buildSceneGeometry(scene, assets);
+    const LandscapeStats& ls = rs.stats().landscape;
+    std::printf("forest grid over the landscape: %zu cells, %.3g potentially visible plants\n", ls.cells, ls.instances);
+    for (int res : {lb::kAutoResolution, 32, 96, 128}) {
+        scene.lighting.forestGridResolution = res;
+        std::vector<double> t;
+        for (int k = 0; k < reps; ++k) {
+            buildLandscapeArrays(rs, scene);   // the landscape's arrays (timed apart, in its stats) and the lattice
+            t.push_back(rs.stats().landscapeLight.seconds);
+        }
+        std::sort(t.begin(), t.end());
+        const LandscapeLightStats& st = rs.stats().landscapeLight;
+        const double nodeSteps = double(st.dims.x) * st.dims.y * st.dims.z * 2.0 * std::max({st.dims.x, st.dims.y, st.dims.z}) * 3.0;
+        const std::string key = res == lb::kAutoResolution ? std::string("auto") : std::to_string(res);
+        std::printf("  resolution %s: %d, %dx%dx%d nodes of %.0f m, %.3g plants growing in %zu cells (%.3g tested); median %.3f s; factors "
+                    "%.3f / %.3f / %.3f (min / median / max over cells); %.3g node-steps (x 3 channels), %.1f ns each\n",
+                    key.c_str(), st.resolution, st.dims.x, st.dims.y, st.dims.z, st.spacing, st.plantsGrowing, st.cells, st.plantsTested,
+                    t[t.size() / 2], double(st.minFactor), double(st.medianFactor), double(st.maxFactor), nodeSteps, 1e9 * t[t.size() / 2] / nodeSteps);
+        std::printf("landscape_grid_%s_resolution=%d\nlandscape_grid_%s_s=%.4f\nlandscape_grid_%s_ns_per_node_step=%.2f\n"
+                    "landscape_grid_%s_min_factor=%.4f\nlandscape_grid_%s_max_factor=%.4f\n",
+                    key.c_str(), st.resolution, key.c_str(), t[t.size() / 2], key.c_str(), 1e9 * t[t.size() / 2] / nodeSteps, key.c_str(),
+                    double(st.minFactor), key.c_str(), double(st.maxFactor));
+    }
+}
+
+} // namespace
 
 int main(int argc, char** argv)
 {
     int reps = 3;
+    bool landscape = true, forest = true;
     for (int a = 1; a < argc; ++a) {
         const std::string s = argv[a];
         if (s == "--reps" && a + 1 < argc) reps = std::atoi(argv[++a]);
+        else if (s == "--no-landscape") landscape = false;
+        else if (s == "--landscape-only") forest = false;
         else {
-            std::printf("usage: bench_forest_grid [--reps R]\n");
+            std::printf("usage: bench_forest_grid [--reps R] [--no-landscape | --landscape-only]\n");
             return s == "--help" ? 0 : 2;
         }
     }
-    const Scene scene = defaultScene();
     const char* tmp = std::getenv("TMPDIR");
     GridCache cache(std::string(tmp ? tmp : "/tmp") + "/sylva_bench_forest_grid_cache");
+    if (!forest) {
+        benchLandscape(reps, cache);
+        return 0;
+    }
+    const Scene scene = defaultScene();
     std::vector<lb::ForestSpecies> species;
     for (size_t s = 0; s < scene.species.size(); ++s) species.push_back(lb::forestSpecies(loadSpeciesGrids(scene, s, &cache).density));
     std::vector<lb::ForestPlant> plants;
@@ -73,5 +119,6 @@ int main(int argc, char** argv)
         std::printf("forest_grid_%s_s=%.4f\nforest_grid_%s_min_factor=%.4f\nforest_grid_%s_max_factor=%.4f\n", key.c_str(), t[t.size() / 2], key.c_str(),
                     double(r.minFactor), key.c_str(), double(r.maxFactor));
     }
+    if (landscape) benchLandscape(reps, cache);
     return 0;
 }

@@ -13,6 +13,7 @@
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/render/shade.h"
+#include "core/terrain/landscape_light.h"
 #include "small_forest.h"
 
 using namespace sylva;
@@ -59,6 +60,39 @@ Scene stand(const lb::ForestSpecies& f, double gap)
     s.render.spp = 1;
     s.render.mode = RenderMode::Lb;
     s.lighting.forestGridResolution = 32;
+    return s;
+}
+
+// A landscape of shrubs in a V valley along z (121 m across, walls rising 0.6 m per metre), lit by a low sun
+// from +x, seen from above the valley's south end looking north along it.
+Scene valley(const lb::ForestSpecies& f)
+{
+    Scene s;
+    s.species.resize(1);
+    s.species[0].name = "shrub";
+    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    constexpr uint32_t n = 121;
+    std::vector<float> hts(size_t(n) * n);
+    for (uint32_t j = 0; j < n; ++j)
+        for (uint32_t i = 0; i < n; ++i) hts[size_t(j) * n + i] = 0.6f * std::fabs(float(i) - 60.0f);
+    s.terrain.dem = "(in memory)";
+    s.terrain.spacing = 1.0;
+    s.terrain.field = std::make_shared<const HeightField>(buildHeightField(std::move(hts), n, n, 1.0f, 1.0f));
+    s.terrain.cells = 6;
+    s.terrain.tiles.size = 20.0;
+    TilePlantDesc p;
+    p.species = 0;
+    p.speciesName = "shrub";
+    p.spacing = 1.2 * std::max(f.boxMax.x - f.boxMin.x, f.boxMax.z - f.boxMin.z);
+    s.terrain.tiles.plants = {p};
+    s.camera.position = {60.0, 75.0, -25.0};
+    s.camera.target = {60.0, 5.0, 60.0};
+    s.camera.fovY = 50.0f;
+    s.sun.direction = {0.9f, 0.42f, 0.0f};
+    s.render.width = 64;
+    s.render.height = 64;
+    s.render.spp = 1;
+    s.render.mode = RenderMode::Lb;
     return s;
 }
 
@@ -156,6 +190,54 @@ private Q_SLOTS:
                 ++checked;
             }
         QVERIFY(checked > 200);
+    }
+
+    // The landscape's plants: per pixel, the indirect light with the grid on is the one with it off times the
+    // landscape lattice's factor at the hit (the renderer applies what the lattice gave), and the valley's
+    // floor comes out darker against its ridges than with the grid off.
+    void landscapeValleyDarkerThanRidges()
+    {
+        Scene s = valley(m_assets[0].forest);
+        s.lighting.forestGrid = ForestGridMode::Off;
+        const RenderScene off = buildRenderScene(s, m_assets, glm::vec3(1.0f));
+        QVERIFY(!off.stats().landscapeLight.solved && off.landLight.empty());
+        s.lighting.forestGrid = ForestGridMode::Auto;
+        const RenderScene on = buildRenderScene(s, m_assets, glm::vec3(1.0f));
+        const LandscapeLightStats& st = on.stats().landscapeLight;
+        QVERIFY2(st.solved && st.applied && !st.skipped, qPrintable(QString("spread %1").arg(double(st.spread))));
+        QVERIFY(!on.stats().forestGrid.solved);   // no top-level instances
+        const Film fa = renderFilm(off.view()), fb = renderFilm(on.view());
+        const RenderView v = on.view();
+        double floorOn = 0.0, floorOff = 0.0, ridgeOn = 0.0, ridgeOff = 0.0;
+        int plants = 0, floors = 0, ridges = 0;
+        for (int y = 0; y < fa.height; ++y)
+            for (int x = 0; x < fa.width; ++x) {
+                Hit hit{};
+                const Ray ray = cameraRay(v, float(x) + 0.5f, float(y) + 0.5f);
+                const size_t k = size_t(y) * size_t(fa.width) + size_t(x);
+                if (!intersectStage(v, ray, hit) || hit.inst != kLandscapeInst) {
+                    QCOMPARE(fb.pixels[k].indirect, fa.pixels[k].indirect);   // the ground and the sky: no factor
+                    continue;
+                }
+                const glm::vec3 p = ray.org + hit.t * ray.dir - v.terrainOrigin;
+                const glm::vec3 f = landLightFactor(v.landLightLayout, v.landLight, p);
+                for (int c = 0; c < 3; ++c) {
+                    QVERIFY(f[c] > 0.0f && f[c] < 1.2f);
+                    QVERIFY(std::fabs(fb.pixels[k].indirect[c] - fa.pixels[k].indirect[c] * f[c]) <= 1e-5f + 1e-5f * fa.pixels[k].indirect[c]);
+                }
+                ++plants;
+                const auto lum = [](const glm::vec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; };
+                if (std::fabs(p.x - 60.0f) < 12.0f) floorOn += lum(fb.pixels[k].indirect), floorOff += lum(fa.pixels[k].indirect), ++floors;
+                if (std::fabs(p.x - 60.0f) > 45.0f) ridgeOn += lum(fb.pixels[k].indirect), ridgeOff += lum(fa.pixels[k].indirect), ++ridges;
+            }
+        qInfo("%d plant pixels (%d on the floor, %d on the ridges); floor / ridge luminance: grid on %.3f, off %.3f; factors %.3f / %.3f / %.3f",
+              plants, floors, ridges, (floorOn / floors) / (ridgeOn / ridges), (floorOff / floors) / (ridgeOff / ridges), double(st.minFactor),
+              double(st.medianFactor), double(st.maxFactor));
+        QVERIFY(plants > 800 && floors > 100 && ridges > 50);
+        // The walls (31 degrees) stand above the sun (25) but below the lattice's 45-degree direction: the floor
+        // loses the sun's level share, the ridges' first columns keep it (tst_landscape_light has the steep valley).
+        QVERIFY((floorOn / floors) / (ridgeOn / ridges) < 0.98 * (floorOff / floors) / (ridgeOff / ridges));
+        QVERIFY(st.minFactor < 0.5f * st.maxFactor);
     }
 
     // Auto on a stand whose plants stand far apart (off each other's lattice lines, as tst_forest_grid's
