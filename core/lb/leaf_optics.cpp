@@ -32,7 +32,7 @@ LeafOptics leafOptics(const LbParams& params)
 ScatteredWeights scatteredWeights(const LbParams& params)
 {
     const LeafOptics o = leafOptics(params);
-    return {(glm::vec3(1.0f) + o.ratio) * 0.25f, 0.25f};
+    return {(glm::vec3(1.0f) + o.ratio) * 0.25f, 0.25f, kMaxLeafScattering * 0.25f};
 }
 
 } // namespace sylva::lb

@@ -29,9 +29,15 @@ LeafOptics leafOptics(const LbParams& params);
 // The weights the renderer multiplies kd x L x sunRadiance by under `lighting.direct` once: leaves
 // (1 + t) / 4 per channel, bark 1 / 4. (The seed's sum weighs the grid by 1: its grid is mostly the
 // unscattered sun, a beam, which the seed shows as if it met every face head on.)
+// A leaf scatters (reflects plus transmits) at most this share of the light it receives, whatever its
+// texture colour kd and the preset's t: kd x (1 + t) is capped at it per channel (kd x (1 + t) exceeds 1
+// for a bright green texel under the leaf preset's t = 1.31). The Blender export caps its translucent
+// BSDF by the same rule, kd + kd x t <= kMaxLeafScattering.
+inline constexpr float kMaxLeafScattering = 0.98f;
 struct ScatteredWeights {
     glm::vec3 leaf;
     float bark;
+    float leafCap;   // kd x leaf never exceeds it per channel: kMaxLeafScattering / 4
 };
 ScatteredWeights scatteredWeights(const LbParams& params);
 

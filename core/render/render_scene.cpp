@@ -6,6 +6,7 @@
 #include <array>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <tbb/parallel_for.h>
 
@@ -592,6 +593,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
         SpeciesRecord sr{};
         sr.leafIndirect = glm::vec3(1.0f);
         sr.barkIndirect = 1.0f;
+        sr.leafIndirectCap = std::numeric_limits<float>::max();   // the seed's sum: kd x L, uncapped (old pictures)
 
         // Lighting grid, normalized by the unobstructed photon density.
         const LightingGrid& g = a.lighting;
@@ -610,6 +612,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
                 const lb::ScatteredWeights w = lb::scatteredWeights(scene.species[s].lighting);
                 sr.leafIndirect = w.leaf;
                 sr.barkIndirect = w.bark;
+                sr.leafIndirectCap = w.leafCap;
             }
         }
         rs.species.push_back(sr);

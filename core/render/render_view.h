@@ -117,8 +117,10 @@ struct SpeciesRecord {
     uint32_t gridOffset;     // into RenderView::lighting (3 floats per node, already normalized)
     glm::vec3 leafIndirect;  // leaf materials: kd x L x sunRadiance x this
     float barkIndirect;      // other materials
+    float leafIndirectCap;   // per channel, kd x leafIndirect is at most this (energy: lb::ScatteredWeights::leafCap)
+    uint32_t pad[3];
 };
-static_assert(sizeof(SpeciesRecord) == 48);
+static_assert(sizeof(SpeciesRecord) == 64);
 
 // A surface material for shading. Texture indices are into RenderView::textures, -1 = none. 48 bytes.
 struct MaterialRecord {

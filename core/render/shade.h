@@ -226,6 +226,9 @@ SYLVA_HD inline SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, c
     }
     s.albedo = kd;
     s.indirectWeight = m.isLeaf ? sp.leafIndirect : glm::vec3(sp.barkIndirect);
+    if (m.isLeaf)   // a leaf scatters at most kMaxLeafScattering of what it receives (leaf_optics.h)
+        for (int c = 0; c < 3; ++c)
+            if (kd[c] * s.indirectWeight[c] > sp.leafIndirectCap) s.indirectWeight[c] = sp.leafIndirectCap / kd[c];
     s.specular = m.specular;
     s.shininess = m.shininess;
     s.extent = in.scale * fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/base/error.h"
+#include "core/lb/leaf_optics.h"
 #include "core/render/render_scene.h"
 #include "pipeline/io/atomic_file.h"
 #include "pipeline/io/image_io.h"
@@ -142,6 +143,7 @@ std::string writeBlenderScene(const Scene& scene, const std::vector<SpeciesAsset
     py << "SAMPLES = arg('--samples', " << o.samples << ")\nSEED = arg('--seed', " << o.seed << ")\nTHREADS = arg('--threads', "
        << o.threads << ")\nOUT = arg('--out', " << pyString(o.exrPath) << ")\nSUN_ON = arg('--sun', 1)\nSKY_ON = arg('--sky', 1)\nTRANS_ON = arg('--translucent', 1)\nGROUND_ON = arg('--ground', 1)\n";
     py << "DATA = " << pyString(base) << "\n";
+    py << "LEAF_MAX = " << lb::kMaxLeafScattering << "   # a leaf scatters at most this share (core/lb/leaf_optics.h)\n";
     py << R"PY(
 for ob in list(bpy.data.objects):
     bpy.data.objects.remove(ob, do_unlink=True)
@@ -199,7 +201,7 @@ def image(path, colorspace):
     return img
 
 # Sylva's surface material: kd = diffuse x texture (sRGB decoded, bilinear, wrapped); leaves add
-# diffuse transmission kd x ratio, capped at 0.98 - kd (translucent BSDF); a cut-out (nearest texel, opaque where alpha >= 0.5)
+# diffuse transmission kd x ratio, capped at LEAF_MAX - kd (translucent BSDF); a cut-out (nearest texel, opaque where alpha >= 0.5)
 # lets the ray through as a transparent BSDF.
 # Sylva's Phong term ks x (r . v)^n x sunRadiance (sun only) as a GGX Glossy BSDF of the same peak radiance
 # and about the same lobe: Phong n about the reflection vector is Blinn n' = 4n about the half vector, alpha^2 =
@@ -228,8 +230,8 @@ def material(name, diffuse, leaf, ratio, color_png, mask_png, spec=(0.0, 0.0, 0.
         tr = node(nt, 'ShaderNodeVectorMath', operation='MULTIPLY')
         nt.links.new(col, tr.inputs[0])
         tr.inputs[1].default_value = (ratio[0] * TRANS_ON, ratio[1] * TRANS_ON, ratio[2] * TRANS_ON)
-        room = node(nt, 'ShaderNodeVectorMath', operation='SUBTRACT')   # energy: kd + transmission <= 0.98
-        room.inputs[0].default_value = (0.98, 0.98, 0.98)
+        room = node(nt, 'ShaderNodeVectorMath', operation='SUBTRACT')   # energy: kd + transmission <= LEAF_MAX
+        room.inputs[0].default_value = (LEAF_MAX, LEAF_MAX, LEAF_MAX)
         nt.links.new(col, room.inputs[1])
         cap = node(nt, 'ShaderNodeVectorMath', operation='MINIMUM')
         nt.links.new(tr.outputs[0], cap.inputs[0])

@@ -7,10 +7,13 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <regex>
 #include <sstream>
 
+#include "core/lb/leaf_optics.h"
 #include "core/render/render_scene.h"
+#include "core/render/shade.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
@@ -280,6 +283,45 @@ private Q_SLOTS:
         QVERIFY(std::fabs(rs.species[0].leafIndirect.y - w.leaf.y) < 1e-6f && rs.species[0].barkIndirect == 0.25f);
         const RenderScene rsSeed = buildRenderScene(seed, sum, sunRadiance(seed.sun));
         QVERIFY(rsSeed.species[0].leafIndirect == glm::vec3(1.0f) && rsSeed.species[0].barkIndirect == 1.0f);
+        QCOMPARE(rs.species[0].leafIndirectCap, lb::kMaxLeafScattering / 4.0f);
+        QCOMPARE(rsSeed.species[0].leafIndirectCap, std::numeric_limits<float>::max());   // the seed's sum: uncapped
+    }
+
+    // Energy: under lighting.direct once a leaf face sends back at most kMaxLeafScattering of the scattered
+    // light it receives, kd x (1 + t) / 4 <= 0.98 / 4 per channel, as the Blender export's translucent cap. With
+    // g = 0.9 in green (t = 19) every leaf hit's green is capped and red and blue (the preset's t) are not;
+    // the light stage's indirect part is albedo x weight x L x sunRadiance with that weight.
+    void onceLeafScattersAtMostItsShare()
+    {
+        const Scene s = parseScene(R"({"version": 1, "species": [{"name": "shrub", "grow": {"species": "shrub", "seed": 2, "triangles": 2000},
+            "lighting": {"preset": "leaf", "grid": 12, "g": [-0.12, 0.9, -0.333]}}], "instances": [{"species": "shrub", "position": [0, 0, 0]}],
+            "lighting": {"direct": "once"}, "render": {"width": 48, "height": 32}})", ".", "cap.sylva.json");
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, nullptr, true);
+        const RenderScene rs = buildRenderScene(s, assets, sunRadiance(s.sun));
+        const RenderView v = rs.view();
+        const float cap = lb::kMaxLeafScattering / 4.0f;
+        const glm::vec3 w = rs.species[0].leafIndirect;
+        QVERIFY(w.y * 0.05f > cap);   // green: capped for any kd above 0.05
+        int leaves = 0, cappedGreen = 0;
+        for (int y = 0; y < v.height; ++y)
+            for (int x = 0; x < v.width; ++x) {
+                const Ray ray = cameraRay(v, float(x) + 0.5f, float(y) + 0.5f);
+                Hit hit{};
+                if (!intersectStage(v, ray, hit) || hit.prim == kGroundPrim || hit.inst == kTerrainInst) continue;
+                if (!v.materials[v.triMaterial[hit.prim]].isLeaf) continue;
+                const SurfacePoint sp = surfaceStage(v, ray, hit);
+                ++leaves;
+                for (int c = 0; c < 3; ++c) {
+                    const float want = std::min(sp.albedo[c] * w[c], cap);
+                    QVERIFY2(std::fabs(sp.albedo[c] * sp.indirectWeight[c] - want) <= 1e-5f * std::max(want, 1e-3f),
+                             qPrintable(QString("pixel %1,%2 channel %3: kd %4 x weight %5, want %6").arg(x).arg(y).arg(c).arg(sp.albedo[c]).arg(sp.indirectWeight[c]).arg(want)));
+                }
+                if (sp.albedo.y * w.y > cap) ++cappedGreen;
+                const SampleParts parts = lightStage(v, sp, x, y, 0);
+                const glm::vec3 expect = sp.albedo * sp.lighting * sp.indirectWeight * v.sunRadiance * v.indirectScale;
+                for (int c = 0; c < 3; ++c) QVERIFY(std::fabs(parts.indirect[c] - expect[c]) <= 1e-5f * std::max(expect[c], 1e-3f));
+            }
+        QVERIFY2(leaves > 20 && cappedGreen > leaves / 2, qPrintable(QString("%1 leaf hits, %2 capped in green").arg(leaves).arg(cappedGreen)));
     }
 
     void truthPartSkipsWithQuick()
