@@ -80,6 +80,8 @@ bool refreshSceneSky(const Scene& before, Scene& after, std::string* error)
     bool same = d.built && d.built == o.built && d.kind == o.kind;
     if (d.kind == sky::SkyKind::Preetham)
         same = same && d.turbidity == o.turbidity && d.scale == o.scale && after.sun.direction == before.sun.direction;
+    else if (d.kind == sky::SkyKind::Uniform)
+        same = same && after.sky == before.sky;
     else
         same = same && d.path == o.path && d.rotationDeg == o.rotationDeg && d.intensity == o.intensity && d.sunFromMap == o.sunFromMap;
     if (same) return true;

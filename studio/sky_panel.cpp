@@ -62,6 +62,7 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     m_kind->addItem(tr("Constant colour"), int(sky::SkyKind::Constant));
     m_kind->addItem(tr("Preetham (analytic)"), int(sky::SkyKind::Preetham));
     m_kind->addItem(tr("HDR map"), int(sky::SkyKind::Map));
+    m_kind->addItem(tr("Uniform colour (lights the plants)"), int(sky::SkyKind::Uniform));
     skyForm->addRow(tr("Model"), m_kind);
     connect(m_kind, &QComboBox::currentIndexChanged, this, [this](int idx) {
         const auto kind = sky::SkyKind(m_kind->itemData(idx).toInt());

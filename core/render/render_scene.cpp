@@ -900,7 +900,7 @@ FrameSun frameSun(const Scene& scene, const glm::vec3& sunRadiance)
     if (!(glm::length(sd) > 0.0f)) throw Error("sun: direction must not be zero");
     FrameSun out{glm::normalize(sd), sunRadiance};
     const SkyDesc& skyDesc = scene.skyModel;
-    if (skyDesc.analytic() && skyDesc.built && (skyDesc.kind == sky::SkyKind::Preetham || skyDesc.sunFromMap)) {
+    if (skyDesc.analytic() && skyDesc.built && (skyDesc.kind == sky::SkyKind::Preetham || (skyDesc.kind == sky::SkyKind::Map && skyDesc.sunFromMap))) {
         // The sky's own sun replaces the scene's (scaled by sun.intensity). Its radiance() is the irradiance
         // facing it; the renderer's sun shows albedo x sunRadiance x cos, so the irradiance / pi (the same
         // Lambertian surface the virtual lights light with albedo / pi x their power).

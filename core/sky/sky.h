@@ -143,7 +143,9 @@ SYLVA_HD inline glm::vec3 envMapRadiance(const EnvMapView& m, glm::vec3 d)
     return glm::vec3(p[0], p[1], p[2]) * m.intensity;
 }
 
-enum class SkyKind : int { Constant = 0, Preetham = 1, Map = 2 };
+// Uniform: the scene level only (SkyDesc), the constant colour lighting like a map: loadSceneSky builds it as a
+// uniform Map sky, so no SkyView holds it.
+enum class SkyKind : int { Constant = 0, Preetham = 1, Map = 2, Uniform = 3 };
 
 // Everything per-ray code needs about the sky: plain data (the map's pixels by pointer, owned by Sky).
 struct SkyView {

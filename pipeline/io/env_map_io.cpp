@@ -65,6 +65,20 @@ std::string loadSceneSky(Scene& scene, const EnvMapReader& read)
         d.built = std::make_shared<const sky::Sky>(sky::preethamSky(p, bundledCieTable()));
         return std::string();
     }
+    if (d.kind == sky::SkyKind::Uniform) {
+        // The constant colour as a map: 256 x 128 pixels (more than the virtual lights the defaults ask for), no sun
+        // search (the scene's sun stays).
+        const glm::vec3 c = scene.sky;
+        if (!std::isfinite(c.x + c.y + c.z) || glm::any(glm::lessThan(c, glm::vec3(0.0f))))
+            throw Error("uniform sky: the colour must be finite and >= 0");
+        sky::EnvMap map;
+        map.width = 256;
+        map.height = 128;
+        map.rgb.resize(size_t(map.width) * size_t(map.height) * 3);
+        for (size_t i = 0; i < map.rgb.size(); i += 3) map.rgb[i] = c.x, map.rgb[i + 1] = c.y, map.rgb[i + 2] = c.z;
+        d.built = std::make_shared<const sky::Sky>(sky::mapSky(std::move(map), 0.0f, 1.0f, false));
+        return std::string();
+    }
     EnvMapFile f = read ? read(d.path) : readEnvMap(d.path);
     const std::string summary = envMapCleanSummary(d.path, f);
     d.built = std::make_shared<const sky::Sky>(sky::mapSky(std::move(f.map), d.rotationDeg, d.intensity, d.sunFromMap));

@@ -532,13 +532,14 @@ const char* skyKindName(sky::SkyKind k)
     switch (k) {
     case sky::SkyKind::Preetham: return "preetham";
     case sky::SkyKind::Map: return "hdri";
+    case sky::SkyKind::Uniform: return "uniform";
     default: return "constant";
     }
 }
 
 bool parseSkyKind(const std::string& name, sky::SkyKind* out)
 {
-    for (sky::SkyKind k : {sky::SkyKind::Constant, sky::SkyKind::Preetham, sky::SkyKind::Map})
+    for (sky::SkyKind k : {sky::SkyKind::Constant, sky::SkyKind::Preetham, sky::SkyKind::Map, sky::SkyKind::Uniform})
         if (name == skyKindName(k)) {
             *out = k;
             return true;
@@ -550,14 +551,18 @@ const Table<Scene>& skyTable()
 {
     static const Table<Scene> table = [] {
         TableBuilder<Scene> b(Layout::Inline);
-        b.enumeration("kind", [](auto& s) -> auto& { return s.skyModel.kind; }, parseSkyKind, skyKindName, "sky kind", "constant, preetham, hdri")
-            .doc("string", "`constant` (`color` everywhere), `preetham` (Preetham et al. 1999, the sun's direction), `hdri` (an equirectangular map, `path`)")
+        b.enumeration("kind", [](auto& s) -> auto& { return s.skyModel.kind; }, parseSkyKind, skyKindName, "sky kind", "constant, preetham, hdri, uniform")
+            .doc("string",
+                 "`constant` (`color` everywhere: the background and the ground's ambient light; leaves and bark get none), "
+                 "`preetham` (Preetham et al. 1999, the sun's direction), `hdri` (an equirectangular map, `path`), `uniform` (`color` "
+                 "everywhere as a map: its virtual lights light leaves, bark and ground with shadow rays, the closer one to a path "
+                 "tracer: [ACCURACY.md](ACCURACY.md) \"Ground truth\")")
             .writtenIf([](const Scene& s) { return s.skyModel.analytic(); })
             .summarized([](const Scene& s) { return std::string(skyKindName(s.skyModel.kind)) + " sky"; });
         b.color("color", &Scene::sky, 0.0f, kNoUpperBound)
-            .doc("`[r, g, b]`", "the constant sky's radiance, each >= 0 (background and the ground's ambient light)")
-            .writtenIf([](const Scene& s) { return !s.skyModel.analytic(); })
-            .summarized([](const Scene& s) { return s.skyModel.analytic() ? std::string() : "radiance " + human3(s.sky); });
+            .doc("`[r, g, b]`", "`constant`, `uniform`: the sky's radiance, each >= 0")
+            .writtenIf([](const Scene& s) { return s.skyModel.hasColor(); })
+            .summarized([](const Scene& s) { return s.skyModel.hasColor() ? "radiance " + human3(s.sky) : std::string(); });
         b.number("turbidity", [](auto& s) -> auto& { return s.skyModel.turbidity; }, Bounds{.lo = sky::kMinTurbidity, .hi = sky::kMaxTurbidity})
             .doc("number", "`preetham`: atmospheric turbidity, 2 .. 10")
             .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Preetham; })
@@ -588,7 +593,7 @@ const Table<Scene>& skyTable()
             .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Map; });
         b.integer("lights", [](auto& s) -> auto& { return s.skyModel.lights; }, sky::kMinVirtualLights, sky::kMaxVirtualLights)
             .doc("integer",
-                 "`preetham`, `hdri`: virtual directional lights the sky is split into (equal power), 1 .. 65536; the default 64 "
+                 "`preetham`, `hdri`, `uniform`: virtual directional lights the sky is split into (equal power), 1 .. 65536; the default 64 "
                  "is provisional (not yet measured on the speed/accuracy front)")
             .writtenIf([](const Scene& s) { return s.skyModel.analytic(); })
             .summarized([](const Scene& s) {
@@ -597,7 +602,7 @@ const Table<Scene>& skyTable()
             });
         b.integer("interleave", [](auto& s) -> auto& { return s.skyModel.interleave; }, 1, sky::kMaxVirtualLights)
             .doc("integer",
-                 "`preetham`, `hdri`: K subsets of the lights, one per pixel of each K-pixel block and cycled over the samples "
+                 "`preetham`, `hdri`, `uniform`: K subsets of the lights, one per pixel of each K-pixel block and cycled over the samples "
                  "(lights / K shadow rays a pixel and sample; spp >= K uses every light in every pixel), 1 .. `lights`; default 8 "
                  "(provisional)")
             .writtenIf([](const Scene& s) { return s.skyModel.analytic(); });
@@ -607,15 +612,15 @@ const Table<Scene>& skyTable()
                 if (o.contains(QLatin1String(key)) && !allowed)
                     r.fail(path.field(key), std::string("only with kind ") + kinds + " (the sky is " + skyKindName(d.kind) + ")");
             };
-            only("color", !d.analytic(), "constant");
+            only("color", d.hasColor(), "constant or uniform");
             only("turbidity", d.kind == sky::SkyKind::Preetham, "preetham");
             only("scale", d.kind == sky::SkyKind::Preetham, "preetham");
             only("path", d.kind == sky::SkyKind::Map, "hdri");
             only("rotation_deg", d.kind == sky::SkyKind::Map, "hdri");
             only("intensity", d.kind == sky::SkyKind::Map, "hdri");
             only("sun_from_map", d.kind == sky::SkyKind::Map, "hdri");
-            only("lights", d.analytic(), "preetham or hdri");
-            only("interleave", d.analytic(), "preetham or hdri");
+            only("lights", d.analytic(), "preetham, hdri or uniform");
+            only("interleave", d.analytic(), "preetham, hdri or uniform");
             if (d.kind == sky::SkyKind::Map && d.path.empty()) r.fail(path.field("path"), "missing (required with kind hdri: the map)");
             if (d.interleave > d.lights)
                 r.fail(path.field("interleave"), "must be at most lights (" + std::to_string(d.lights) + "), got " + std::to_string(d.interleave));
@@ -635,7 +640,7 @@ const Table<LightingDesc>& sceneLightingTable()
             .doc("string",
                  "`seed`: the grid as solved is added to the shadow-rayed sun (the seed's sum: direct light counted twice inside "
                  "crowns; the default, closer to Cycles under the constant sky); `once`: the grid less its uncollided sunlight, "
-                 "weighed as light from all directions (leaves kd x (1 + t) / 4, bark kd / 4), so it adds only scattered light "
+                 "weighed as light from all directions (leaves min(kd x (1 + t), 0.98) / 4 per channel, bark kd / 4), so it adds only scattered light "
                  "(closer to Cycles under a Preetham or map sky: [ACCURACY.md](ACCURACY.md))")
             .summarized([](const LightingDesc& l) { return std::string("direct light ") + directLightName(l.direct); });
         b.enumeration("forest_grid", &LightingDesc::forestGrid, parseForestGridMode, forestGridModeName, "forest grid", "off, auto, on")

@@ -125,7 +125,7 @@ std::string writeBlenderScene(const Scene& scene, const std::vector<SpeciesAsset
     if (scene.terrain.enabled()) throw Error("Blender export: a scene with a terrain is not supported (the ground plane only)");
     if (!scene.groups.empty()) throw Error("Blender export: instance groups are not supported (species instances only)");
     if (assets.size() != scene.species.size()) throw Error("Blender export: the species' assets are not loaded");
-    if (scene.skyModel.analytic() && skyExr.empty())
+    if (scene.skyModel.analytic() && !scene.skyModel.hasColor() && skyExr.empty())
         throw Error("Blender export: a Preetham or map sky needs its equirectangular EXR (sylva sky -o FILE.exr)");
     std::error_code ec;
     fs::create_directories(dir, ec);

@@ -2,7 +2,7 @@
 // else renders albedo / pi x the map's upper-hemisphere irradiance (integrated here over the map's pixels);
 // a uniform map gives the closed form L; interleaved subsets accumulated over samples equal / converge to
 // the all-lights picture; plants shade the floor under the sky lights; camera rays that leave the scene see
-// the map; a Preetham sky renders finite and lit; old constant-sky files keep their meaning; bad sky keys
+// the map; `sky.kind` uniform lights like a map of its colour; a Preetham sky renders finite and lit; old constant-sky files keep their meaning; bad sky keys
 // are refused.
 #include <QDir>
 #include <QTemporaryDir>
@@ -185,6 +185,61 @@ private Q_SLOTS:
                 for (int k = 0; k < 3; ++k) QCOMPARE(sky[i][k], L[k]);
             }
         }
+    }
+
+    // `sky.kind` uniform: the constant colour as a map. It reads and writes back; the scene's sun stays (no sun
+    // search in a uniform map); the white ground shows the colour L (the constant sky's closed form, within 1% at
+    // 256 lights) and the sky pixels L; and unlike the constant sky it lights the plants: with the sun off, the
+    // constant sky leaves every plant pixel's local part 0, the uniform sky lights them all.
+    void uniformSkyLightsPlants()
+    {
+        QTemporaryDir dir;
+        const std::string text = R"({"version": 1, "species": [{"name": "b", "grow": {"species": "shrub", "triangles": 1500}}],
+            "instances": [{"species": "b", "position": [0, -1000, 0]}],
+            "sky": {"kind": "uniform", "color": [0.3, 0.5, 0.9], "lights": 256, "interleave": 1}})";
+        const Scene parsed = parseScene(text, dir.path().toStdString(), "uniform.json");
+        QCOMPARE(parsed.skyModel.kind, sky::SkyKind::Uniform);
+        const glm::vec3 L(0.3f, 0.5f, 0.9f);
+        QCOMPARE(parsed.sky, L);
+        const Scene again = parseScene(sceneToJson(parsed, dir.path().toStdString()), dir.path().toStdString(), "again.json");
+        QCOMPARE(again.skyModel.kind, sky::SkyKind::Uniform);
+        QCOMPARE(again.sky, L);
+        QCOMPARE(again.skyModel.lights, 256);
+
+        Scene s = openGround();
+        s.sky = L;
+        s.skyModel = parsed.skyModel;
+        s.sun.direction = glm::vec3(0.3f, 0.5f, 0.6f);
+        s.sun.intensity = 1.0f;
+        loadSceneSky(s);
+        QVERIFY(s.skyModel.built && s.skyModel.built->kind == sky::SkyKind::Map);
+        QCOMPARE(composeSky(s), glm::vec3(0.0f));
+        const FrameSun fs = frameSun(s, glm::vec3(0.7f));
+        QCOMPARE(fs.direction, glm::normalize(s.sun.direction));
+        QCOMPARE(fs.radiance, glm::vec3(0.7f));
+        s.sun.intensity = 0.0f;
+        for (const glm::vec3& c : picture(s, m_shrub))
+            for (int k = 0; k < 3; ++k) QVERIFY2(std::abs(c[k] - L[k]) <= 0.01f * L[k], qPrintable(QString("%1 vs %2").arg(c[k]).arg(L[k])));
+        s.camera.position = {0.0, 1.0, 0.0};
+        s.camera.target = {0.0, 5.0, 1.0};
+        for (const glm::vec3& c : composeMode(film(s, m_shrub), RenderMode::Full, composeSky(s)))
+            for (int k = 0; k < 3; ++k) QCOMPARE(c[k], L[k]);
+
+        Scene constant = shrubPatch();
+        constant.sky = L;
+        Scene uniform = constant;
+        uniform.skyModel = s.skyModel;
+        const Film fc = film(constant, m_shrub), fu = film(uniform, m_shrub);
+        int plants = 0, lit = 0;
+        for (size_t i = 0; i < fc.pixels.size(); ++i) {
+            const SampleParts &c = fc.pixels[i], &u = fu.pixels[i];
+            if (c.skyCover != 0.0f || c.normal.y == 1.0f) continue;   // sky or floor
+            ++plants;
+            QCOMPARE(c.local, glm::vec3(0.0f));
+            lit += luminance(glm::dvec3(u.local)) > 0.0 ? 1 : 0;   // a leaf every light's shadow ray misses stays dark
+        }
+        QVERIFY(plants > 100);
+        QVERIFY2(lit >= plants * 95 / 100, qPrintable(QString("%1 of %2 plant pixels lit by the uniform sky").arg(lit).arg(plants)));
     }
 
     // Interleaved sampling: on the open ground (every light visible everywhere) K subsets cycled over
@@ -391,6 +446,8 @@ private Q_SLOTS:
             {R"({"turbidity": 3})", "sky.turbidity"},
             {R"({"kind": "preetham", "color": [1, 1, 1]})", "sky.color"},
             {R"({"kind": "preetham", "path": )" + path + "}", "sky.path"},
+            {R"({"kind": "uniform", "path": )" + path + "}", "sky.path"},
+            {R"({"kind": "uniform", "turbidity": 3})", "sky.turbidity"},
             {R"({"kind": "preetham", "lights": 0})", "sky.lights"},
             {R"({"kind": "preetham", "lights": 70000})", "sky.lights"},
             {R"({"kind": "preetham", "lights": 16, "interleave": 32})", "sky.interleave"},
