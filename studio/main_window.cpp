@@ -27,6 +27,7 @@
 
 #include "pipeline/backend_select.h"
 #include "pipeline/cache/grid_cache.h"
+#include "pipeline/io/env_map_io.h"
 #include "pipeline/render/render_job.h"
 #include "studio/autosave_controller.h"
 #include "studio/background_priority.h"
@@ -408,7 +409,9 @@ bool MainWindow::newScene()
 {
     if (!maybeSave()) return false;
     m_lighting->cancel();   // exports of the old scene may finish
-    m_doc->reset(Scene{}, QString());
+    Scene fresh = newSceneDefaults();
+    loadSceneSky(fresh);   // a uniform sky: built from the colour, cannot fail
+    m_doc->reset(fresh, QString());
     appendLog(tr("new scene"));
     return true;
 }

@@ -73,4 +73,12 @@ glm::vec3 sunDirection(double elevationDeg, double azimuthDeg)
     return glm::vec3(float(std::cos(el) * std::sin(az)), float(std::sin(el)), float(std::cos(el) * std::cos(az)));
 }
 
+Scene newSceneDefaults()
+{
+    Scene s;
+    s.skyModel.kind = sky::SkyKind::Uniform;
+    s.lighting.direct = DirectLight::Once;
+    return s;
+}
+
 } // namespace sylva

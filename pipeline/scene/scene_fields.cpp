@@ -639,9 +639,10 @@ const Table<LightingDesc>& sceneLightingTable()
         b.enumeration("direct", &LightingDesc::direct, parseDirectLight, directLightName, "direct light", "seed, once")
             .doc("string",
                  "`seed`: the grid as solved is added to the shadow-rayed sun (the seed's sum: direct light counted twice inside "
-                 "crowns; the default, closer to Cycles under the constant sky); `once`: the grid less its uncollided sunlight, "
-                 "weighed as light from all directions (leaves min(kd x (1 + t), 0.98) / 4 per channel, bark kd / 4), so it adds only scattered light "
-                 "(closer to Cycles under a Preetham or map sky: [ACCURACY.md](ACCURACY.md))")
+                 "crowns; the default of scene files, so old ones keep their picture); `once`: the grid less its uncollided sunlight, "
+                 "weighed as light from all directions (leaves min(kd x (1 + t), 0.98) / 4 per channel, bark kd / 4), so it adds only "
+                 "scattered light (closer to Cycles on the stand, the forest and under a Preetham or map sky; with `sky.kind` uniform "
+                 "the closest on every scene measured, and what a new scene in the studio starts with: [ACCURACY.md](ACCURACY.md))")
             .summarized([](const LightingDesc& l) { return std::string("direct light ") + directLightName(l.direct); });
         b.enumeration("forest_grid", &LightingDesc::forestGrid, parseForestGridMode, forestGridModeName, "forest grid", "off, auto, on")
             .doc("string",

@@ -466,6 +466,10 @@ private Q_SLOTS:
         const std::string saved = sceneToJson(scene(), base);
         QVERIFY(m_win->newScene());
         QVERIFY(scene().species.empty());
+        // A new scene starts on the lighting closest to Cycles (newSceneDefaults), its sky built.
+        QCOMPARE(scene().skyModel.kind, sky::SkyKind::Uniform);
+        QCOMPARE(scene().lighting.direct, DirectLight::Once);
+        QVERIFY(scene().skyModel.built != nullptr);
         QVERIFY(m_win->openFile(path));
         QCOMPARE(m_prompts, 0);
         QCOMPARE(QString::fromStdString(sceneToJson(scene(), base)), QString::fromStdString(saved));
