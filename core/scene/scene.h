@@ -132,7 +132,7 @@ struct SkyDesc {
     bool sunFromMap = true;              // map: its sun found, taken out and made the sun (replacing `sun`)
     // The built sky (pipeline/io/env_map_io: loadSceneSky), shared by the scene's copies; not in the file.
     std::shared_ptr<const sky::Sky> built;
-    // Lit through virtual lights (shadow rays, the LB boundary) with its own background: every kind but Constant.
+    // Lit through virtual lights (shadow rays) with its own background: every kind but Constant.
     bool analytic() const { return kind != sky::SkyKind::Constant; }
     // The scene's `sky` colour is the sky's radiance: Constant (background, the ground's unoccluded ambient light)
     // and Uniform (the same colour as a map: it lights leaves, bark and ground with shadow rays).
