@@ -3,6 +3,7 @@
 
 #include "core/backend/backend.h"
 
+#include <array>
 #include <span>
 #include <sstream>
 
@@ -240,6 +241,28 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
         }
     }
     return grid;
+}
+
+LightingGrid lightingForWeights(const DensityGrid& density, const lb::LbParams& params, const lb::BoundaryWeights& w,
+                                GridCache* cache, Progress* progress, JobLog* log, Backend* backend)
+{
+    const std::vector<lb::WeightedSolve> solves = lb::weightedSolves(params, w);
+    if (solves.size() == 1 && solves[0].channels == std::array<bool, 3>{true, true, true})
+        return lightingFor(density, solves[0].params, cache, progress, log, backend);
+    LightingGrid out;
+    out.geometry = density.geometry;
+    out.rgb.assign(density.geometry.nodeCount() * 3, 0.0f);
+    for (size_t k = 0; k < solves.size(); ++k) {
+        SubProgress part(progress, double(k) / double(solves.size()), double(k + 1) / double(solves.size()));
+        Progress sub([&](double f, const std::string& msg) { part.report(f, msg); });
+        if (progress && progress->isCancelled()) sub.cancel();
+        const LightingGrid g = lightingFor(density, solves[k].params, cache, &sub, log, backend);
+        for (int c = 0; c < 3; ++c)
+            if (solves[k].channels[size_t(c)])
+                for (size_t n = 0; n < density.geometry.nodeCount(); ++n) out.rgb[n * 3 + size_t(c)] = g.rgb[n * 3 + size_t(c)];
+    }
+    if (solves.empty() && progress) progress->report(1.0, "no light on the boundary");
+    return out;
 }
 
 std::string opticsJsonMembers(const lb::LbParams& params, const std::string& preset)

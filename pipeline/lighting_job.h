@@ -48,6 +48,14 @@ std::string densityHash(const DensityGrid& density);
 LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params, GridCache* cache,
                          Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
 
+// The lighting for a boundary given per channel (params' sun, intensity and boundary replaced by w): a
+// boundary that is one distribution x a factor per channel is one lightingFor; any other (the sun plus a
+// coloured sky) is one single-optics lightingFor per channel (its optics in all three, so each is one channel
+// solve: as many as params' own). Each is cached (or relit from a cached basis) like lightingFor. A channel
+// whose weights are all 0 is 0 without a solve.
+LightingGrid lightingForWeights(const DensityGrid& density, const lb::LbParams& params, const lb::BoundaryWeights& w,
+                                GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
+
 // Relighting by linearity (issue 18 item 2): the lighting of a species for unit boundaries e_m, one grid
 // per moving lattice direction (18: every sun, above or below the horizon), each cached like a lighting
 // grid (key: the grid, the optics, steps and storage, the boundary e_m; not the sun). lightingFor uses a

@@ -9,15 +9,10 @@
 
 namespace sylva {
 
-std::string assetKey(const SpeciesDesc& species, const SunDesc& sun, bool lit)
+std::string assetKey(const SpeciesDesc& species, const Scene& scene, bool lit)
 {
     std::string key = speciesFingerprint(species);
-    if (lit) {
-        char buf[128];
-        const glm::vec3 d = glm::normalize(sun.direction);
-        std::snprintf(buf, sizeof buf, "|lit sun %.9g %.9g %.9g", double(d.x), double(d.y), double(d.z));
-        key += buf;
-    }
+    if (lit) key += "|lit " + speciesLightingKey(scene);
     return key;
 }
 
@@ -34,12 +29,12 @@ void AssetStore::insert(const std::string& key, AssetsPtr assets)
     m_assets[key] = std::move(assets);
 }
 
-AssetsPtr AssetStore::findLocked(const SpeciesDesc& sp, const SunDesc& sun, bool lit) const
+AssetsPtr AssetStore::findLocked(const SpeciesDesc& sp, const Scene& scene, bool lit) const
 {
-    auto it = m_assets.find(assetKey(sp, sun, true));
+    auto it = m_assets.find(assetKey(sp, scene, true));
     if (it != m_assets.end()) return it->second;
     if (lit) return nullptr;
-    it = m_assets.find(assetKey(sp, sun, false));
+    it = m_assets.find(assetKey(sp, scene, false));
     return it == m_assets.end() ? nullptr : it->second;
 }
 
@@ -48,7 +43,7 @@ std::vector<AssetsPtr> AssetStore::forScene(const Scene& scene, bool lit) const
     std::lock_guard lock(m_mutex);
     std::vector<AssetsPtr> out;
     for (const SpeciesDesc& sp : scene.species) {
-        AssetsPtr a = findLocked(sp, scene.sun, lit);
+        AssetsPtr a = findLocked(sp, scene, lit);
         if (!a) return {};
         out.push_back(std::move(a));
     }
@@ -60,7 +55,7 @@ std::vector<AssetsPtr> AssetStore::litForAnySun(const Scene& scene) const
     std::lock_guard lock(m_mutex);
     std::vector<AssetsPtr> out;
     for (const SpeciesDesc& sp : scene.species) {
-        const std::string prefix = assetKey(sp, scene.sun, false) + "|lit sun ";
+        const std::string prefix = assetKey(sp, scene, false) + "|lit sun ";
         auto it = m_assets.lower_bound(prefix);
         if (it != m_assets.end() && it->first.compare(0, prefix.size(), prefix) != 0) it = m_assets.end();
         if (it == m_assets.end()) return {};
@@ -74,7 +69,7 @@ std::vector<size_t> AssetStore::missingSpecies(const Scene& scene, bool lit) con
     std::lock_guard lock(m_mutex);
     std::vector<size_t> out;
     for (size_t s = 0; s < scene.species.size(); ++s)
-        if (!findLocked(scene.species[s], scene.sun, lit)) out.push_back(s);
+        if (!findLocked(scene.species[s], scene, lit)) out.push_back(s);
     return out;
 }
 
@@ -113,6 +108,9 @@ std::vector<AssetsPtr> ensureAssets(const Scene& scene, bool lit, AssetStore& st
         Scene one;
         one.species.push_back(sp);
         one.sun = scene.sun;
+        one.sky = scene.sky;
+        one.skyModel = scene.skyModel;
+        one.lighting = scene.lighting;
         JobLog jobLog;
         std::vector<SpeciesAssets> loaded;
         try {
@@ -123,7 +121,7 @@ std::vector<AssetsPtr> ensureAssets(const Scene& scene, bool lit, AssetStore& st
         }
         if (log)
             for (const std::string& line : speciesLogLines(sp.name, jobLog)) log(line);
-        store.insert(assetKey(sp, scene.sun, lit), std::make_shared<const SpeciesAssets>(std::move(loaded.at(0))));
+        store.insert(assetKey(sp, scene, lit), std::make_shared<const SpeciesAssets>(std::move(loaded.at(0))));
         if (progress) progress->report(double(m + 1) / double(missing.size()), sp.name + ": done");
     }
     std::vector<AssetsPtr> out = store.forScene(scene, lit);

@@ -19,9 +19,10 @@ class GridCache;
 
 using AssetsPtr = std::shared_ptr<const SpeciesAssets>;
 
-// The key of a species' assets: its scene-file entry (name left out), and with lighting the sun
-// direction its grid was solved for. Equal keys give equal assets.
-std::string assetKey(const SpeciesDesc& species, const SunDesc& sun, bool lit);
+// The key of a species' assets: its scene-file entry (name left out), and with lighting "|lit " and what its
+// grid was solved for in the scene (speciesLightingKey: the LB sun, direct light, the sky in the boundary).
+// Equal keys give equal assets.
+std::string assetKey(const SpeciesDesc& species, const Scene& scene, bool lit);
 
 // Thread-safe map key -> assets. Jobs fill it; the viewport and exports read it. The disk grid cache
 // sits below it (a key missing here may still be a cache hit on disk).
@@ -44,7 +45,7 @@ public:
     size_t size() const;
 
 private:
-    AssetsPtr findLocked(const SpeciesDesc& sp, const SunDesc& sun, bool lit) const;
+    AssetsPtr findLocked(const SpeciesDesc& sp, const Scene& scene, bool lit) const;
     mutable std::mutex m_mutex;
     std::map<std::string, AssetsPtr> m_assets;
 };

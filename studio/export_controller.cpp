@@ -84,8 +84,8 @@ Job* ExportController::exportSpeciesGrids(int species, const QString& folder, Gr
     const SpeciesDesc& sp = scene.species[size_t(species)];
     const std::string dir = folder.toStdString();
     const GridExportFiles files = gridExportFiles(dir, sp.name, format);
-    AssetsPtr held = m_assets->find(assetKey(sp, scene.sun, true));
-    if (!held) held = m_assets->find(assetKey(sp, scene.sun, false));
+    AssetsPtr held = m_assets->find(assetKey(sp, scene, true));
+    if (!held) held = m_assets->find(assetKey(sp, scene, false));
     GridCache* cache = m_cache;
     Backend* backend = m_backend;
     log(tr("exporting the grids of %1 to %2").arg(QString::fromStdString(sp.name), QDir::toNativeSeparators(folder)));

@@ -52,7 +52,7 @@ void InspectorController::refresh()
         return;
     }
     const Scene& s = m_doc->scene();
-    const std::string key = assetKey(s.species[size_t(species)], s.sun, true);
+    const std::string key = assetKey(s.species[size_t(species)], s, true);
     if (key == m_inspectedKey) return;   // shown or loading
     if (m_lighting->isPending()) {
         // The lighting job solves these grids (or is about to): read them from the cache when it is
@@ -89,14 +89,14 @@ Job* InspectorController::inspectSpecies(int species)
     const Scene scene = m_doc->scene();
     if (species < 0 || size_t(species) >= scene.species.size()) return nullptr;
     const SpeciesDesc& sp = scene.species[size_t(species)];
-    const std::string key = assetKey(sp, scene.sun, true);
+    const std::string key = assetKey(sp, scene, true);
     if (m_job) m_job->cancel();
     m_inspectedKey = key;
     const QString name = QString::fromStdString(sp.name);
     m_inspector->setMessage(tr("Loading the grids of %1...").arg(name));
     // The species' mesh when the viewport already holds it (no second import).
-    AssetsPtr held = m_assets->find(assetKey(sp, scene.sun, true));
-    if (!held) held = m_assets->find(assetKey(sp, scene.sun, false));
+    AssetsPtr held = m_assets->find(assetKey(sp, scene, true));
+    if (!held) held = m_assets->find(assetKey(sp, scene, false));
     auto result = std::make_shared<std::shared_ptr<const SpeciesGrids>>();
     GridCache* cache = m_cache;
     Backend* backend = m_backend;

@@ -94,7 +94,7 @@ Job* LightingScheduler::computeLighting(bool reload)
     const Scene scene = m_doc->scene();
     const bool lit = viewNeedsLighting();
     std::vector<std::string> target;
-    for (const SpeciesDesc& sp : scene.species) target.push_back(assetKey(sp, scene.sun, lit));
+    for (const SpeciesDesc& sp : scene.species) target.push_back(assetKey(sp, scene, lit));
     for (const VolumeDesc& v : scene.volumes) target.push_back(VolumeLightStore::key(scene, v, lit));
     if (m_job) {
         // One lighting job at a time. One that already makes what the scene needs (the camera or an
@@ -114,8 +114,8 @@ Job* LightingScheduler::computeLighting(bool reload)
         // Keep what the scene uses (and what undo may bring back soon: everything of this sun).
         std::vector<std::string> keep;
         for (const SpeciesDesc& sp : scene.species) {
-            keep.push_back(assetKey(sp, scene.sun, true));
-            keep.push_back(assetKey(sp, scene.sun, false));
+            keep.push_back(assetKey(sp, scene, true));
+            keep.push_back(assetKey(sp, scene, false));
         }
         if (m_assets->size() > 4 * keep.size() + 8) m_assets->retainOnly(keep);
     }
@@ -187,6 +187,9 @@ std::optional<Relighting> LightingScheduler::relightingFor(const Scene& scene) c
     // Direct light counted once: the grid is the solve minus its uncollided part, which the bases (full
     // solves) do not separate; the lighting job makes those grids.
     if (scene.lighting.direct != DirectLight::Seed) return std::nullopt;
+    // The sky in the boundary: the bases would compose it too, but its weights follow the sky and the sun's
+    // radiance as well; the lighting job makes those grids.
+    if (scene.lighting.boundary != LbBoundary::Sun) return std::nullopt;
     Relighting r;
     r.sun = scene.sun.direction;
     for (const SpeciesDesc& sp : scene.species) {

@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include <QCheckBox>
 #include <QComboBox>
 #include <QDateEdit>
 #include <QDateTime>
@@ -127,6 +128,14 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     });
     lightForm->addRow(tr("Interleave"), m_interleave);
     skyForm->addRow(m_lightRows);
+    m_lbSky = new QCheckBox(tr("Sky in the LB lighting"));
+    m_lbSky->setObjectName("lighting.boundary");
+    m_lbSky->setToolTip(tr("The LB boundary holds the sky as well as the sun, so leaves also get skylight scattered through the "
+                           "crown (lighting.boundary sun_sky; the species are lit again)"));
+    connect(m_lbSky, &QCheckBox::toggled, this, [this](bool on) {
+        apply(m_lbSky, tr("Change LB boundary"), [&](Scene& s) { s.lighting.boundary = on ? LbBoundary::SunSky : LbBoundary::Sun; });
+    });
+    skyForm->addRow(m_lbSky);
     layout->addWidget(skyBox);
 
     // The sun.
@@ -296,7 +305,8 @@ void SkyPanel::refresh()
     const SkyDesc& d = s.skyModel;
     {
         const QSignalBlocker b1(m_kind), b2(m_lights), b3(m_interleave), b4(m_sunMode), b5(m_dial), b6(m_date), b7(m_time),
-            b8(m_timeSlider);
+            b8(m_timeSlider), b9(m_lbSky);
+        m_lbSky->setChecked(s.lighting.boundary == LbBoundary::SunSky);
         m_kind->setCurrentIndex(m_kind->findData(int(d.kind)));
         m_lights->setValue(d.lights);
         m_interleave->setValue(d.interleave);

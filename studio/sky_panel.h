@@ -1,5 +1,5 @@
 // The sky panel (issue 16 item 9): the sky model (constant, Preetham, HDR map) with its turbidity, map
-// file, rotation and intensity, the virtual lights and their interleaving, and the sun by dial (elevation,
+// file, rotation and intensity, the virtual lights and their interleaving, the sky in the LB boundary, and the sun by dial (elevation,
 // azimuth) or by date, time, time zone and place with a time slider. Every change is an undoable edit
 // of the document (edits of one control less than a second apart merge into one step).
 #pragma once
@@ -11,6 +11,7 @@
 
 #include "studio/scene_document.h"
 
+class QCheckBox;
 class QComboBox;
 class QDateEdit;
 class QDial;
@@ -45,6 +46,7 @@ public:
     QDoubleSpinBox* mapIntensity() const { return m_intensity; }
     QSpinBox* lights() const { return m_lights; }
     QSpinBox* interleave() const { return m_interleave; }
+    QCheckBox* lbSky() const { return m_lbSky; }
     QComboBox* sunMode() const { return m_sunMode; }
     QDoubleSpinBox* sunElevation() const { return m_elevation; }
     QDial* sunAzimuthDial() const { return m_dial; }
@@ -73,6 +75,7 @@ private:
     QPushButton* m_browse;
     QDoubleSpinBox *m_rotation, *m_intensity;
     QSpinBox *m_lights, *m_interleave;
+    QCheckBox* m_lbSky;
     QComboBox* m_sunMode;
     QStackedWidget* m_sunPages;
     QDoubleSpinBox *m_elevation, *m_azimuth;

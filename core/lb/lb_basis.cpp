@@ -39,32 +39,60 @@ BoundaryWeights sunWeights(const glm::vec3& sun, const glm::vec3& intensity)
 
 BoundaryWeights skyWeights(const sky::Sky& sky, const glm::vec3& unit, int width)
 {
-    // Light arriving from sky direction w travels along -w: it goes to the lattice direction nearest
-    // -w. Only the upper hemisphere is sky; below the horizon is the ground (not a light source here).
-    const sky::EnvMap map = sky::skyToMap(sky, width);
-    glm::dvec3 share[kDirections] = {};
-    glm::vec3 n[kDirections];
-    for (int m = 1; m < kDirections; ++m) n[m] = glm::normalize(glm::vec3(kC[m][0], kC[m][1], kC[m][2]));
-    for (int y = 0; y < map.height; ++y) {
-        const double omega = sky::envMapPixelSolidAngle(map.width, map.height, y);
-        for (int x = 0; x < map.width; ++x) {
-            const glm::vec3 d = sky::envMapPixelDirection(map.width, map.height, x, y);
-            if (!(d.y > 0.0f)) continue;
-            int best = 1;
-            float bestDot = -2.0f;
-            for (int m = 1; m < kDirections; ++m) {
-                const float dd = -glm::dot(d, n[m]);
-                if (dd > bestDot) bestDot = dd, best = m;
-            }
-            const float* p = &map.rgb[(size_t(y) * size_t(map.width) + size_t(x)) * 3];
-            share[best] += glm::dvec3(p[0], p[1], p[2]) * omega;
-        }
-    }
+    // Light arriving from sky direction w travels along -w: it goes to the lattice direction nearest -w,
+    // i.e. the sky share nearest to -n_m. Only the upper hemisphere is sky; below the horizon is the ground
+    // (not a light source here).
+    std::vector<glm::vec3> against;
+    for (int m = 1; m < kDirections; ++m) against.push_back(-glm::vec3(float(kC[m][0]), float(kC[m][1]), float(kC[m][2])));
+    const std::vector<glm::dvec3> share = sky::skyDirectionShares(sky, against, width, true);
     BoundaryWeights b;
     for (int c = 0; c < 3; ++c)
         for (int m = 1; m < kDirections; ++m)
-            b.w[size_t(c)][size_t(m)] = unit[c] > 0.0f ? float(share[m][c] / double(unit[c])) : 0.0f;
+            b.w[size_t(c)][size_t(m)] = unit[c] > 0.0f ? float(share[size_t(m - 1)][c] / double(unit[c])) : 0.0f;
     return b;
+}
+
+std::vector<WeightedSolve> weightedSolves(const LbParams& params, const BoundaryWeights& w)
+{
+    // Each channel's distribution scaled to a largest value of 1, and that scale.
+    std::array<std::vector<float>, 3> dist;
+    glm::vec3 scale(0.0f);
+    for (int c = 0; c < 3; ++c) {
+        for (int m = 1; m < kDirections; ++m) {
+            const float v = w.w[size_t(c)][size_t(m)];
+            if (!std::isfinite(v) || v < 0.0f) throw Error("LB boundary: a weight is negative or not finite");
+            scale[c] = std::max(scale[c], v);
+        }
+        dist[size_t(c)].assign(kDirections, 0.0f);
+        if (scale[c] > 0.0f)
+            for (int m = 1; m < kDirections; ++m) dist[size_t(c)][size_t(m)] = w.w[size_t(c)][size_t(m)] / scale[c];
+    }
+    std::vector<int> lit;
+    for (int c = 0; c < 3; ++c)
+        if (scale[c] > 0.0f) lit.push_back(c);
+    if (lit.empty()) return {};
+    bool same = true;   // every lit channel the same distribution (to float rounding)
+    for (int c : lit)
+        for (int m = 1; m < kDirections; ++m)
+            same = same && std::fabs(dist[size_t(c)][size_t(m)] - dist[size_t(lit[0])][size_t(m)]) <= 1e-6f;
+    std::vector<WeightedSolve> out;
+    if (same) {
+        WeightedSolve s{params, {}};
+        s.params.boundary = dist[size_t(lit[0])];
+        s.params.intensity = scale;
+        for (int c : lit) s.channels[size_t(c)] = true;
+        out.push_back(std::move(s));
+        return out;
+    }
+    for (int c : lit) {
+        WeightedSolve s{params, {}};
+        s.params.channels = {params.channels[size_t(c)], params.channels[size_t(c)], params.channels[size_t(c)]};
+        s.params.boundary = dist[size_t(c)];
+        s.params.intensity = glm::vec3(scale[c]);
+        s.channels[size_t(c)] = true;
+        out.push_back(std::move(s));
+    }
+    return out;
 }
 
 std::vector<int> basisDirections(BasisSet set)

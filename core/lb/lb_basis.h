@@ -36,6 +36,18 @@ BoundaryWeights sunWeights(const glm::vec3& sun, const glm::vec3& intensity);
 // are computed on skyToMap(sky, width) (core/sky/sky_light.h).
 BoundaryWeights skyWeights(const sky::Sky& sky, const glm::vec3& unit, int width = 256);
 
+// A boundary given per channel as solves whose boundary is one distribution (LbParams::boundary) x an
+// intensity per channel, what the solvers take: weights that are one distribution x a factor per channel
+// (to 1e-6 of the largest) make one solve of every channel; any other (the sun plus a coloured sky) one
+// solve per channel, its optics in all three (one channel solve each, as many as the channels' own). A
+// channel whose weights are all 0 is in no solve (its light is 0). Throws Error on a negative or
+// non-finite weight. Used by pipeline/lighting_job.h lightingForWeights and the reference comparisons.
+struct WeightedSolve {
+    LbParams params;
+    std::array<bool, 3> channels{};   // which channels of the result this solve gives
+};
+std::vector<WeightedSolve> weightedSolves(const LbParams& params, const BoundaryWeights& w);
+
 // Which lattice directions a basis holds: every moving direction (18), or those a sun above the
 // horizon (direction toward it with y > 0) can light (17: +y never is).
 enum class BasisSet { All, UpperSun };

@@ -222,9 +222,7 @@ const Scene& onTerrain(const Scene& scene, Scene& storage)
 
 } // namespace
 
-// The sky's part of the frame: a Preetham or map sky's per-ray parameters, its map pixels and its
-// virtual lights (N of them, K interleaved subsets). The constant sky: none (the frame as before).
-static void setSky(RenderScene& rs, const SkyDesc& d)
+void setFrameSky(RenderScene& rs, const SkyDesc& d)
 {
     rs.base.skyModel = sky::SkyView{};
     rs.base.skyLightCount = 0;
@@ -391,7 +389,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
         rs.m_stats.terrainSamplesX = hf.layout.nx;
         rs.m_stats.terrainSamplesZ = hf.layout.nz;
     }
-    setSky(rs, scene.skyModel);
+    setFrameSky(rs, scene.skyModel);
     rs.accel = scene.render.accel;
     rs.lodLevels = lod;
     const size_t ns = assets.size(), ni = scene.instances.size();
@@ -881,6 +879,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     const FrameSun sun = frameSun(scene, sunRadiance);
     b.sunDir = sun.direction;
     b.sunRadiance = sun.radiance;
+    b.lbRadiance = lbRadiance(scene, sun);
     b.sky = composeSky(scene);
     b.camera = makeCamera(scene.camera, width, height);
     b.width = width;
@@ -909,6 +908,22 @@ FrameSun frameSun(const Scene& scene, const glm::vec3& sunRadiance)
         out.radiance = sun.present ? sun.radiance() * (scene.sun.intensity / sky::kPi) : glm::vec3(0.0f);
     }
     return out;
+}
+
+glm::vec3 lbSunDirection(const Scene& scene)
+{
+    const SkyDesc& d = scene.skyModel;
+    if (d.kind == sky::SkyKind::Map && d.sunFromMap && d.built && d.built->sun.present) return d.built->sun.direction;
+    return scene.sun.direction;
+}
+
+glm::vec3 lbRadiance(const Scene& scene, const FrameSun& sun)
+{
+    if (scene.lighting.boundary == LbBoundary::Sun) return sun.radiance;
+    glm::vec3 u = sun.radiance;
+    for (int c = 0; c < 3; ++c)
+        if (!(u[c] > 0.0f)) u[c] = 1.0f;
+    return u;
 }
 
 RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,

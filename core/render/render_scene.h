@@ -150,6 +150,12 @@ bool hasLevelsFor(const RenderScene& rs, const Scene& scene);
 RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
                              Progress* progress = nullptr);
 
+// The sky's part of a built frame: a Preetham or map sky's per-ray parameters, its map pixels and its
+// virtual lights (d.lights of them, d.interleave subsets); the constant sky: none (the frame as before).
+// buildRenderScene calls it; changing only the lights or subsets of the same sky needs nothing else (the
+// sun and the LB grids stay). Throws Error when the sky is not built or its counts are out of range.
+void setFrameSky(RenderScene& rs, const SkyDesc& d);
+
 // The sun the frame lights with: the scene's direction and `sunRadiance`, or a built Preetham sky's (or a
 // map sky's, with sun_from_map) own sun, radiance() x sun.intensity / pi (a surface shows albedo x radiance
 // x cos). What buildRenderScene and the Blender export use. Throws Error on a zero direction.
@@ -158,6 +164,13 @@ struct FrameSun {
     glm::vec3 radiance;
 };
 FrameSun frameSun(const Scene& scene, const glm::vec3& sunRadiance);
+// The direction the species' LB grids are solved toward: the scene's sun, or a map sky's own sun when the
+// frame lights with it (sun_from_map), so the LB's light comes from where the drawn sun is.
+glm::vec3 lbSunDirection(const Scene& scene);
+// The radiance the species' normalized LB grids are in units of (RenderView::lbRadiance; surfaces show
+// albedo x grid x it): the frame sun's; with lighting.boundary sun_sky a channel the sun leaves dark takes 1,
+// so a sky without a sun (a map with none, a Preetham sky at night, sun.intensity 0) still lights the grid.
+glm::vec3 lbRadiance(const Scene& scene, const FrameSun& sun);
 
 // Camera basis and image extents for a camera and image size (throws Error on a degenerate camera).
 // The rotation of an instance from its degrees about x, y, z: R = Rz Ry Rx (column-major glm).

@@ -240,6 +240,7 @@ struct RenderView {
     LandLightLayout landLightLayout; // of landLight, terrain frame: the forest grid's factor on landscape plants (dims.x 0: none)
     glm::vec3 sunDir;                // toward the sun, normalized
     glm::vec3 sunRadiance;           // blackbody colour (luminance 1) x intensity
+    glm::vec3 lbRadiance;            // the species' normalized grids are in units of it (render_scene.h lbRadiance)
     glm::vec3 sky;                   // the constant sky (skyModel.kind Constant), else 0
     sky::SkyView skyModel;           // the sky camera rays see; Map: its pixels are skyMap (skyModel.map.rgb unused)
     uint32_t skyLightCount;          // skyLights (0: the constant sky's ambient ground light as before)

@@ -327,7 +327,7 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
         if (v.volumeCount > 0) out.local *= sunThroughVolumes(v, s.p);
     }
     if (v.skyLightCount > 0) out.local += s.albedo * skyLightIrradiance(v, offsetPoint(s.p, s.ng, s.extent), s.ng, px, py, sample);
-    out.indirect = s.albedo * s.lighting * s.indirectWeight * v.sunRadiance * v.indirectScale;
+    out.indirect = s.albedo * s.lighting * s.indirectWeight * v.lbRadiance * v.indirectScale;
     return out;
 }
 

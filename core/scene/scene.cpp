@@ -46,6 +46,16 @@ bool parseDirectLight(const std::string& name, DirectLight* out)
     return true;
 }
 
+const char* lbBoundaryName(LbBoundary b) { return b == LbBoundary::SunSky ? "sun_sky" : "sun"; }
+
+bool parseLbBoundary(const std::string& name, LbBoundary* out)
+{
+    if (name == "sun") *out = LbBoundary::Sun;
+    else if (name == "sun_sky") *out = LbBoundary::SunSky;
+    else return false;
+    return true;
+}
+
 const char* forestGridModeName(ForestGridMode m) { return m == ForestGridMode::On ? "on" : m == ForestGridMode::Auto ? "auto" : "off"; }
 
 bool parseForestGridMode(const std::string& name, ForestGridMode* out)

@@ -158,9 +158,15 @@ enum class DirectLight { Seed, Once };
 // On where exposure differs (factors spread by 2% or more), else skipped (said in render --stats).
 enum class ForestGridMode { Off, Auto, On };
 
+// What the species' LB boundary holds (issue 16 item 7): Sun = the seed's sun alone (LB_MODEL.md "Boundary
+// condition"; old files); SunSky = the sun plus the sky's radiance over each lattice direction's share of
+// the upper hemisphere (lb::skyWeights), so leaves also receive skylight scattered through the crown.
+enum class LbBoundary { Sun, SunSky };
+
 // The scene's lighting beyond sun and sky (the `lighting` block).
 struct LightingDesc {
     DirectLight direct = DirectLight::Seed;
+    LbBoundary boundary = LbBoundary::Sun;
     ForestGridMode forestGrid = ForestGridMode::Off;
     int forestGridResolution = 0;        // forest grid nodes along the plants' longest horizontal extent; 0 =
                                          // automatic (4 across the median crown, at most 32: lb::kAutoResolution)
@@ -215,6 +221,8 @@ const char* renderModeName(RenderMode mode);      // "full", "local", "ambient",
 bool parseRenderMode(const std::string& name, RenderMode* out);
 const char* directLightName(DirectLight d);       // "seed", "once"
 bool parseDirectLight(const std::string& name, DirectLight* out);
+const char* lbBoundaryName(LbBoundary b);         // "sun", "sun_sky"
+bool parseLbBoundary(const std::string& name, LbBoundary* out);
 const char* forestGridModeName(ForestGridMode m); // "off", "auto", "on"
 bool parseForestGridMode(const std::string& name, ForestGridMode* out);
 const char* accelName(AccelKind kind);            // "bvh", "kdtree"

@@ -95,7 +95,7 @@ glm::dvec3 skyTotal(const Sky& sky, int width)
     return envMapIntegral(skyToMap(sky, width));
 }
 
-std::vector<glm::dvec3> skyDirectionShares(const Sky& sky, const std::vector<glm::vec3>& directions, int width)
+std::vector<glm::dvec3> skyDirectionShares(const Sky& sky, const std::vector<glm::vec3>& directions, int width, bool upperOnly)
 {
     std::vector<glm::vec3> dirs;
     for (const glm::vec3& d : directions) {
@@ -114,6 +114,7 @@ std::vector<glm::dvec3> skyDirectionShares(const Sky& sky, const std::vector<glm
         const double omega = envMapPixelSolidAngle(m.width, m.height, y) * scale;
         for (int x = 0; x < m.width; ++x) {
             const glm::vec3 d = rotateAzimuth(envMapPixelDirection(m.width, m.height, x, y), c, s);
+            if (upperOnly && !(d.y > 0.0f)) continue;
             size_t best = 0;
             float bestDot = -2.0f;
             for (size_t i = 0; i < dirs.size(); ++i) {

@@ -48,8 +48,10 @@ std::vector<VirtualLight> skyLights(const Sky& sky, int count, int width = 512);
 // Integral of the sky's radiance (without its sun) over the whole sphere, RGB: what the LB boundary
 // distributes; and the same over the share of the sphere nearest to each of `directions` (the LB
 // lattice's, any length > 0; the shares sum to the total). Computed over the map of skyToMap(width) (a
-// map sky: its own pixels), each pixel given whole to the direction with the largest cosine.
+// map sky: its own pixels, rotated), each pixel given whole to the direction with the largest cosine (the
+// first of equals); upperOnly: only the pixels above the horizon (the sky; below it is the ground).
 glm::dvec3 skyTotal(const Sky& sky, int width = 512);
-std::vector<glm::dvec3> skyDirectionShares(const Sky& sky, const std::vector<glm::vec3>& directions, int width = 512);
+std::vector<glm::dvec3> skyDirectionShares(const Sky& sky, const std::vector<glm::vec3>& directions, int width = 512,
+                                           bool upperOnly = false);
 
 } // namespace sylva::sky

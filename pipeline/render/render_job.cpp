@@ -16,6 +16,7 @@
 #include "core/backend/backend.h"
 #include "core/base/error.h"
 #include "core/lb/lb_solver.h"
+#include "core/sky/sky_light.h"
 #include "core/render/tonemap.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/grow/tree_grower.h"
@@ -137,16 +138,20 @@ SpeciesGrids gridsForMesh(const Scene& scene, const SpeciesDesc& sp, const Trian
     if (progress && progress->isCancelled()) densityProgress.cancel();
     g.density = densityForTriangles(mesh, vs, cache, &densityProgress, log);
     g.params = sp.lighting;
-    g.params.sun = scene.sun.direction;
+    g.params.sun = lbSunDirection(scene);
     SubProgress lightPart(progress, 0.2, 1.0);
     Progress lightProgress([&](double f, const std::string& msg) { lightPart.report(f, msg); });
     if (progress && progress->isCancelled()) lightProgress.cancel();
-    g.lighting = lightingFor(g.density, g.params, cache, &lightProgress, log, backend);
+    const std::optional<lb::BoundaryWeights> weights = speciesBoundary(scene, g.params);
+    auto solve = [&](const lb::LbParams& p) {
+        return weights ? lightingForWeights(g.density, p, *weights, cache, &lightProgress, log, backend)
+                       : lightingFor(g.density, p, cache, &lightProgress, log, backend);
+    };
+    g.lighting = solve(g.params);
     if (scene.lighting.direct == DirectLight::Once) {
         // Direct light counted once: the same LB with scattering off is the uncollided sunlight the
         // renderer's shadow rays already draw; the grid keeps the scattered rest (cached like any solve).
-        const LightingGrid uncollided = lightingFor(g.density, lb::uncollidedParams(g.params), cache, &lightProgress, log, backend);
-        g.lighting = lb::scatteredPart(g.lighting, uncollided);
+        g.lighting = lb::scatteredPart(g.lighting, solve(lb::uncollidedParams(g.params)));
     }
     const std::vector<float> f = lb::boundaryDistribution(g.params.sun);
     const float free = std::accumulate(f.begin(), f.end(), 0.0f);
@@ -155,6 +160,38 @@ SpeciesGrids gridsForMesh(const Scene& scene, const SpeciesDesc& sp, const Trian
 }
 
 } // namespace
+
+std::optional<lb::BoundaryWeights> speciesBoundary(const Scene& scene, const lb::LbParams& params)
+{
+    if (scene.lighting.boundary == LbBoundary::Sun) return std::nullopt;
+    const SkyDesc& d = scene.skyModel;
+    if (d.analytic() && !d.built) throw Error("lighting.boundary sun_sky: the scene's sky is not built (loadSceneSky)");
+    const sky::Sky constant = sky::constantSky(scene.sky, sky::SkySun{});
+    const sky::Sky& sky = d.analytic() ? *d.built : constant;
+    const FrameSun sun = frameSun(scene, sunRadiance(scene.sun));
+    const glm::vec3 unit = lbRadiance(scene, sun);
+    const std::vector<float> f = lb::boundaryDistribution(params.sun);
+    const glm::vec3 free = params.intensity * std::accumulate(f.begin(), f.end(), 0.0f);
+    lb::BoundaryWeights w = lb::sunWeights(params.sun, params.intensity * (sun.radiance / unit));
+    w += lb::skyWeights(sky, float(sky::kPi) * unit / free);
+    return w;
+}
+
+std::string speciesLightingKey(const Scene& scene)
+{
+    char buf[512];
+    const glm::vec3 d = glm::normalize(lbSunDirection(scene));
+    std::snprintf(buf, sizeof buf, "sun %.9g %.9g %.9g|direct %s", double(d.x), double(d.y), double(d.z), directLightName(scene.lighting.direct));
+    std::string key = buf;
+    if (scene.lighting.boundary == LbBoundary::Sun) return key;
+    const SkyDesc& k = scene.skyModel;
+    const glm::vec3 r = frameSun(scene, sunRadiance(scene.sun)).radiance;
+    std::snprintf(buf, sizeof buf, "|boundary %s|sky %d %.9g %.9g %.9g T %.9g scale %.9g rot %.9g int %.9g from map %d|radiance %.9g %.9g %.9g|",
+                  lbBoundaryName(scene.lighting.boundary), int(k.kind), double(scene.sky.x), double(scene.sky.y),
+                  double(scene.sky.z), k.turbidity, double(k.scale), double(k.rotationDeg), double(k.intensity), int(k.sunFromMap),
+                  double(r.x), double(r.y), double(r.z));
+    return key + buf + k.path;
+}
 
 const CieTable& bundledCieTable()
 {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,19 @@ glm::vec3 sunRadiance(const SunDesc& sun);
 // The bundled default forest (resources/default_forest.sylva.json): five grown broadleaf species,
 // 962 instances, 896x448.
 Scene defaultScene();
+
+// The boundary weights of a species' LB solve when the scene asks for more than the sun (lighting.boundary
+// sun_sky; params: the species' optics with the LB sun, lbSunDirection): the sun's weights x its radiance
+// over lbRadiance, plus the sky's (lb::skyWeights, its sun kept apart) in units of pi x lbRadiance over the
+// sun's free-field total, so that open space shows albedo x (fluence / pi) from the sky as from the sun
+// (docs/RENDERING.md "The sky in the LB boundary"). nullopt: the sun alone (the seed's boundary, solved
+// from params as always). Throws Error when the scene's sky needs building (loadSceneSky) and is not built.
+std::optional<lb::BoundaryWeights> speciesBoundary(const Scene& scene, const lb::LbParams& params);
+
+// What a species' lighting grid depends on beyond the species itself, as text (equal text, equal grids): the
+// LB sun (lbSunDirection), lighting.direct and, with lighting.boundary sun_sky, the sky's settings and the
+// frame sun's radiance. The studio keys its in-memory assets with it.
+std::string speciesLightingKey(const Scene& scene);
 
 // Whether a render mode uses the LB lighting grids (local does not: no grid is solved for it).
 bool modeNeedsLighting(RenderMode mode);

@@ -644,6 +644,10 @@ const Table<LightingDesc>& sceneLightingTable()
                  "scattered light (closer to Cycles on the stand, the forest and under a Preetham or map sky; with `sky.kind` uniform "
                  "the closest on every scene measured, and what a new scene in the studio starts with: [ACCURACY.md](ACCURACY.md))")
             .summarized([](const LightingDesc& l) { return std::string("direct light ") + directLightName(l.direct); });
+        b.enumeration("boundary", &LightingDesc::boundary, parseLbBoundary, lbBoundaryName, "LB boundary", "sun, sun_sky")
+            .doc("string",
+                 "`sun` (default: the seed's boundary, the sun alone; old files keep their picture) or `sun_sky`: each lattice direction's boundary value also gets the sky's radiance over its share of the upper hemisphere (any `sky.kind`; constant: `sky.color`), so leaves receive skylight scattered through the crown too, in the renderer's units of the sun (a sky without a sun still lights the grid) ([RENDERING.md](RENDERING.md) \"The sky in the LB boundary\")")
+            .summarized([](const LightingDesc& l) { return std::string("LB boundary ") + lbBoundaryName(l.boundary); });
         b.enumeration("forest_grid", &LightingDesc::forestGrid, parseForestGridMode, forestGridModeName, "forest grid", "off, auto, on")
             .doc("string",
                  "the forest-level LB grid (seed 000 section 3): `off` (default: every instance of a species lit alike), `on` "

@@ -214,6 +214,61 @@ private Q_SLOTS:
         QCOMPARE(z.totals().y, 0.0f);
     }
 
+    // A boundary per channel (the sun plus a coloured sky, issue 16 item 7) through weightedSolves: one
+    // solve when the channels share a distribution, one per lit channel otherwise; the solves' channels put
+    // together equal the superposition of the 18 unit-boundary solves (the basis) with the same weights.
+    void weightedSolvesAreTheSuperposition()
+    {
+        std::mt19937 rng(11);
+        const DensityGrid d = randomDensity({8, 7, 9}, rng);
+        const LbParams p = leafParams();
+        const glm::vec3 sun(0.3f, 0.8f, -0.4f);
+
+        // The sun alone at any per-channel intensity: one solve of all three channels.
+        const std::vector<WeightedSolve> one = weightedSolves(p, sunWeights(sun, glm::vec3(0.5f, 1.0f, 2.0f)));
+        QCOMPARE(one.size(), size_t(1));
+        QVERIFY(one[0].channels[0] && one[0].channels[1] && one[0].channels[2]);
+
+        // A sky whose colour changes with elevation (blue overhead, warm at the horizon) beside the sun.
+        sky::EnvMap m;
+        m.width = 64;
+        m.height = 32;
+        m.rgb.resize(size_t(m.width * m.height * 3));
+        for (int y = 0; y < m.height; ++y)
+            for (int x = 0; x < m.width; ++x) {
+                const float t = float(y) / float(m.height - 1);
+                float* px = m.ptr(x, y);
+                px[0] = 0.2f + 0.6f * t;
+                px[1] = 0.4f + 0.2f * t + 0.1f * float(x % 4);
+                px[2] = 1.0f - 0.5f * t;
+            }
+        const sky::Sky coloured = sky::mapSky(m, 30.0f, 1.0f, false);
+        BoundaryWeights w = sunWeights(sun, glm::vec3(1.0f));
+        w += skyWeights(coloured, glm::vec3(2.0f, 1.5f, 1.0f), 64);
+        w.w[1].fill(0.0f);   // a dark green channel: in no solve
+        const std::vector<WeightedSolve> split = weightedSolves(p, w);
+        QCOMPARE(split.size(), size_t(2));
+        LightingGrid sum;
+        sum.geometry = d.geometry;
+        sum.rgb.assign(d.geometry.nodeCount() * 3, 0.0f);
+        for (const WeightedSolve& s : split) {
+            QCOMPARE(s.params.channels[0].g, s.params.channels[2].g);   // one channel's optics in all three
+            const LightingGrid g = solveLighting(d, s.params);
+            for (int c = 0; c < 3; ++c)
+                if (s.channels[size_t(c)])
+                    for (size_t n = 0; n < d.geometry.nodeCount(); ++n) sum.rgb[n * 3 + size_t(c)] = g.rgb[n * 3 + size_t(c)];
+        }
+        const Basis b = solveBasis(d, p, BasisSet::All);
+        const LightingGrid composed = composeLighting(b.dirs, b.ptrs(), w);
+        QVERIFY2(relL2(sum, composed) < 1e-5, qPrintable(QString("relative L2 %1").arg(relL2(sum, composed))));
+        for (size_t n = 0; n < d.geometry.nodeCount(); ++n) QCOMPARE(sum.rgb[n * 3 + 1], 0.0f);
+
+        BoundaryWeights bad = w;
+        bad.w[0][3] = -1.0f;
+        QVERIFY_THROWS_EXCEPTION(Error, weightedSolves(p, bad));
+        QVERIFY(weightedSolves(p, BoundaryWeights{}).empty());
+    }
+
     // The uncollided part against Beer-Lambert along each lattice direction, computed here: with the
     // sun straight down, direction m's value at node r is bc_m x prod (1 - rho sigma_t) over the nodes
     // behind it back to the boundary.

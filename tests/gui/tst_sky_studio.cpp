@@ -3,6 +3,7 @@
 // slider moves the sun as NOAA's algorithm (core/sky/sun_position) and the solar-noon closed form place it;
 // with every species' basis in memory a sun change starts no lighting job and writes nothing to the grid
 // cache (no LB solve), and the viewport's picture equals a render of freshly solved grids.
+#include <QCheckBox>
 #include <QComboBox>
 #include <QDateEdit>
 #include <QDial>
@@ -295,6 +296,27 @@ private Q_SLOTS:
         pre.render.width = size.width();
         pre.render.height = size.height();
         QVERIFY(maxStep(v->lastImage().copy(0, 0, size.width(), 8), constantSky.copy(0, 0, size.width(), 8)) > 8);
+
+        // The sky in the LB boundary from the panel: the species are lit again by a lighting job (the bases do
+        // not compose it), with the grid `sylva render` solves for the same scene, and the picture changes.
+        const QImage sunBoundary = v->lastImage();
+        const int jobsSky = lighting->lightingJobs();
+        panel->lbSky()->setChecked(true);
+        QCOMPARE(win.document()->scene().lighting.boundary, LbBoundary::SunSky);
+        QVERIFY(!lighting->relightingFor(win.document()->scene()));
+        QVERIFY(waitForFinalImage(v, 180000));
+        QVERIFY(lighting->lightingJobs() > jobsSky);
+        const Scene withSky = win.document()->scene();
+        const AssetsPtr held = win.assetStore()->find(assetKey(withSky.species[0], withSky, true));
+        QVERIFY(held);
+        const std::vector<SpeciesAssets> skyAssets = loadSpeciesAssets(withSky, &fresh, true);
+        QCOMPARE(held->lighting.rgb.size(), skyAssets[0].lighting.rgb.size());
+        QVERIFY(held->lighting.rgb == skyAssets[0].lighting.rgb);
+        QVERIFY(held->lightingNorm == skyAssets[0].lightingNorm);
+        QVERIFY(maxStep(v->lastImage(), sunBoundary) > 0);
+        win.document()->undoStack()->undo();
+        QCOMPARE(win.document()->scene().lighting.boundary, LbBoundary::Sun);
+        QVERIFY(!panel->lbSky()->isChecked());
         win.document()->undoStack()->setClean();
     }
 };

@@ -204,7 +204,7 @@ private Q_SLOTS:
         QTRY_VERIFY_WITH_TIMEOUT(m_win->inspector()->grids() != nullptr, 30000);
         const auto grids = m_win->inspector()->grids();
         const Scene& s = scene();
-        const AssetsPtr lit = m_win->assetStore()->find(assetKey(s.species[0], s.sun, true));
+        const AssetsPtr lit = m_win->assetStore()->find(assetKey(s.species[0], s, true));
         QVERIFY(lit);
         QCOMPARE(grids->lighting.geometry, lit->lighting.geometry);
         QVERIFY(grids->lighting.rgb == lit->lighting.rgb);
@@ -231,7 +231,7 @@ private Q_SLOTS:
         QVERIFY(relitSpy.wait(60000));
         QTRY_VERIFY_WITH_TIMEOUT(m_win->inspector()->grids() != nullptr, 30000);
         const auto second = m_win->inspector()->grids();
-        const AssetsPtr relit = m_win->assetStore()->find(assetKey(scene().species[0], scene().sun, true));
+        const AssetsPtr relit = m_win->assetStore()->find(assetKey(scene().species[0], scene(), true));
         QVERIFY(relit);
         QVERIFY(second->lighting.rgb == relit->lighting.rgb);
         QVERIFY(relit->lighting.rgb != grids->lighting.rgb);
@@ -262,7 +262,7 @@ private Q_SLOTS:
         QVERIFY(QDir().mkpath(folder));
         QVERIFY(waitForJob(m_win->exporter()->exportSpeciesGrids(0, folder), 60000));
         const Scene& s = scene();
-        const AssetsPtr lit = m_win->assetStore()->find(assetKey(s.species[0], s.sun, true));
+        const AssetsPtr lit = m_win->assetStore()->find(assetKey(s.species[0], s, true));
         QVERIFY(lit);
         const LightingGrid light = readLightingGrid(QDir(folder).filePath("Tree_1.lighting.npy").toStdString());
         QCOMPARE(light.geometry, lit->lighting.geometry);   // dims from the array, origin and spacing from the sidecar

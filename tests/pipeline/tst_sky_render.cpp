@@ -9,15 +9,18 @@
 #include <QTest>
 
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "core/base/error.h"
+#include "core/lb/lb_solver.h"
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/sky/sky_light.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/io/env_map_io.h"
+#include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "tests/pipeline/small_forest.h"
 
@@ -240,6 +243,94 @@ private Q_SLOTS:
         }
         QVERIFY(plants > 100);
         QVERIFY2(lit >= plants * 95 / 100, qPrintable(QString("%1 of %2 plant pixels lit by the uniform sky").arg(lit).arg(plants)));
+    }
+
+    // The sky in the LB boundary (issue 16 item 7, `lighting.boundary` sun_sky): the key reads and writes
+    // back; in open space the boundary's free field, as the renderer scales it, is the sun's radiance plus
+    // 2 x the sky's (fluence / pi: the sun's E = pi S, the upper hemisphere's 2 pi L); with the sun dark a
+    // Preetham sky lights the plants' LB part, which the sun's boundary leaves at 0; with the sun on, the
+    // sky only adds (superposition) to every plant pixel's LB part.
+    void skyInTheLbBoundary()
+    {
+        QTemporaryDir dir;
+        const std::string base = dir.path().toStdString();
+        const std::string text = R"({"version": 1, "species": [{"name": "b", "grow": {"species": "shrub", "triangles": 1500, "seed": 3},
+            "lighting": {"grid": 16}}], "instances": [{"species": "b", "position": [0, 0, 0]}], "lighting": {"boundary": "sun_sky"}})";
+        const Scene parsed = parseScene(text, base, "b.json");
+        QCOMPARE(parsed.lighting.boundary, LbBoundary::SunSky);
+        QCOMPARE(parseScene(sceneToJson(parsed, base), base, "again.json").lighting.boundary, LbBoundary::SunSky);
+        QCOMPARE(Scene{}.lighting.boundary, LbBoundary::Sun);
+        std::string bad = text;
+        bad.replace(bad.find("\"sun_sky\""), 9, "\"sky\"");
+        try {
+            parseScene(bad, base, "bad.json");
+            QFAIL("lighting.boundary \"sky\" was accepted");
+        } catch (const Error& e) {
+            QVERIFY2(std::string(e.what()).find("boundary") != std::string::npos, e.what());
+        }
+
+        // The units, with the constant sky L (any kind can go into the boundary).
+        Scene c = parsed;
+        const glm::vec3 L(0.2f, 0.3f, 0.5f);
+        c.sky = L;
+        c.sun.direction = glm::vec3(0.2f, 0.9f, 0.3f);
+        for (float intensity : {1.0f, 0.0f}) {
+            c.sun.intensity = intensity;
+            lb::LbParams p = c.species[0].lighting;
+            p.sun = lbSunDirection(c);
+            const std::optional<lb::BoundaryWeights> w = speciesBoundary(c, p);
+            QVERIFY(w.has_value());
+            const FrameSun fs = frameSun(c, sunRadiance(c.sun));
+            const glm::vec3 unit = lbRadiance(c, fs);
+            if (intensity == 0.0f) QCOMPARE(unit, glm::vec3(1.0f));
+            const std::vector<float> f = lb::boundaryDistribution(p.sun);
+            float free = 0.0f;
+            for (float v : f) free += v;
+            for (int k = 0; k < 3; ++k) {
+                const double shown = double(w->totals()[k]) / double(p.intensity[k] * free) * double(unit[k]);
+                const double expect = double(fs.radiance[k]) + 2.0 * double(L[k]);
+                QVERIFY2(std::abs(shown - expect) < 1e-4 * expect, qPrintable(QString("channel %1: %2 vs %3").arg(k).arg(shown).arg(expect)));
+            }
+            Scene sunOnly = c;
+            sunOnly.lighting.boundary = LbBoundary::Sun;
+            QVERIFY(!speciesBoundary(sunOnly, p).has_value());
+            QCOMPARE(lbRadiance(sunOnly, fs), fs.radiance);
+        }
+
+        // Shrubs under a Preetham sky, their LB part in the picture.
+        Scene r = shrubPatch();
+        r.species = parsed.species;
+        r.skyModel.kind = sky::SkyKind::Preetham;
+        r.skyModel.turbidity = 4.0;
+        r.sun.direction = glm::vec3(0.3f, 0.5f, 0.6f);
+        loadSceneSky(r);
+        auto lbParts = [&](LbBoundary boundary, float sunIntensity) {
+            Scene q = r;
+            q.lighting.boundary = boundary;
+            q.sun.intensity = sunIntensity;
+            const std::vector<SpeciesAssets> assets = loadSpeciesAssets(q, nullptr, true);
+            return renderFilm(buildRenderScene(q, assets, sunRadiance(q.sun)).view());
+        };
+        const Film darkSun = lbParts(LbBoundary::Sun, 0.0f), darkSky = lbParts(LbBoundary::SunSky, 0.0f);
+        const Film litSun = lbParts(LbBoundary::Sun, 1.0f), litSky = lbParts(LbBoundary::SunSky, 1.0f);
+        int plants = 0, skyLit = 0;
+        double sumSun = 0.0, sumSky = 0.0;
+        for (size_t i = 0; i < darkSun.pixels.size(); ++i) {
+            if (darkSun.pixels[i].skyCover != 0.0f || darkSun.pixels[i].normal.y == 1.0f) continue;   // sky or floor
+            ++plants;
+            QCOMPARE(darkSun.pixels[i].indirect, glm::vec3(0.0f));
+            skyLit += luminance(glm::dvec3(darkSky.pixels[i].indirect)) > 0.0 ? 1 : 0;
+            for (int k = 0; k < 3; ++k) {
+                const float a = litSun.pixels[i].indirect[k], b = litSky.pixels[i].indirect[k];
+                QVERIFY2(b >= a * (1.0f - 1e-4f), qPrintable(QString("pixel %1 channel %2: %3 with the sky, %4 without").arg(i).arg(k).arg(b).arg(a)));
+            }
+            sumSun += luminance(glm::dvec3(litSun.pixels[i].indirect));
+            sumSky += luminance(glm::dvec3(litSky.pixels[i].indirect));
+        }
+        QVERIFY(plants > 100);
+        QVERIFY2(skyLit >= plants * 95 / 100, qPrintable(QString("%1 of %2 plant pixels").arg(skyLit).arg(plants)));
+        qInfo("  shrubs' LB part under a Preetham sky (T 4): sun + sky / sun alone %.3f", sumSky / sumSun);
+        QVERIFY(sumSky > 1.05 * sumSun);
     }
 
     // Interleaved sampling: on the open ground (every light visible everywhere) K subsets cycled over
