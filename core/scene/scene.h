@@ -127,8 +127,8 @@ struct SkyDesc {
     std::string path;                    // HDR map (absolute once read; relative to the scene file in it)
     float rotationDeg = 0.0f;            // map: about +Y, adds to every azimuth
     float intensity = 1.0f;              // map: multiplies its pixels (and its sun)
-    int lights = 64;                     // N virtual lights (provisional default, see docs/SCENE.md)
-    int interleave = 8;                  // K subsets: N / K shadow rays per pixel and sample
+    int lights = 64;                     // N virtual lights (default measured: docs/ACCURACY.md "Sky light")
+    int interleave = 16;                 // K subsets: N / K shadow rays per pixel and sample
     bool sunFromMap = true;              // map: its sun found, taken out and made the sun (replacing `sun`)
     // The built sky (pipeline/io/env_map_io: loadSceneSky), shared by the scene's copies; not in the file.
     std::shared_ptr<const sky::Sky> built;

@@ -15,10 +15,10 @@ int runStudy(const Args& args)
     study::Options o;
     const std::string what = args.positional()[0];
     if (what == "all") {
-        o.parts = {study::Part::Lb, study::Part::Voxel, study::Part::Render, study::Part::Scene, study::Part::Truth};
+        o.parts = {study::Part::Lb, study::Part::Voxel, study::Part::Render, study::Part::Scene, study::Part::Truth, study::Part::Sky};
     } else if (what != "report") {
         study::Part part;
-        if (!study::parsePart(what, &part)) throw UsageError("expected lb, voxel, render, scene, truth, all or report, got '" + what + "'");
+        if (!study::parsePart(what, &part)) throw UsageError("expected lb, voxel, render, scene, truth, sky, all or report, got '" + what + "'");
         o.parts = {part};
     }
     o.outDir = args.get("--out", "docs");
@@ -40,8 +40,8 @@ int runStudy(const Args& args)
 
 Command studyCommand()
 {
-    return {"study", "lb|voxel|render|scene|truth|all|report [--out DIR] [--quick]",
-            "measure speed against accuracy; regenerate ACCURACY.md with tables and plots (report: from stored numbers; scene: the forest-level grid against per-instance solves and the relighting basis against direct solves; truth: against Blender's Cycles, skipped without `blender` or with --quick)",
+    return {"study", "lb|voxel|render|scene|truth|sky|all|report [--out DIR] [--quick]",
+            "measure speed against accuracy; regenerate ACCURACY.md with tables and plots (report: from stored numbers; scene: the forest-level grid against per-instance solves and the relighting basis against direct solves; truth: against Blender's Cycles, skipped without `blender` or with --quick; sky: virtual lights x subsets x spp under three skies, the LB with the sky in its boundary against Monte Carlo)",
             {{"--out", "DIR", "folder of ACCURACY.md; plots and numbers go to DIR/accuracy (default docs)"},
              {"--quick", "", "small grids, fewer paths and samples: a few minutes"},
              {"--tree", "MESH", "the real tree (default ../shared/data/trees/quaternius/OBJ/Tree_1.obj)"},

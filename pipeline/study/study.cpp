@@ -15,6 +15,7 @@ bool parsePart(const std::string& name, Part* out)
     else if (name == "render") *out = Part::Render;
     else if (name == "scene") *out = Part::Scene;
     else if (name == "truth") *out = Part::Truth;
+    else if (name == "sky") *out = Part::Sky;
     else return false;
     return true;
 }
@@ -50,6 +51,7 @@ Result run(const Options& options)
     input.render = part(Part::Render, "render", render, measureRender, saveRender, loadRender);
     input.scene = part(Part::Scene, "scene", scene, measureScene, saveScene, loadScene);
     if (wants(Part::Truth)) measureTruth(options);   // writes accuracy/truth.md, which the report includes
+    if (wants(Part::Sky)) measureSky(options);       // writes accuracy/sky.md, likewise
     Result result;
     writeReport(options, input, result);
     result.seconds = secondsNow() - t0;

@@ -11,7 +11,7 @@ class GridCache;
 
 namespace study {
 
-enum class Part { Lb, Voxel, Render, Scene, Truth };   // Scene: the forest-level grid and the relighting basis   // Truth: against Cycles (needs `blender`; skipped without it and with --quick)
+enum class Part { Lb, Voxel, Render, Scene, Truth, Sky };   // Scene: the forest-level grid and the relighting basis   // Truth: against Cycles (needs `blender`; skipped without it and with --quick)   // Sky: virtual lights x subsets x spp, the LB with the sky
 
 struct Options {
     std::vector<Part> parts;            // measured now; the others' stored results are reused (empty: report only)
@@ -35,7 +35,7 @@ struct Result {
 // program), the plots. Throws Error on failures.
 Result run(const Options& options);
 
-// "lb", "voxel", "render", "scene", "truth" -> Part; false otherwise.
+// "lb", "voxel", "render", "scene", "truth", "sky" -> Part; false otherwise.
 bool parsePart(const std::string& name, Part* out);
 
 } // namespace study

@@ -31,6 +31,11 @@ SceneData measureScene(const Options& options);
 // false (and a log line) when skipped: no `blender` (SYLVA_BLENDER overrides the program) or --quick.
 bool measureTruth(const Options& options);
 
+// Sky light (study_sky.cpp): N virtual lights x K subsets x spp on the default forest under a Preetham sky and
+// two HDR maps against 1024 lights x 64 spp, beside the sun-only frame's time; the LB with the sky in its
+// boundary against Monte Carlo with the same boundary. Writes outDir/accuracy/sky.md (the report includes it).
+bool measureSky(const Options& options);
+
 // What the report is written from: whichever parts have stored results.
 struct ReportInput {
     const LbData* lb = nullptr;

@@ -712,6 +712,11 @@ void writeReport(const Options& options, const ReportInput& in, Result& result)
     md << presetSection(in.lb, in.render);
     if (in.scene) md << sceneSection(*in.scene, pl);
     else md << "## Scene scale: the forest-level grid and the relighting basis\n\nNot measured yet: `sylva study scene`.\n\n";
+    {   // the sky's lights, written by `sylva study sky` (measureSky) and kept until rerun
+        std::ifstream sky(dir + "/accuracy/sky.md");
+        if (sky) md << sky.rdbuf();
+        else md << "## Sky light: virtual lights, interleaving and samples\n\nNot measured yet: `sylva study sky`.\n\n";
+    }
     {   // the ground truth against Cycles, written by `sylva study truth` (measureTruth) and kept until rerun
         std::ifstream truth(dir + "/accuracy/truth.md");
         if (truth) md << truth.rdbuf();

@@ -1,5 +1,6 @@
 // `sylva study lb --quick` end to end (CI smoke test, label slow): the report, its kept sections, the plots or
-// the note that they were skipped, and `sylva study report` from the stored numbers; `sylva study scene --quick`.
+// the note that they were skipped, and `sylva study report` from the stored numbers; `sylva study scene --quick`;
+// `sylva study sky --quick`.
 #include <QDir>
 #include <QFile>
 #include <QJsonArray>
@@ -11,6 +12,8 @@
 #include <QTest>
 
 #include <cmath>
+#include <map>
+#include <tuple>
 
 namespace {
 
@@ -150,6 +153,42 @@ private Q_SLOTS:
             ++storages;
         }
         QCOMPARE(storages, 2);
+    }
+
+    // `sylva study sky --quick`: N lights x K subsets x spp on the default forest under a Preetham sky, and
+    // the LB with the sky in its boundary against Monte Carlo. What must hold whatever the numbers: errors
+    // finite in [0, 1); interleaved subsets cycled over more samples come closer to all the lights; the LB
+    // stays near the reference with the sky in its boundary as with the sun alone; the sky adds light in
+    // open space.
+    void quickSkyStudy()
+    {
+        QTemporaryDir dir;
+        QVERIFY(dir.isValid());
+        const Run r = sylva({"study", "sky", "--quick", "--out", dir.path()});
+        QVERIFY2(r.code == 0, qPrintable(r.err + r.out));
+        const QString md = readAll(dir.filePath("ACCURACY.md"));
+        QVERIFY(md.contains("## Sky light: virtual lights, interleaving and samples"));
+        QVERIFY(md.contains("### Preetham"));
+        QVERIFY(md.contains("sylva study lb"));   // the parts not measured say how to measure them
+        std::map<std::tuple<int, int, int>, double> lightErr;
+        std::map<QString, std::pair<double, double>> lbRows;   // boundary -> (error against Monte Carlo, open-space value)
+        for (const QString& line : md.split('\n')) {
+            QStringList cells = line.split('|');
+            for (QString& c : cells) c = c.trimmed().remove('*');
+            if (cells.size() == 11 && cells[1].toInt() > 0 && cells[3].toInt() > 0) {
+                const double le = cells[7].toDouble(), e = cells[8].toDouble(), ratio = cells[6].toDouble();
+                QVERIFY2(std::isfinite(le) && le >= 0.0 && le < 1.0 && e >= 0.0 && e < 1.0 && ratio > 0.0, qPrintable(line));
+                lightErr[{cells[1].toInt(), cells[2].toInt(), cells[3].toInt()}] = le;
+            }
+            if (cells.size() == 6 && (cells[1] == "sun" || cells[1] == "sun_sky")) lbRows[cells[1]] = {cells[2].toDouble(), cells[4].toDouble()};
+        }
+        QCOMPARE(lightErr.size(), size_t(6));
+        const double at4 = lightErr[std::make_tuple(64, 8, 4)], at1 = lightErr[std::make_tuple(64, 8, 1)];
+        QVERIFY2(at4 < at1, qPrintable(QString("%1 vs %2").arg(at4).arg(at1)));
+        QVERIFY(lightErr[std::make_tuple(16, 1, 1)] > 0.0);
+        QCOMPARE(lbRows.size(), size_t(2));
+        for (const auto& [name, row] : lbRows) QVERIFY2(row.first > 0.0 && row.first < 0.6, qPrintable(name + ": " + QString::number(row.first)));
+        QVERIFY(lbRows["sun_sky"].second > lbRows["sun"].second);
     }
 };
 
