@@ -50,7 +50,8 @@ std::string speciesFingerprint(const SpeciesDesc& species)
 ScenePart changedParts(const Scene& a, const Scene& b)
 {
     ScenePart p = ScenePart::None;
-    if (!sameSpecies(a.species, b.species)) p = p | ScenePart::Species;
+    // The lighting block (direct light, LB boundary, forest grid) decides the species' grids: a species change.
+    if (!sameSpecies(a.species, b.species) || !(a.lighting == b.lighting)) p = p | ScenePart::Species;
     bool sameInstances = a.instances.size() == b.instances.size();
     for (size_t i = 0; sameInstances && i < a.instances.size(); ++i) sameInstances = sameInstance(a.instances[i], b.instances[i]);
     if (!sameInstances) p = p | ScenePart::Instances;

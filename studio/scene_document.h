@@ -15,7 +15,7 @@ namespace sylva {
 // Which parts of the scene an edit touched (listeners redo only what depends on them).
 enum class ScenePart : unsigned {
     None = 0,
-    Species = 1u << 0,     // the species list or a species' settings
+    Species = 1u << 0,     // the species list, a species' settings or the lighting block (what their grids follow)
     Instances = 1u << 1,   // the instance list or an instance's placement
     Ground = 1u << 2,
     Sun = 1u << 3,

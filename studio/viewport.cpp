@@ -296,6 +296,12 @@ bool Viewport::paintGpu()
     for (const RenderPass& p : m_worker->passes())
         if (p.divisor == 1) spps.push_back(p.spp);
     if (spps.empty()) spps.push_back(1);
+    // Progressive refinement (issue 16 item 5) on the device, as the worker does it on the CPU: the schedule's
+    // passes light with the sun's shadow ray alone, then one full-size frame of every sample and sky-light
+    // subset (refinementFor's count: the picture the worker accumulates, `sylva render --spp` at that count).
+    RenderScene& rs = m_gpuFrame->frame.rs;
+    const Refinement refine = refinementFor(rs.view(), m_scene.render.spp, spps.back());
+    if (refine.frames > 0) spps.push_back(refine.samples);
     m_gpuPass = std::min(m_gpuPass, spps.size() - 1);
     const QSize size = renderSize();
     const int w = size.width(), h = size.height();
@@ -319,7 +325,10 @@ bool Viewport::paintGpu()
     const size_t pass = m_gpuPass;
     const bool last = pass + 1 == spps.size();
     placeViewFrame(m_gpuFrame->frame, m_scene, sunRadiance(m_scene.sun), w, h, spps[pass]);
-    m_gpuFrame->device->place(m_gpuFrame->frame.rs);
+    const uint32_t skyLights = rs.base.skyLightCount;
+    if (refine.frames > 0 && !last) rs.base.skyLightCount = 0;   // moving: the sun alone
+    m_gpuFrame->device->place(rs);
+    rs.base.skyLightCount = skyLights;
     // The last pass is also kept on the host (lastImage(), tests, export of what is shown).
     QImage picture;
     if (last) picture = QImage(w, h, QImage::Format_RGBX8888);
