@@ -275,7 +275,7 @@ SYLVA_HD inline void volumeStage(const RenderView& v, const Ray& ray, float tEnd
     }
     for (int k = n - 1; k >= 0; --k) {
         const VolumeSegment s = marchVolume(vv, v.volumeInstances[order[k]], ray.org, ray.dir, ray.tmin, tEnd, v.sunDir, v.sunRadiance,
-                                            v.indirectScale);
+                                            v.lbRadiance, v.indirectScale);
         const glm::vec3& T = s.transmittance;
         const float mean = (T.x + T.y + T.z) * (1.0f / 3.0f);
         parts.local = parts.local * T + s.local;

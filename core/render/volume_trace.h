@@ -254,9 +254,12 @@ struct VolumeSegment {
 // bricks that hold medium, density and light sampled trilinearly at each step's midpoint, integrated with
 // the exact exponential over the step (the source held constant: T (1 - e^-sigma_t dt) S / sigma_t).
 // sunDir: toward the sun (unit); sunRadiance: the renderer's sun (surfaces show albedo x it x cos, so its
-// irradiance is pi x it); indirectScale: the LB's weight, as on surfaces.
+// irradiance is pi x it); lbRadiance: the unit of the normalized LB grids (RenderView::lbRadiance: the sun's
+// radiance, or 1 where the sun is dark and the sky is in the boundary); indirectScale: the LB's weight, as
+// on surfaces.
 SYLVA_HD inline VolumeSegment marchVolume(const VolumeArrays& vv, const VolumeInstanceRecord& in, const glm::vec3& org, const glm::vec3& dir,
-                                          float tmin, float tmax, const glm::vec3& sunDir, const glm::vec3& sunRadiance, float indirectScale)
+                                          float tmin, float tmax, const glm::vec3& sunDir, const glm::vec3& sunRadiance,
+                                          const glm::vec3& lbRadiance, float indirectScale)
 {
     VolumeSegment s{glm::vec3(1.0f), glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
     const VolumeGridRecord g = vv.grids[in.grid];
@@ -272,7 +275,11 @@ SYLVA_HD inline VolumeSegment marchVolume(const VolumeArrays& vv, const VolumeIn
     const float mu = glm::dot(sunDir, glm::normalize(dir));   // propagation -sunDir vs. toward the camera -dir
     const glm::vec3 phase(henyeyGreenstein(g.g.x, mu), henyeyGreenstein(g.g.y, mu), henyeyGreenstein(g.g.z, mu));
     const glm::vec3 sunSource = phase * 3.14159265358979f * sunRadiance;   // sigma_s rho T_sun x this
-    const glm::vec3 lbSource = 0.25f * indirectScale * sunRadiance;         // sigma_s rho phi x this (phi / 4 pi x pi)
+    const glm::vec3 lbSource = 0.25f * indirectScale * lbRadiance;          // sigma_s rho phi x this (phi / 4 pi x pi)
+    // The sun's uncollided light in the grid's units (combined tracer): T_sun x sunRadiance / lbRadiance (1 when equal).
+    glm::vec3 sunInLb(1.0f);
+    for (int ch = 0; ch < 3; ++ch)
+        if (lbRadiance[ch] > 0.0f && lbRadiance[ch] != sunRadiance[ch]) sunInLb[ch] = sunRadiance[ch] / lbRadiance[ch];
     const glm::vec3 sigmaA = g.sigmaT - g.sigmaS;
     const bool grey = g.sigmaT.x == g.sigmaT.y && g.sigmaT.y == g.sigmaT.z;
     walkBricks(vv, g, o, d, t0, t1, [&](float m, float ta, float tb) {
@@ -310,7 +317,7 @@ SYLVA_HD inline VolumeSegment marchVolume(const VolumeArrays& vv, const VolumeIn
             }
             if (lb) {
                 glm::vec3 phi = trilinear3(vv.light + g.lightOffset, at);
-                if (sun) phi = glm::max(phi - tSun, glm::vec3(0.0f));   // multiple scattering only
+                if (sun) phi = glm::max(phi - tSun * sunInLb, glm::vec3(0.0f));   // multiple scattering only
                 s.indirect += tw * sigS * phi * lbSource;
             }
             if (hot) {

@@ -13,7 +13,7 @@ namespace sylva {
 lb::LbParams volumeLightingParams(const Scene& scene, const VolumeDesc& v)
 {
     lb::LbParams p = v.lighting;
-    p.sun = scene.sun.direction;
+    p.sun = lbSunDirection(scene);
     p.steps = 0;
     p.tolerance = 0.0;
     return p;
@@ -48,7 +48,10 @@ Scene lightSceneVolumes(const Scene& scene, GridCache* cache, bool needLighting,
             const lb::LbParams p = volumeLightingParams(s, v);
             JobLog own;
             try {
-                data->lighting = lightingFor(data->density, p, cache, &sub, &own, backend);
+                // lighting.boundary sun_sky: the sky in the volume's boundary too, in the species' units.
+                const std::optional<lb::BoundaryWeights> w = speciesBoundary(s, p);
+                data->lighting = w ? lightingForWeights(data->density, p, *w, cache, &sub, &own, backend)
+                                   : lightingFor(data->density, p, cache, &sub, &own, backend);
             } catch (const Error& e) {   // e.g. sigma_t over the LB's stability bound: name the volume
                 throw Error("volume '" + v.name + "': " + e.what() + " (the LB solve of tracers lb and combined; single needs none)");
             }

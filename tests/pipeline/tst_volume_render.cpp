@@ -7,6 +7,7 @@
 #include <QTemporaryDir>
 #include <QTest>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -19,6 +20,7 @@
 #include "core/reference/mc_reference.h"
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
+#include "pipeline/io/env_map_io.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/volume_job.h"
@@ -250,6 +252,43 @@ private Q_SLOTS:
         QVERIFY2(eLb < 0.25, qPrintable(QString::number(eLb)));
         QVERIFY2(eCombined < 0.25, qPrintable(QString::number(eCombined)));
         QVERIFY2(eSingle > eCombined, "single scattering alone should miss the multiple scattering");
+    }
+
+    // The sky in the LB boundary for volumes too (lighting.boundary sun_sky): under a Preetham sky with the
+    // sun dark, a cloud drawn by the LB tracer is black with the sun's boundary and lit with the sky's; with
+    // the sun on, the sky only adds to every pixel's LB part (combined tracer: the sun's uncollided light
+    // taken out in the grid's units).
+    void skyInTheVolumeBoundary()
+    {
+        Scene s = emptyView({8.0, 6.0, -30.0}, {7.5, 7.5, 7.5});
+        s.sun.direction = glm::vec3(glm::normalize(glm::dvec3(-0.6, 0.7, -0.4)));
+        s.skyModel.kind = sky::SkyKind::Preetham;
+        loadSceneSky(s);
+        auto ball = [](int i, int j, int k) {
+            const double r = std::sqrt((i - 7.5) * (i - 7.5) + (j - 7.5) * (j - 7.5) + (k - 7.5) * (k - 7.5));
+            return float(std::clamp(1.2 * (1.0 - r / 7.0), 0.0, 1.0));
+        };
+        VolumeDesc v = volumeOf({16, 16, 16}, 1.0, {0.0, 0.0, 0.0}, 0.02f, 0.58f, 0.0f, ball);
+        auto film = [&](LbBoundary b, float sunIntensity, VolumeTracer t) {
+            Scene q = s;
+            q.lighting.boundary = b;
+            q.sun.intensity = sunIntensity;
+            VolumeDesc vd = v;
+            vd.tracer = t;
+            q.volumes = {vd};
+            const Scene lit = lightSceneVolumes(q, nullptr, true);
+            return renderFilm(buildRenderScene(lit, m_assets, sunRadiance(lit.sun)).view());
+        };
+        const Film darkSun = film(LbBoundary::Sun, 0.0f, VolumeTracer::Lb), darkSky = film(LbBoundary::SunSky, 0.0f, VolumeTracer::Lb);
+        const Film litSun = film(LbBoundary::Sun, 1.0f, VolumeTracer::Combined), litSky = film(LbBoundary::SunSky, 1.0f, VolumeTracer::Combined);
+        int lit = 0;
+        for (size_t i = 0; i < darkSun.pixels.size(); ++i) {
+            QCOMPARE(darkSun.pixels[i].indirect, glm::vec3(0.0f));
+            if (darkSky.pixels[i].indirect.y > 0.0f) ++lit;
+            for (int c = 0; c < 3; ++c) QVERIFY(litSky.pixels[i].indirect[c] >= litSun.pixels[i].indirect[c] * (1.0f - 1e-4f));
+        }
+        std::printf("cloud under a Preetham sky, the sun dark: %d of %zu pixels lit through the sky's LB boundary\n", lit, darkSun.pixels.size());
+        QVERIFY(lit > 100);
     }
 
     // An absorbing box between the sun and the ground: ground pixels whose sun ray crosses the box are
