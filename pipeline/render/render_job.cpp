@@ -153,13 +153,17 @@ SpeciesGrids gridsForMesh(const Scene& scene, const SpeciesDesc& sp, const Trian
         // renderer's shadow rays already draw; the grid keeps the scattered rest (cached like any solve).
         g.lighting = lb::scatteredPart(g.lighting, solve(lb::uncollidedParams(g.params)));
     }
-    const std::vector<float> f = lb::boundaryDistribution(g.params.sun);
-    const float free = std::accumulate(f.begin(), f.end(), 0.0f);
-    g.lightingNorm = g.params.intensity * free;
+    g.lightingNorm = sunFreeField(g.params);
     return g;
 }
 
 } // namespace
+
+glm::vec3 sunFreeField(const lb::LbParams& params)
+{
+    const std::vector<float> f = lb::boundaryDistribution(params.sun);
+    return params.intensity * std::accumulate(f.begin(), f.end(), 0.0f);
+}
 
 std::optional<lb::BoundaryWeights> speciesBoundary(const Scene& scene, const lb::LbParams& params)
 {
@@ -170,8 +174,7 @@ std::optional<lb::BoundaryWeights> speciesBoundary(const Scene& scene, const lb:
     const sky::Sky& sky = d.analytic() ? *d.built : constant;
     const FrameSun sun = frameSun(scene, sunRadiance(scene.sun));
     const glm::vec3 unit = lbRadiance(scene, sun);
-    const std::vector<float> f = lb::boundaryDistribution(params.sun);
-    const glm::vec3 free = params.intensity * std::accumulate(f.begin(), f.end(), 0.0f);
+    const glm::vec3 free = sunFreeField(params);
     lb::BoundaryWeights w = lb::sunWeights(params.sun, params.intensity * (sun.radiance / unit));
     w += lb::skyWeights(sky, float(sky::kPi) * unit / free);
     return w;

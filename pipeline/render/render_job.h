@@ -28,6 +28,10 @@ glm::vec3 sunRadiance(const SunDesc& sun);
 // 962 instances, 896x448.
 Scene defaultScene();
 
+// What the renderer divides a species' or volume's LB grid by (SpeciesAssets / VolumeData lightingNorm): the
+// sun's free-field total sum_m max(0, n_m . d) x params.intensity per channel, whatever else the boundary holds.
+glm::vec3 sunFreeField(const lb::LbParams& params);
+
 // The boundary weights of a species' LB solve when the scene asks for more than the sun (lighting.boundary
 // sun_sky; params: the species' optics with the LB sun, lbSunDirection): the sun's weights x its radiance
 // over lbRadiance, plus the sky's (lb::skyWeights, its sun kept apart) in units of pi x lbRadiance over the

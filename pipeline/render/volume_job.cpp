@@ -1,8 +1,6 @@
 // LB lighting and blackbody tables of a scene's volumes.
 #include "pipeline/render/volume_job.h"
 
-#include <numeric>
-
 #include "core/base/error.h"
 #include "core/color/color.h"
 #include "core/lb/lb_solver.h"
@@ -59,8 +57,7 @@ Scene lightSceneVolumes(const Scene& scene, GridCache* cache, bool needLighting,
                 for (const auto& st : own.stages) log->stages.push_back(v.name + ": " + st);
                 for (const auto& w : own.warnings) log->warnings.push_back(v.name + ": " + w);
             }
-            const std::vector<float> f = lb::boundaryDistribution(p.sun);
-            data->lightingNorm = p.intensity * std::accumulate(f.begin(), f.end(), 0.0f);
+            data->lightingNorm = sunFreeField(p);
         } else {
             data->lighting = LightingGrid{};
         }
