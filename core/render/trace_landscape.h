@@ -53,7 +53,7 @@ SYLVA_HD inline InstanceRecord landPlantInstance(const RenderView& v, uint32_t c
 }
 
 // The plants of cell `cell`'s tile along the ray (camera-relative o, d): the tile's 2D tree, every node as
-// tall as the tile raised by the cell's ground range; each plant reached is lifted onto the ground, thinned,
+// tall as its plants raised over the ground's range under it (the cell's plane, LandCell); each plant reached is lifted onto the ground, thinned,
 // box-tested and traced in its mesh. Returns true when an any-hit query found a hit.
 template <bool AnyHit, bool Kd>
 SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, const glm::vec3& d, float& tmax)
@@ -69,9 +69,13 @@ SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, 
     const glm::vec3 ot = (o - corner) * ik, dt = d * ik;   // the tile frame (t unchanged)
     const glm::vec3 inv = safeReciprocal(dt);
     const float gLo = c.ground.x * ik, gHi = c.ground.y * ik;   // the cell corner lies at the terrain frame's y = 0
-    // A node's box: its rectangle, its plants' vertical extent raised anywhere in the cell's ground range.
+    // The ground under tile-frame (x, z): the cell's plane within its deviation, clipped to the cell's range.
+    const float p0 = c.plane.x * ik, px = c.plane.y * ik, pz = c.plane.z * ik, pe = c.plane.w * ik;
+    // A node's box: its rectangle, its plants' vertical extent raised anywhere in the ground's range under it.
     auto entry = [&](const TileNode& n) {
-        return rayBoxEntry(glm::vec3(n.lox, gLo + n.ylo, n.loz), glm::vec3(n.hix, gHi + n.yhi, n.hiz), ot, inv, q.tmin, tmax);
+        const float x0 = px * n.lox, x1 = px * n.hix, z0 = pz * n.loz, z1 = pz * n.hiz;
+        const float lo = maxf(p0 + minf(x0, x1) + minf(z0, z1) - pe, gLo), hi = minf(p0 + maxf(x0, x1) + maxf(z0, z1) + pe, gHi);
+        return rayBoxEntry(glm::vec3(n.lox, lo + n.ylo, n.loz), glm::vec3(n.hix, hi + n.yhi, n.hiz), ot, inv, q.tmin, tmax);
     };
     // Every node's box is tested once, by its parent (the root here): the stack keeps the entry distance of
     // each deferred child, re-checked against the closest hit when it comes up.
@@ -105,9 +109,10 @@ SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, 
             for (uint32_t k = n.first; k < n.first + n.count; ++k) {
                 const TilePlant& p = v.tilePlants[k];
                 SYLVA_COUNT(g_plantBoxTests);
-                // The plant's box raised anywhere in the cell's ground range first (tile frame): most plants of a
-                // leaf are rejected before the height field is read.
-                if (!(rayBoxEntry(glm::vec3(p.x + p.lo.x, gLo + p.lo.y, p.z + p.lo.z), glm::vec3(p.x + p.hi.x, gHi + p.hi.y, p.z + p.hi.z), ot, inv,
+                // The plant's box raised anywhere in the ground's range at its root (the plane's bound; tile frame)
+                // first: most plants of a leaf are rejected before the height field is read.
+                const float g = p0 + px * p.x + pz * p.z, lo = maxf(g - pe, gLo), hi = minf(g + pe, gHi);
+                if (!(rayBoxEntry(glm::vec3(p.x + p.lo.x, lo + p.lo.y, p.z + p.lo.z), glm::vec3(p.x + p.hi.x, hi + p.hi.y, p.z + p.hi.z), ot, inv,
                                   q.tmin, tmax) <= tmax))
                     continue;
                 // Its root on the ground, its box there, and only then whether it grows (density, snow, rock).

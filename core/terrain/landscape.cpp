@@ -307,6 +307,50 @@ void setLandscapeDensity(LandscapeLayout& L, const DensityDesc& density, double 
     L.noRock = density.enabled && density.noRock ? 1u : 0u;
 }
 
+namespace {
+
+// Cell record of tile t over samples [i0, i1] x [j0, j1] (the footprint of its plants), the cell's corner at DEM
+// frame (x0, z0): the samples' range and the least-squares plane h = a + b tx + c tz in the tile frame (tx = (X -
+// x0) / tileScale) with the samples' largest deviation from it, plus rounding (the traversal evaluates the plane in
+// float, the roots' heights are float).
+LandCell groundUnder(const HeightField& field, long i0, long i1, long j0, long j1, double x0, double z0, double tileScale, uint32_t t)
+{
+    const HeightFieldLayout& H = field.layout;
+    float lo = 3e38f, hi = -3e38f;
+    double n = 0.0, sx = 0.0, sz = 0.0, sh = 0.0, sxx = 0.0, szz = 0.0, sxz = 0.0, sxh = 0.0, szh = 0.0;
+    // Centred coordinates (tile metres about the footprint's middle) keep the normal equations well conditioned.
+    const double mx = 0.5 * double(i0 + i1) * H.dx, mz = 0.5 * double(j0 + j1) * H.dz;
+    for (long j = j0; j <= j1; ++j)
+        for (long i = i0; i <= i1; ++i) {
+            const float h = field.heights[size_t(j) * H.nx + size_t(i)];
+            lo = std::min(lo, h), hi = std::max(hi, h);
+            const double x = (double(i) * H.dx - mx) / tileScale, z = (double(j) * H.dz - mz) / tileScale;
+            n += 1.0, sx += x, sz += z, sh += h, sxx += x * x, szz += z * z, sxz += x * z, sxh += x * h, szh += z * h;
+        }
+    // Solve [n sx sz; sx sxx sxz; sz sxz szz] (a, b, c) = (sh, sxh, szh) by Cramer's rule; a flat plane through
+    // the range's middle when the samples are one row or column (the matrix is singular).
+    const double det = n * (sxx * szz - sxz * sxz) - sx * (sx * szz - sxz * sz) + sz * (sx * sxz - sxx * sz);
+    double a = 0.5 * (double(lo) + double(hi)), b = 0.0, c = 0.0;
+    if (i1 > i0 && j1 > j0 && std::abs(det) > 1e-12 * std::max(1.0, n * sxx * szz)) {
+        a = (sh * (sxx * szz - sxz * sxz) - sx * (sxh * szz - sxz * szh) + sz * (sxh * sxz - sxx * szh)) / det;
+        b = (n * (sxh * szz - sxz * szh) - sh * (sx * szz - sxz * sz) + sz * (sx * szh - sxh * sz)) / det;
+        c = (n * (sxx * szh - sxh * sxz) - sx * (sx * szh - sxh * sz) + sh * (sx * sxz - sxx * sz)) / det;
+    }
+    double e = 0.0;
+    for (long j = j0; j <= j1; ++j)
+        for (long i = i0; i <= i1; ++i) {
+            const double x = (double(i) * H.dx - mx) / tileScale, z = (double(j) * H.dz - mz) / tileScale;
+            e = std::max(e, std::abs(double(field.heights[size_t(j) * H.nx + size_t(i)]) - (a + b * x + c * z)));
+        }
+    // From the footprint's middle to the cell corner: tx' = tx + (mx - x0) / tileScale.
+    a -= b * (mx - x0) / tileScale + c * (mz - z0) / tileScale;
+    const double mag = std::max(std::abs(double(lo)), std::abs(double(hi)));
+    e += 1e-4 * (mag + double(hi - lo)) + 1e-4;
+    return LandCell{glm::vec2(lo, hi), t, 0, glm::vec4(float(a), float(b), float(c), float(e))};
+}
+
+} // namespace
+
 LandscapeBuild buildLandscape(const HeightField& field, uint32_t cells, const TileSetDesc& tiles, const TilingDesc& tiling,
                               const DensityDesc& density, double terrainY, float snowY, float rockCos,
                               const std::vector<LandscapeSpecies>& species)
@@ -374,13 +418,7 @@ LandscapeBuild buildLandscape(const HeightField& field, uint32_t cells, const Ti
             const double z0 = double(cz) * C + double(L.tileScale) * e.y, z1 = double(cz) * C + double(L.tileScale) * e.w;
             const long i0 = std::clamp(long(std::floor(x0 / H.dx)), 0L, long(H.nx - 1)), i1 = std::clamp(long(std::ceil(x1 / H.dx)), 0L, long(H.nx - 1));
             const long j0 = std::clamp(long(std::floor(z0 / H.dz)), 0L, long(H.nz - 1)), j1 = std::clamp(long(std::ceil(z1 / H.dz)), 0L, long(H.nz - 1));
-            float lo = 3e38f, hi = -3e38f;
-            for (long j = j0; j <= j1; ++j)
-                for (long i = i0; i <= i1; ++i) {
-                    const float h = field.heights[size_t(j) * H.nx + size_t(i)];
-                    lo = std::min(lo, h), hi = std::max(hi, h);
-                }
-            b.cells[cz * L.cellsX + cx] = LandCell{glm::vec2(lo, hi), t, 0};
+            b.cells[cz * L.cellsX + cx] = groundUnder(field, i0, i1, j0, j1, double(cx) * C, double(cz) * C, double(L.tileScale), t);
         }
     });
     for (size_t c = 0; c < nc; ++c) {

@@ -1,7 +1,7 @@
 // Plant-covered landscapes (seed 002 sections 4.1-4.3, 5.2): the terrain cut into N x N cells, each mapped
 // to a Wang tile (a square population of plant instances), a 2D kd-tree over the cells and a 2D tree per
 // tile whose boxes reach the tile's top; plants are lifted onto the height field and thinned by the density
-// rule while tracing, nothing is stored per cell beyond its tile and ground range. Plain records here (host
+// rule while tracing, nothing is stored per cell beyond its tile and a bound of its ground (range and plane). Plain records here (host
 // and device); the traversal is core/render/trace_landscape.h, the build is landscape.cpp.
 #pragma once
 
@@ -43,11 +43,17 @@ struct LandNode {
     uint32_t pad;
 };
 
-// One cell: the ground's min/max height under its tile's plants, its tile. 16 bytes.
+// One cell: the ground under its tile's plants' footprint, its tile. ground: the min/max height there; plane:
+// a plane through it, the ground height at tile-frame (tx, tz) (tile metres, the cell corner at 0) within
+// plane.x + plane.y tx + plane.z tz +- plane.w metres (DEM frame), a least-squares fit to the samples under the
+// footprint with its largest deviation from them (the ground is linear between samples, so the bound holds
+// everywhere on it) plus float rounding. The traversal raises a tile node or plant over the plane's range under
+// it instead of the whole cell's (a cell on a slope spans tens of metres). 32 bytes.
 struct LandCell {
     glm::vec2 ground;
     uint32_t tile;
     uint32_t pad;
+    glm::vec4 plane;
 };
 
 // A tile: its 2D tree (tileNodes from nodeOffset, node 0 its root) and plants. yLo/yHi: the plants' boxes'

@@ -121,6 +121,75 @@ class TestLandscape : public QObject {
 private Q_SLOTS:
     void initTestCase() { m_assets = test::oneShrub(); }
 
+    // The cells' ground bound (LandCell: range and plane +- deviation), which the traversal raises tile nodes
+    // and plants over: the ground under every plant of every cell's tile (its root, where the traversal reads it
+    // with landPlantHeight, and random points under its box) lies inside it, at 4, 16 and 32 cells of a sloped,
+    // bumpy terrain; and on cells much smaller than the hills the plane's band is narrower than the range it replaces.
+    void cellGroundBoundHoldsTheGround()
+    {
+        const uint32_t n = 257;
+        const float spacing = 2.0f;
+        std::vector<float> heights(size_t(n) * n);
+        for (uint32_t j = 0; j < n; ++j)
+            for (uint32_t i = 0; i < n; ++i)
+                heights[size_t(j) * n + i] = 40.0f * std::sin(0.05f * float(i)) * std::cos(0.04f * float(j)) + 0.3f * float(i) +
+                                             2.0f * std::sin(1.3f * float(i) + 0.7f * float(j)) + 1500.0f;
+        const HeightField field = buildHeightField(std::move(heights), n, n, spacing, spacing);
+        const HeightFieldView view{field.layout, field.heights.data(), field.ranges.data()};
+        std::mt19937 rng(5);
+        std::uniform_real_distribution<float> u01(0.0f, 1.0f);
+        for (const uint32_t cells : {4u, 16u, 32u}) {
+            TileSetDesc tiles;
+            tiles.size = 0.8 * double(n - 1) * spacing / double(cells);   // non-conforming: plants scaled by 1.25
+            tiles.seed = 3;
+            TilePlantDesc p;
+            p.species = 0;
+            p.speciesName = "tree";
+            p.spacing = 3.0;
+            tiles.plants = {p};
+            const LandscapeSpecies sp{0, glm::vec3(-1.5f, 0.0f, -1.5f), glm::vec3(1.5f, 6.0f, 1.5f), 100.0};
+            const LandscapeBuild b = buildLandscape(field, cells, tiles, TilingDesc{}, DensityDesc{}, 0.0, 3e38f, -2.0f, {sp});
+            const LandscapeLayout& L = b.layout;
+            size_t tested = 0, outside = 0;
+            double range = 0.0, band = 0.0;
+            for (uint32_t cz = 0; cz < L.cellsZ; ++cz)
+                for (uint32_t cx = 0; cx < L.cellsX; ++cx) {
+                    const LandCell& c = b.cells[size_t(cz) * L.cellsX + cx];
+                    range += double(c.ground.y - c.ground.x);
+                    band += std::min(2.0 * double(c.plane.w), double(c.ground.y - c.ground.x));
+                    const TileRecord& t = b.tiles[c.tile];
+                    for (uint32_t k = 0; k < t.plantCount; ++k) {
+                        const TilePlant& pl = b.plants[t.plantOffset + k];
+                        for (int s = 0; s < 4; ++s) {
+                            TilePlant at = pl;   // s = 0: the root; else a random point under the plant's box
+                            if (s > 0) {
+                                at.x = pl.x + pl.lo.x + u01(rng) * (pl.hi.x - pl.lo.x);
+                                at.z = pl.z + pl.lo.z + u01(rng) * (pl.hi.z - pl.lo.z);
+                            }
+                            float y;
+                            uint32_t tri;
+                            if (!landPlantHeight(L, view, cx, cz, at, y, tri)) continue;   // off the terrain
+                            const double g = double(c.plane.x) + double(c.plane.y) * at.x + double(c.plane.z) * at.z;
+                            const double lo = std::max(g - c.plane.w, double(c.ground.x)), hi = std::min(g + c.plane.w, double(c.ground.y));
+                            ++tested;
+                            if (!(double(y) >= lo && double(y) <= hi)) {
+                                if (outside++ < 5)
+                                    qWarning("cells %u, cell (%u, %u): ground %.4f outside [%.4f, %.4f]", cells, cx, cz, double(y), lo, hi);
+                            }
+                        }
+                    }
+                }
+            const double nc = double(L.cellsX) * L.cellsZ;
+            qInfo("%u^2 cells: %zu ground points tested, %zu outside; mean range %.2f m, mean plane band %.2f m", cells, tested, outside,
+                  range / nc, band / nc);
+            QVERIFY(tested > 20000);
+            QCOMPARE(outside, size_t(0));
+            // Cells much smaller than the hills' 250 m wavelength are nearly planar (at 4 cells of 103 m the hills curve
+            // within a cell, and the band is about the range).
+            if (cells >= 16) QVERIFY2(band < 0.7 * range, "the plane's band should be narrower than the range on these slopes");
+        }
+    }
+
     // The cells' kd-tree and the tiles' 2D trees find the closest hit a flattened scene of the same plants
     // finds (a BVH over every plant), ray for ray: rays from the camera, from above and grazing the ground,
     // with tiles that do (k = 1) and do not (k = 0.8) conform to the cells.
