@@ -367,6 +367,15 @@ private Q_SLOTS:
         RenderTimings timings;
         const RenderScene rs = prepareRenderScene(s, &cache, nullptr, nullptr, &cpuBackend, timings);
         const Film cpu = renderFilm(rs.view());
+        {   // a picture, not a flat field (a camera looking at nothing would compare equal too)
+            const ImageRgba a = toneMapped(composeMode(cpu, RenderMode::Full, s.sky), cpu.width, cpu.height, 0.18f);
+            double sum = 0.0, sq = 0.0;
+            const size_t np = a.pixels.size() / 4;
+            for (size_t i = 0; i < np; ++i) sum += a.pixels[4 * i + 1], sq += double(a.pixels[4 * i + 1]) * a.pixels[4 * i + 1];
+            const double mean = sum / double(np), sd = std::sqrt(std::max(0.0, sq / double(np) - mean * mean));
+            qInfo("CPU picture: mean green %.3f, standard deviation %.3f", mean, sd);
+            QVERIFY(sd > 0.03);
+        }
         const Film gpu = cuda::renderCuda(cuda::DeviceScene(rs));
         QCOMPARE(gpu.width, cpu.width);
         QCOMPARE(gpu.height, cpu.height);
