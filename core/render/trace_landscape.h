@@ -53,8 +53,9 @@ SYLVA_HD inline InstanceRecord landPlantInstance(const RenderView& v, uint32_t c
 }
 
 // The plants of cell `cell`'s tile along the ray (camera-relative o, d): the tile's 2D tree, every node as
-// tall as its plants raised over the ground's range under it (the cell's plane, LandCell); each plant reached is lifted onto the ground, thinned,
-// box-tested and traced in its mesh. Returns true when an any-hit query found a hit.
+// tall as its plants raised over the ground's range under it (the cell's plane, LandCell); each plant reached
+// is lifted onto the ground, thinned, box-tested and traced in its mesh. Returns true when an any-hit query
+// found a hit.
 template <bool AnyHit, bool Kd>
 SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, const glm::vec3& d, float& tmax)
 {
