@@ -31,6 +31,7 @@
 #include "core/base/error.h"
 #include "core/base/version.h"
 #include "core/render/render_cpu.h"
+#include "core/render/scene_bytes.h"
 #include "pipeline/mpi/mpi_session.h"
 #include "pipeline/mpi/mpi_tiles.h"
 
@@ -182,49 +183,17 @@ void broadcastBytes(void* data, size_t bytes, double timeout)
     }
 }
 
-// What the other ranks need to trace the frame (RenderScene::view()): the arrays' sizes and the view's
-// environment, camera and settings (its pointers mean nothing on another rank; view() sets them).
-#define SYLVA_X(part, where, T, name, stat) +1
-constexpr size_t kSceneArrays = 0 SYLVA_RENDER_ARRAYS(SYLVA_X);
-#undef SYLVA_X
-struct SceneHeader {
-    uint64_t counts[kSceneArrays];
-    RenderView base;
-};
-static_assert(std::is_trivially_copyable_v<RenderView>, "the view's settings travel as bytes");
-
-// The broadcast in three steps. Rank 0 posts the header (sceneHeader); the other ranks, once it has
-// come, make room for the arrays (allocateScene: for a large scene mostly the first touch of fresh
+// What the other ranks need to trace the frame (RenderScene::view()): the header of core/render/scene_bytes.h.
+// The broadcast in three steps. Rank 0 posts the header (renderSceneHeader); the other ranks, once it has
+// come, make room for the arrays (allocateRenderScene: for a large scene mostly the first touch of fresh
 // memory, 0.1-0.5 s for the default forest's 290 MB on the 2-core VM, during which rank 0 traces) and
 // say so (kReady); then the arrays travel (broadcastArrays, 9-11 GB/s over shared memory).
-SceneHeader sceneHeader(const RenderScene& rs)
-{
-    SceneHeader h{};
-    size_t i = 0;
-#define SYLVA_X(part, where, T, name, stat) h.counts[i++] = rs.name.size();
-    SYLVA_RENDER_ARRAYS(SYLVA_X)
-#undef SYLVA_X
-    h.base = rs.base;
-    return h;
-}
-
-RenderScene allocateScene(const SceneHeader& h)
-{
-    RenderScene rs;
-    size_t i = 0;
-#define SYLVA_X(part, where, T, name, stat) rs.name.resize(size_t(h.counts[i++]));
-    SYLVA_RENDER_ARRAYS(SYLVA_X)
-#undef SYLVA_X
-    rs.base = h.base;
-    return rs;
-}
+using SceneHeader = RenderSceneHeader;
 
 // Rank 0's arrays to every rank (MPI_Ibcast takes a non-const buffer; rank 0's is only read).
 void broadcastArrays(const RenderScene& rs, double timeout)
 {
-#define SYLVA_X(part, where, T, name, stat) broadcastBytes(const_cast<T*>(rs.name.data()), rs.name.size() * sizeof(T), timeout);
-    SYLVA_RENDER_ARRAYS(SYLVA_X)
-#undef SYLVA_X
+    forEachRenderSceneArray(const_cast<RenderScene&>(rs), [&](void* data, size_t bytes) { broadcastBytes(data, bytes, timeout); });
 }
 
 std::unique_ptr<tbb::global_control> threadLimit(int threads)
@@ -544,7 +513,7 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
         if (const RenderScene* rs = queue.sceneToSend()) {
             try {
                 if (!headerPosted) {
-                    header = sceneHeader(*rs);
+                    header = renderSceneHeader(*rs);
                     check(MPI_Ibcast(&header, int(sizeof header), MPI_BYTE, 0, MPI_COMM_WORLD, &headerReq), "Ibcast");
                     headerPosted = true;
                 }
@@ -682,7 +651,7 @@ public:
             beat();
             std::this_thread::sleep_for(std::chrono::microseconds(200));
         }
-        RenderScene rs = busy([&] { return allocateScene(h); });
+        RenderScene rs = busy([&] { return allocateRenderScene(h); });
         send(nullptr, 0, kReady);
         try {
             broadcastArrays(rs, m_timeout);

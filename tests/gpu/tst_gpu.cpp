@@ -1,5 +1,6 @@
 // The CUDA backend against the CPU path: LB solves, ray hits, pictures; and the CPU fallback.
 // Tests that need a device skip with a message when there is none (CI machines have no GPU).
+#include <QDir>
 #include <QProcess>
 #include <QTemporaryDir>
 #include <QTest>
@@ -10,9 +11,11 @@
 #include <random>
 
 #include "core/backend/backend.h"
+#include "core/base/error.h"
 #include "core/grid/grid_compare.h"
 #include "core/lb/lb_solver.h"
 #include "core/render/render_cpu.h"
+#include "core/render/scene_bytes.h"
 #include "core/render/shade.h"
 #include "cuda/device_query.h"
 #include "pipeline/backend_select.h"
@@ -341,10 +344,12 @@ private Q_SLOTS:
         QTest::newRow("forest, Preetham sky, sun_sky boundary") << "default_forest.sylva.json" << true;
     }
 
+    // With SYLVA_GPU_REPLAY_DIR=DIR each prepared frame and its CPU film are also written to DIR/NAME.frame (with or
+    // without a device) for gpu_replay on a machine that has a device but not these libraries (device_replay.sh).
     void bundledScenesMatchCpu()
     {
-        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
-#if SYLVA_HAVE_CUDA
+        const QString replayDir = qEnvironmentVariable("SYLVA_GPU_REPLAY_DIR");
+        if (!m_noDevice.isEmpty() && replayDir.isEmpty()) QSKIP(qPrintable("skipped: " + m_noDevice));
         QFETCH(QString, file);
         QFETCH(bool, sky);
         Scene s = readSceneFile(std::string(SYLVA_TEST_DATA) + "/../../resources/" + file.toStdString());
@@ -376,6 +381,13 @@ private Q_SLOTS:
             qInfo("CPU picture: mean green %.3f, standard deviation %.3f", mean, sd);
             QVERIFY(sd > 0.03);
         }
+        if (!replayDir.isEmpty()) {
+            QDir().mkpath(replayDir);
+            QString name = QString::fromLatin1(QTest::currentDataTag()).section(',', 0, 0);
+            writeRenderSceneFile((replayDir + "/" + name + (sky ? "_sky" : "") + ".frame").toStdString(), rs, cpu, s.sky);
+        }
+        if (!m_noDevice.isEmpty()) QSKIP(qPrintable("frame written; the compare skipped: " + m_noDevice));
+#if SYLVA_HAVE_CUDA
         const Film gpu = cuda::renderCuda(cuda::DeviceScene(rs));
         QCOMPARE(gpu.width, cpu.width);
         QCOMPARE(gpu.height, cpu.height);
@@ -483,6 +495,69 @@ private Q_SLOTS:
         interop.releasePixelBuffer();
         glDeleteBuffers(1, &pbo);
 #endif
+    }
+
+    // The frame file gpu_replay reads (core/render/scene_bytes.h), on any machine: the shrubs' frame and film
+    // written and read back give the same arrays, settings and film; gpu_replay --cpu traces the read frame to the
+    // same bits as the film stored; a truncated file or another layout is refused with a message.
+    void frameFileRoundTrip()
+    {
+        Scene s = test::twoShrubs();
+        const RenderScene rs = buildRenderScene(s, litShrubs(), sunRadiance(s.sun));
+        const Film film = renderFilm(rs.view());
+        QTemporaryDir dir;
+        const std::string path = dir.filePath("shrubs.frame").toStdString();
+        writeRenderSceneFile(path, rs, film, s.sky);
+        RenderScene back;
+        Film backFilm;
+        glm::vec3 sky(0.0f);
+        readRenderSceneFile(path, back, backFilm, sky);
+        QCOMPARE(sky, s.sky);
+        QCOMPARE(backFilm.width, film.width);
+        QVERIFY(std::memcmp(backFilm.pixels.data(), film.pixels.data(), film.pixels.size() * sizeof(SampleParts)) == 0);
+        size_t arrays = 0, bytes = 0;
+        std::vector<std::pair<const void*, size_t>> mine;
+        forEachRenderSceneArray(const_cast<RenderScene&>(rs), [&](void* d, size_t n) { mine.emplace_back(d, n); });
+        forEachRenderSceneArray(back, [&](void* d, size_t n) {
+            QCOMPARE(n, mine[arrays].second);
+            QVERIFY(n == 0 || std::memcmp(d, mine[arrays].first, n) == 0);
+            ++arrays, bytes += n;
+        });
+        QCOMPARE(arrays, kRenderSceneArrays);
+        QVERIFY(bytes > 100000);
+        QVERIFY(std::memcmp(&back.base, &rs.base, sizeof(RenderView)) == 0);
+        const Film again = renderFilm(back.view());
+        QVERIFY(std::memcmp(again.pixels.data(), film.pixels.data(), film.pixels.size() * sizeof(SampleParts)) == 0);
+
+        QProcess p;
+        p.start(SYLVA_GPU_REPLAY_PATH, {dir.path(), "--cpu"});
+        QVERIFY(p.waitForFinished(120000));
+        const QString out = QString::fromUtf8(p.readAllStandardOutput());
+        QVERIFY2(p.exitCode() == 0, qPrintable(out + QString::fromUtf8(p.readAllStandardError())));
+        QVERIFY2(out.contains("shrubs full: 0 of") && out.contains("the same bits") && out.contains("frames_failed=0"), qPrintable(out));
+
+        // A truncated file, and one whose signature is another build's.
+        {
+            QFile f(QString::fromStdString(path));
+            QVERIFY(f.open(QIODevice::ReadWrite));
+            const QByteArray all = f.readAll();
+            f.resize(all.size() / 2);
+        }
+        for (int pass = 0; pass < 2; ++pass) {
+            try {
+                readRenderSceneFile(path, back, backFilm, sky);
+                QFAIL("a bad frame file was read");
+            } catch (const Error& e) {
+                const std::string why = e.what();
+                QVERIFY2(why.find(pass == 0 ? "ends early" : "another build") != std::string::npos, e.what());
+            }
+            if (pass == 0) {
+                QFile f(QString::fromStdString(path));
+                QVERIFY(f.open(QIODevice::ReadWrite));
+                QVERIFY(f.seek(sizeof(uint64_t) + 6));   // inside "sylva frame <version>"
+                f.write("X");
+            }
+        }
     }
 
     // With no visible device, --backend cuda says so on stderr and renders on the CPU (runs everywhere).

@@ -1,0 +1,48 @@
+// A built frame (RenderScene: its flat arrays and view settings) as bytes for another process: the MPI ranks
+// receive rank 0's frame this way (pipeline/mpi/mpi_render.cpp), and a frame written to a file is traced again
+// elsewhere (tests/gpu/gpu_replay.cpp: the GPU checks on a machine that has a device but none of the pipeline's
+// libraries). The header holds every array's element count and the view's settings (RenderView as bytes: its
+// pointers mean nothing in another process; RenderScene::view() sets them); the arrays follow in
+// SYLVA_RENDER_ARRAYS order. Only what tracing needs travels (not meshLevels or the other build-side members).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <type_traits>
+
+#include "core/render/render_scene.h"
+
+namespace sylva {
+
+#define SYLVA_X(part, where, T, name, stat) +1
+inline constexpr size_t kRenderSceneArrays = 0 SYLVA_RENDER_ARRAYS(SYLVA_X);
+#undef SYLVA_X
+static_assert(std::is_trivially_copyable_v<RenderView>, "the view's settings travel as bytes");
+
+struct RenderSceneHeader {
+    uint64_t counts[kRenderSceneArrays];
+    RenderView base;
+};
+
+RenderSceneHeader renderSceneHeader(const RenderScene& rs);
+
+// A scene with the header's arrays sized (value-initialized) and its view settings, ready to receive the arrays.
+RenderScene allocateRenderScene(const RenderSceneHeader& h);
+
+// fn(data, bytes) for each array in SYLVA_RENDER_ARRAYS order (rs's own storage: read it to send, write it to receive).
+template <class Fn>
+void forEachRenderSceneArray(RenderScene& rs, Fn&& fn)
+{
+#define SYLVA_X(part, where, T, name, stat) fn(static_cast<void*>(rs.name.data()), rs.name.size() * sizeof(T));
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
+}
+
+// A frame and its traced film to a file, and back. The file starts with a signature of this build's layout
+// (the program version, every array's element size and the header's size): readRenderSceneFile refuses a file
+// another layout wrote (sylva::Error naming both), as it does a short or unreadable one.
+struct Film;
+void writeRenderSceneFile(const std::string& path, const RenderScene& rs, const Film& film, const glm::vec3& sky);
+void readRenderSceneFile(const std::string& path, RenderScene& scene, Film& film, glm::vec3& sky);
+
+} // namespace sylva
