@@ -76,14 +76,16 @@ int main(int argc, char** argv)
 {
     bool sim = true, lb = true;
     int n = 128, reps = 3;
+    double tol = volume::SmokeSettings{}.pressureTolerance;
     for (int a = 1; a < argc; ++a) {
         const std::string s = argv[a];
         if (s == "--sim-only") lb = false;
         else if (s == "--lb-only") sim = false;
         else if (s == "--grid" && a + 1 < argc) n = std::atoi(argv[++a]);
         else if (s == "--reps" && a + 1 < argc) reps = std::atoi(argv[++a]);
+        else if (s == "--tol" && a + 1 < argc) tol = std::atof(argv[++a]);
         else {
-            std::printf("usage: bench_volume [--sim-only | --lb-only] [--grid N (simulation, default 128)] [--reps R]\n");
+            std::printf("usage: bench_volume [--sim-only | --lb-only] [--grid N (simulation, default 128)] [--reps R] [--tol T (pressure, default 1e-6)]\n");
             return s == "--help" ? 0 : 2;
         }
     }
@@ -92,6 +94,7 @@ int main(int argc, char** argv)
         s.cells = glm::ivec3(n);
         s.cellSize = 1.0f / float(n);
         s.dt = 0.02f;
+        s.pressureTolerance = tol;
         volume::SmokeSource src;
         src.shape.centre = glm::vec3(0.5f, 0.12f, 0.5f);
         src.shape.radius = 0.1f;
@@ -117,9 +120,13 @@ int main(int argc, char** argv)
             const double bytes = cells * (184.0 + 250.0 * iterations);
             const double floor = copySeconds(size_t(bytes));
             const char* name = interp == volume::SmokeInterp::Linear ? "linear" : "cubic";
-            std::printf("smoke step %d^3 (%s): %.3f s median of %d (min %.3f), %.2f processor s per step, %.1f pressure iterations; "
-                        "streaming floor of %.0f MB %.3f s (%.1fx the floor)\n",
-                        n, name, t.median, reps, t.min, cpuPerStep, iterations, bytes / 1e6, floor, t.median / floor);
+            std::printf("smoke step %d^3 (%s, pressure tolerance %g): %.3f s median of %d (min %.3f), %.2f processor s per step, %.1f pressure "
+                        "iterations; streaming floor of %.0f MB %.3f s (%.1fx the floor)\n",
+                        n, name, tol, t.median, reps, t.min, cpuPerStep, iterations, bytes / 1e6, floor, t.median / floor);
+            const volume::SmokeStepStats& st = smoke.lastStats();
+            const double divRatio = st.divergenceBefore > 0.0 ? st.divergenceAfter / st.divergenceBefore : 0.0;
+            std::printf("  divergence after / before the last projection: %.2e\n", divRatio);
+            std::printf("smoke_step_%s_divergence_ratio=%.3e\n", name, divRatio);
             std::printf("smoke_step_%s_cpu_s=%.3f\n", name, cpuPerStep);
             std::printf("smoke_step_%s_s=%.4f\nsmoke_step_%s_iterations=%.1f\nsmoke_step_%s_floor_s=%.4f\nsmoke_step_%s_vs_floor=%.2f\n", name,
                         t.median, name, iterations, name, floor, name, t.median / floor);
