@@ -67,7 +67,7 @@ void writeRenderSceneFile(const std::string& path, const RenderScene& rs, const 
         out.write(sig.data(), std::streamsize(sig.size()));
         const RenderSceneHeader h = renderSceneHeader(rs);
         out.write(reinterpret_cast<const char*>(&h), sizeof h);
-        forEachRenderSceneArray(const_cast<RenderScene&>(rs), [&](void* data, size_t bytes) { out.write(static_cast<const char*>(data), std::streamsize(bytes)); });
+        forEachRenderSceneArray(rs, [&](const void* data, size_t bytes) { out.write(static_cast<const char*>(data), std::streamsize(bytes)); });
         const FilmHeader fh{film.width, film.height, {sky.x, sky.y, sky.z}};
         out.write(reinterpret_cast<const char*>(&fh), sizeof fh);
         out.write(reinterpret_cast<const char*>(film.pixels.data()), std::streamsize(film.pixels.size() * sizeof(SampleParts)));

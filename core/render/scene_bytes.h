@@ -29,11 +29,12 @@ RenderSceneHeader renderSceneHeader(const RenderScene& rs);
 // A scene with the header's arrays sized (value-initialized) and its view settings, ready to receive the arrays.
 RenderScene allocateRenderScene(const RenderSceneHeader& h);
 
-// fn(data, bytes) for each array in SYLVA_RENDER_ARRAYS order (rs's own storage: read it to send, write it to receive).
-template <class Fn>
-void forEachRenderSceneArray(RenderScene& rs, Fn&& fn)
+// fn(data, bytes) for each array in SYLVA_RENDER_ARRAYS order (rs's own storage: read it to send, write it to
+// receive); data is const void* for a const scene, void* otherwise.
+template <class Scene, class Fn>
+void forEachRenderSceneArray(Scene& rs, Fn&& fn)
 {
-#define SYLVA_X(part, where, T, name, stat) fn(static_cast<void*>(rs.name.data()), rs.name.size() * sizeof(T));
+#define SYLVA_X(part, where, T, name, stat) fn(static_cast<std::conditional_t<std::is_const_v<Scene>, const void*, void*>>(rs.name.data()), rs.name.size() * sizeof(T));
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
 }

@@ -542,7 +542,7 @@ private Q_SLOTS:
         QVERIFY(std::memcmp(backFilm.pixels.data(), film.pixels.data(), film.pixels.size() * sizeof(SampleParts)) == 0);
         size_t arrays = 0, bytes = 0;
         std::vector<std::pair<const void*, size_t>> mine;
-        forEachRenderSceneArray(const_cast<RenderScene&>(rs), [&](void* d, size_t n) { mine.emplace_back(d, n); });
+        forEachRenderSceneArray(rs, [&](const void* d, size_t n) { mine.emplace_back(d, n); });
         forEachRenderSceneArray(back, [&](void* d, size_t n) {
             QCOMPARE(n, mine[arrays].second);
             QVERIFY(n == 0 || std::memcmp(d, mine[arrays].first, n) == 0);
