@@ -2,12 +2,14 @@
 #include "core/volume/smoke.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdio>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "core/base/error.h"
 #include "core/base/memory.h"
@@ -256,7 +258,65 @@ struct StencilRows {
         if (k + 1 < nz) s += c[k + 1];
         return s;
     }
+    // neighbours(k) for 0 < k < nz - 1, without the branches: the same sum, so loops over the row's
+    // inside vectorize (the ends go through neighbours).
+    T inner(int k) const { return xm[k] + xp[k] + ym[k] + yp[k] + c[k - 1] + c[k + 1]; }
 };
+
+// 1 / count as kInverseCount holds it (0 for 0), in arithmetic a loop vectorizes: the same float.
+[[gnu::always_inline]] inline float inverseCount(uint8_t count)
+{
+    const int c = count;
+    return float(c != 0 ? 1 : 0) / float(c > 1 ? c : 1);
+}
+
+// pick ? a : b, and keep ? a : +0, on the bits: GCC does not turn a ?: of floats into a vector blend under
+// -ftrapping-math (the default), so the stencil loops select this way; the same values as the ?:.
+[[gnu::always_inline]] inline float selectBits(bool pick, float a, float b)
+{
+    const uint32_t m = uint32_t(0) - uint32_t(pick);
+    return std::bit_cast<float>((std::bit_cast<uint32_t>(a) & m) | (std::bit_cast<uint32_t>(b) & ~m));
+}
+[[gnu::always_inline]] inline float keepOrZero(bool keep, float a)
+{
+    return std::bit_cast<float>(std::bit_cast<uint32_t>(a) & (uint32_t(0) - uint32_t(keep)));
+}
+[[gnu::always_inline]] inline double keepOrZero(bool keep, double a)
+{
+    return std::bit_cast<double>(std::bit_cast<uint64_t>(a) & (uint64_t(0) - uint64_t(keep)));
+}
+
+// Runs stage(s, i) for the stages s = 0..stages-1 over the x slabs i of [0, n), each stage in full after the
+// one before it as far as the result goes, with the data of a few slabs in cache across all the stages
+// (temporal blocking): stage s on slab i may read what stage s - 1 wrote on slabs i - 1..i + 1, and what it
+// writes must not be read by stage s - 1 on slab i +- 1 (a red-black sweep writes one colour, the other
+// colour's sweeps read it; a transfer writes x or the residual). The slabs are cut into chunks; each chunk
+// runs its stages as a wavefront (stage s on slab t - s at step t) over the slabs that need nothing from
+// the chunks beside it (a trapezoid: stage s leaves s slabs at each inner edge), then each inner edge
+// finishes its stages 1.. over the 2s slabs around it. Every value is computed from the same inputs as in
+// stage-by-stage passes, so the bits do not depend on the chunks or the thread count.
+template <class Stage>
+void pipelineSlabs(int n, int stages, const Stage& stage)
+{
+    const int cap = std::max(1, 2 * tbb::this_task_arena::max_concurrency());
+    const int chunks = std::max(1, std::min(n / std::max(2 * stages, 8), cap));   // 2 stages' slabs apart: the edges never meet
+    const auto bound = [&](int c) { return int(int64_t(n) * c / chunks); };
+    tbb::parallel_for(0, chunks, [&](int c) {
+        const int a = bound(c), b = bound(c + 1);
+        for (int t = a; t < b + stages - 1; ++t)
+            for (int st = 0; st < stages; ++st) {
+                const int i = t - st;
+                const int lo = a == 0 ? 0 : a + st, hi = b == n ? n - 1 : b - 1 - st;
+                if (i >= lo && i <= hi) stage(st, i);
+            }
+    });
+    if (chunks > 1)
+        tbb::parallel_for(1, chunks, [&](int c) {
+            const int b = bound(c);
+            for (int st = 1; st < stages; ++st)
+                for (int i = b - st; i < b + st; ++i) stage(st, i);
+        });
+}
 
 } // namespace
 
@@ -332,31 +392,85 @@ struct SmokeSim::Solver {
                 const size_t base = l.index(i, j, 0);
                 const uint8_t* cnt = l.count.data() + base;
                 double* y = out + base;
-                for (int k = 0; k < l.n.z; ++k) {
-                    const double v = cnt[k] ? double(cnt[k]) * rows.c[k] - rows.neighbours(k) : 0.0;
-                    y[k] = v;
-                    acc += rows.c[k] * v;
-                }
+                const int nz = l.n.z;
+                const auto edge = [&](int k) { y[k] = cnt[k] ? double(cnt[k]) * rows.c[k] - rows.neighbours(k) : 0.0; };
+                edge(0);
+                for (int k = 1; k < nz - 1; ++k) y[k] = keepOrZero(cnt[k] != 0, double(cnt[k]) * rows.c[k] - rows.inner(k));
+                if (nz > 1) edge(nz - 1);
+                for (int k = 0; k < nz; ++k) acc += rows.c[k] * y[k];
             }
             return acc;
         });
     }
 
-    // One Gauss-Seidel sweep over the cells of one colour ((i + j + k) % 2 == colour), in place: the
-    // cells of a colour depend only on the other colour, so the slabs run in parallel and the result
-    // does not depend on the thread count.
-    static void colourSweep(Level& l, int colour)
+    // One Gauss-Seidel sweep over the cells of one colour ((i + j + k) % 2 == colour) of slab i, in place: the
+    // cells of a colour depend only on the other colour, so slabs run in any order and the result does not
+    // depend on the thread count.
+    static void sweepSlab(Level& l, int colour, int i)
     {
-        forSlabs(l.n.x, [&](int i) {
-            for (int j = 0; j < l.n.y; ++j) {
-                const StencilRows<float> rows(l.n, l.x.data(), l.zeros.data(), i, j);
-                const size_t base = l.index(i, j, 0);
-                float* x = l.x.data() + base;
-                const float* b = l.b.data() + base;
-                const uint8_t* cnt = l.count.data() + base;
-                for (int k = (i + j + colour) & 1; k < l.n.z; k += 2) x[k] = (b[k] + rows.neighbours(k)) * kInverseCount[cnt[k]];
+        for (int j = 0; j < l.n.y; ++j) {
+            const StencilRows<float> rows(l.n, l.x.data(), l.zeros.data(), i, j);
+            const size_t base = l.index(i, j, 0);
+            float* x = l.x.data() + base;
+            const float* b = l.b.data() + base;
+            const uint8_t* cnt = l.count.data() + base;
+            const int nz = l.n.z, first = (i + j + colour) & 1;
+            if (first == 0) x[0] = (b[0] + rows.neighbours(0)) * kInverseCount[cnt[0]];
+            // The row's inside in blocks, 8 lanes at a time: both colours computed into a block buffer,
+            // then the sweep's colour stored. A cell of the colour reads only the other colour's cells,
+            // which the store leaves as they were, so the blocks see what a cell-by-cell sweep sees.
+            constexpr int kBlock = 128;
+            float v[kBlock];
+            for (int k0 = 1; k0 < nz - 1; k0 += kBlock) {
+                const int k1 = std::min(nz - 1, k0 + kBlock);
+                for (int k = k0; k < k1; ++k) v[k - k0] = (b[k] + rows.inner(k)) * inverseCount(cnt[k]);
+                for (int k = k0; k < k1; ++k) x[k] = selectBits((k & 1) == first, v[k - k0], x[k]);
             }
-        });
+            if (nz > 1 && ((nz - 1) & 1) == first) x[nz - 1] = (b[nz - 1] + rows.neighbours(nz - 1)) * kInverseCount[cnt[nz - 1]];
+        }
+    }
+
+    // The first sweep from x = 0: colour 0 from b alone (its neighbours are 0: the same bits as a sweep over
+    // zeros), colour 1 set to 0. Reads nothing of the slabs beside it.
+    static void firstSweepSlab(Level& l, int i)
+    {
+        for (int j = 0; j < l.n.y; ++j) {
+            const size_t base = l.index(i, j, 0);
+            float* x = l.x.data() + base;
+            const float* b = l.b.data() + base;
+            const uint8_t* cnt = l.count.data() + base;
+            for (int k = 0; k < l.n.z; ++k) x[k] = ((i + j + k) & 1) == 0 ? (b[k] + 0.0f) * kInverseCount[cnt[k]] : 0.0f;
+        }
+    }
+
+    // The residual b - A x of slab i into tmp (0 off the fluid).
+    static void residualSlab(Level& l, int i)
+    {
+        for (int j = 0; j < l.n.y; ++j) {
+            const StencilRows<float> rows(l.n, l.x.data(), l.zeros.data(), i, j);
+            const size_t base = l.index(i, j, 0);
+            const float* b = l.b.data() + base;
+            const uint8_t* cnt = l.count.data() + base;
+            float* res = l.tmp.data() + base;
+            const int nz = l.n.z;
+            const auto edge = [&](int k) { res[k] = cnt[k] ? b[k] - (float(cnt[k]) * rows.c[k] - rows.neighbours(k)) : 0.0f; };
+            edge(0);
+            for (int k = 1; k < nz - 1; ++k) res[k] = keepOrZero(cnt[k] != 0, b[k] - (float(cnt[k]) * rows.c[k] - rows.inner(k)));
+            if (nz > 1) edge(nz - 1);
+        }
+    }
+
+    // x += the coarse correction (piecewise constant) on slab i's fluid cells.
+    static void prolongSlab(Level& l, const Level& c, int i)
+    {
+        for (int j = 0; j < l.n.y; ++j) {
+            const size_t base = l.index(i, j, 0);
+            float* x = l.x.data() + base;
+            const uint8_t* cnt = l.count.data() + base;
+            const float* coarse = c.x.data() + c.index(i / 2, j / 2, 0);
+#pragma GCC ivdep
+            for (int k = 0; k < l.n.z; ++k) x[k] = selectBits(cnt[k] != 0, x[k] + coarse[k / 2], x[k]);   // x and coarse: two levels
+        }
     }
 
     // Red-black sweep pairs before and after each coarse correction. Measured at 128^3 (bench_volume_sources,
@@ -366,37 +480,29 @@ struct SmokeSim::Solver {
     // x_l = V-cycle applied to b_l, a symmetric linear operator: kSmoothing red-black Gauss-Seidel pairs before the
     // coarse correction and as many black-red after (the adjoint), restriction = prolongation^T / 2, and a
     // palindromic sweep sequence on the coarsest level. In float: it only preconditions the CG, whose
-    // vectors and tolerance stay in double; half the bytes of a double V-cycle.
+    // vectors and tolerance stay in double; half the bytes of a double V-cycle. The smoothing with the
+    // residual, and the prolongation with the smoothing after it, run as one pipelined pass each
+    // (pipelineSlabs): the sweeps read and write the finest level's x once per pass, not once per sweep.
     void vcycle(size_t li)
     {
         Level& l = levels[li];
-        std::fill(l.x.begin(), l.x.end(), 0.0f);
         if (li + 1 == levels.size()) {
-            for (int sweep = 0; sweep < 8; ++sweep) {
-                colourSweep(l, 0);
-                colourSweep(l, 1);
-            }
-            for (int sweep = 0; sweep < 8; ++sweep) {
-                colourSweep(l, 1);
-                colourSweep(l, 0);
-            }
+            // Colours 0 1 0 1 ... (8 pairs), then 1 0 1 0 ... (8 pairs), the first from x = 0.
+            constexpr int kCoarse = 32;
+            pipelineSlabs(l.n.x, kCoarse, [&](int st, int i) {
+                if (st == 0) firstSweepSlab(l, i);
+                else sweepSlab(l, st < kCoarse / 2 ? st & 1 : (st + 1) & 1, i);
+            });
             return;
         }
-        for (int sweep = 0; sweep < kSmoothing; ++sweep) {
-            colourSweep(l, 0);
-            colourSweep(l, 1);
-        }
-        Level& c = levels[li + 1];
-        forSlabs(l.n.x, [&](int i) {
-            for (int j = 0; j < l.n.y; ++j) {
-                const StencilRows<float> rows(l.n, l.x.data(), l.zeros.data(), i, j);
-                const size_t base = l.index(i, j, 0);
-                const float* b = l.b.data() + base;
-                const uint8_t* cnt = l.count.data() + base;
-                float* res = l.tmp.data() + base;
-                for (int k = 0; k < l.n.z; ++k) res[k] = cnt[k] ? b[k] - (float(cnt[k]) * rows.c[k] - rows.neighbours(k)) : 0.0f;
-            }
+        // Colours 0 1 0 1 (the first from x = 0), then the residual.
+        constexpr int kSweeps = 2 * kSmoothing;
+        pipelineSlabs(l.n.x, kSweeps + 1, [&](int st, int i) {
+            if (st == 0) firstSweepSlab(l, i);
+            else if (st < kSweeps) sweepSlab(l, st & 1, i);
+            else residualSlab(l, i);
         });
+        Level& c = levels[li + 1];
         forSlabs(c.n.x, [&](int I) {
             for (int J = 0; J < c.n.y; ++J)
                 for (int K = 0; K < c.n.z; ++K) {
@@ -412,20 +518,11 @@ struct SmokeSim::Solver {
                 }
         });
         vcycle(li + 1);
-        forSlabs(l.n.x, [&](int i) {
-            for (int j = 0; j < l.n.y; ++j) {
-                const size_t base = l.index(i, j, 0);
-                float* x = l.x.data() + base;
-                const uint8_t* cnt = l.count.data() + base;
-                const float* coarse = c.x.data() + c.index(i / 2, j / 2, 0);
-                for (int k = 0; k < l.n.z; ++k)
-                    if (cnt[k]) x[k] += coarse[k / 2];
-            }
+        // The prolongation, then colours 1 0 1 0.
+        pipelineSlabs(l.n.x, kSweeps + 1, [&](int st, int i) {
+            if (st == 0) prolongSlab(l, c, i);
+            else sweepSlab(l, st & 1, i);
         });
-        for (int sweep = 0; sweep < kSmoothing; ++sweep) {
-            colourSweep(l, 1);
-            colourSweep(l, 0);
-        }
     }
 
     static double dot(const std::vector<double>& a, const std::vector<double>& b)
