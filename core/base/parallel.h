@@ -5,13 +5,17 @@
 //   exec.sum<K>(n, body, out)    out[k] = sum over i of t[k], where body(i, t) fills double t[K] (zeroed
 //                                first); out is the executor's memory (host here, device for CudaExec),
 //                                and later bodies may read it. n = 0 writes zeros.
+//   pipelineSlabs(n, stages, fn) host only: dependent passes over a grid's slabs, temporally blocked.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 namespace sylva {
 
@@ -47,5 +51,40 @@ struct HostExec {
             for (int k = 0; k < K; ++k) out[k] += partial[c * K + k];
     }
 };
+
+// Runs stage(s, i) for the stages s = 0 .. stages - 1 over the slabs i of [0, n) (a grid's planes along its
+// slowest axis), with each stage's result as if it ran over all slabs after the stage before it, but with a
+// few slabs' data in cache across all the stages (temporal blocking). The contract: stage s on slab i reads
+// only what stage s - 1 (or earlier) left on slabs i - 1 .. i + 1, and what it writes is read by no stage
+// s' < s on slabs i - 1 .. i + 1 (so a red-black Gauss-Seidel sweep, writing one colour, may follow the other
+// colour's; a transfer may write another array or the slab's own cells). The slabs are cut into chunks; each
+// chunk runs its stages as a wavefront (stage s on slab t - s at step t) over the slabs that need nothing from
+// the chunks beside it (a trapezoid: stage s stops s slabs short of each inner edge), then each inner edge
+// finishes stages 1 .. over the 2s slabs around it. Every value is computed from the same inputs as in
+// stage-by-stage passes, so the bits do not depend on the chunks or the thread count (tst_parallel checks
+// both against those passes). Used by the smoke simulation's V-cycle (core/volume/smoke.cpp).
+template <class Stage>
+void pipelineSlabs(int n, int stages, const Stage& stage)
+{
+    if (n <= 0 || stages <= 0) return;
+    const int cap = std::max(1, 2 * tbb::this_task_arena::max_concurrency());
+    const int chunks = std::max(1, std::min(n / std::max(2 * stages, 8), cap));   // 2 stages' slabs apart: the edges never meet
+    const auto bound = [&](int c) { return int(int64_t(n) * c / chunks); };
+    tbb::parallel_for(0, chunks, [&](int c) {
+        const int a = bound(c), b = bound(c + 1);
+        for (int t = a; t < b + stages - 1; ++t)
+            for (int st = 0; st < stages; ++st) {
+                const int i = t - st;
+                const int lo = a == 0 ? 0 : a + st, hi = b == n ? n - 1 : b - 1 - st;
+                if (i >= lo && i <= hi) stage(st, i);
+            }
+    });
+    if (chunks > 1)
+        tbb::parallel_for(1, chunks, [&](int c) {
+            const int b = bound(c);
+            for (int st = 1; st < stages; ++st)
+                for (int i = b - st; i < b + st; ++i) stage(st, i);
+        });
+}
 
 } // namespace sylva

@@ -9,7 +9,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "core/base/error.h"
 #include "core/base/memory.h"
@@ -319,38 +318,6 @@ struct StencilRows {
 [[gnu::always_inline]] inline double keepOrZero(bool keep, double a)
 {
     return std::bit_cast<double>(std::bit_cast<uint64_t>(a) & (uint64_t(0) - uint64_t(keep)));
-}
-
-// Runs stage(s, i) for the stages s = 0..stages-1 over the x slabs i of [0, n), each stage in full after the
-// one before it as far as the result goes, with the data of a few slabs in cache across all the stages
-// (temporal blocking): stage s on slab i may read what stage s - 1 wrote on slabs i - 1..i + 1, and what it
-// writes must not be read by stage s - 1 on slab i +- 1 (a red-black sweep writes one colour, the other
-// colour's sweeps read it; a transfer writes x or the residual). The slabs are cut into chunks; each chunk
-// runs its stages as a wavefront (stage s on slab t - s at step t) over the slabs that need nothing from
-// the chunks beside it (a trapezoid: stage s leaves s slabs at each inner edge), then each inner edge
-// finishes its stages 1.. over the 2s slabs around it. Every value is computed from the same inputs as in
-// stage-by-stage passes, so the bits do not depend on the chunks or the thread count.
-template <class Stage>
-void pipelineSlabs(int n, int stages, const Stage& stage)
-{
-    const int cap = std::max(1, 2 * tbb::this_task_arena::max_concurrency());
-    const int chunks = std::max(1, std::min(n / std::max(2 * stages, 8), cap));   // 2 stages' slabs apart: the edges never meet
-    const auto bound = [&](int c) { return int(int64_t(n) * c / chunks); };
-    tbb::parallel_for(0, chunks, [&](int c) {
-        const int a = bound(c), b = bound(c + 1);
-        for (int t = a; t < b + stages - 1; ++t)
-            for (int st = 0; st < stages; ++st) {
-                const int i = t - st;
-                const int lo = a == 0 ? 0 : a + st, hi = b == n ? n - 1 : b - 1 - st;
-                if (i >= lo && i <= hi) stage(st, i);
-            }
-    });
-    if (chunks > 1)
-        tbb::parallel_for(1, chunks, [&](int c) {
-            const int b = bound(c);
-            for (int st = 1; st < stages; ++st)
-                for (int i = b - st; i < b + st; ++i) stage(st, i);
-        });
 }
 
 } // namespace
