@@ -222,7 +222,7 @@ const Scene& onTerrain(const Scene& scene, Scene& storage)
 
 } // namespace
 
-void setFrameSky(RenderScene& rs, const SkyDesc& d)
+void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
 {
     rs.base.skyModel = sky::SkyView{};
     rs.base.skyLightCount = 0;
@@ -239,7 +239,7 @@ void setFrameSky(RenderScene& rs, const SkyDesc& d)
     if (built.kind == sky::SkyKind::Map && built.map) rs.skyMap = built.map->rgb;
     v.map.rgb = nullptr;   // the frame's skyMap array (host or device) is read instead
     rs.base.skyModel = v;
-    rs.skyLights = sky::skyLights(built, d.lights);
+    rs.skyLights = sky::skyLights(built, d.lights, 512, groundPlane);
     rs.base.skyLightCount = uint32_t(rs.skyLights.size());
     rs.base.skyInterleave = sky::makeInterleave(d.interleave, int(rs.skyLights.size()));
 }
@@ -389,7 +389,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
         rs.m_stats.terrainSamplesX = hf.layout.nx;
         rs.m_stats.terrainSamplesZ = hf.layout.nz;
     }
-    setFrameSky(rs, scene.skyModel);
+    setFrameSky(rs, scene.skyModel, groundPlaneShown(scene));
     rs.accel = scene.render.accel;
     rs.lodLevels = lod;
     const size_t ns = assets.size(), ni = scene.instances.size();
@@ -851,7 +851,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     // Environment, camera, settings.
     RenderView& b = rs.base;
     const TerrainDesc& t = scene.terrain;
-    b.groundEnabled = scene.ground.enabled && !t.enabled();   // a terrain is the ground
+    b.groundEnabled = groundPlaneShown(scene);   // a terrain is the ground
     b.groundY = float(scene.ground.height - origin.y);
     b.groundColor = scene.ground.color;
     b.terrainEnabled = t.enabled();

@@ -150,11 +150,16 @@ bool hasLevelsFor(const RenderScene& rs, const Scene& scene);
 RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
                              Progress* progress = nullptr);
 
+// Whether the frame has the ground plane (a terrain replaces it): then every direction below the horizon
+// ends on the ground, for every point above it.
+inline bool groundPlaneShown(const Scene& scene) { return scene.ground.enabled && !scene.terrain.enabled(); }
+
 // The sky's part of a built frame: a Preetham or map sky's per-ray parameters, its map pixels and its
-// virtual lights (d.lights of them, d.interleave subsets); the constant sky: none (the frame as before).
+// virtual lights (d.lights of them, d.interleave subsets; with groundPlane, groundPlaneShown(scene), all of
+// them above the horizon, since the ground hides the rest); the constant sky: none (the frame as before).
 // buildRenderScene calls it; changing only the lights or subsets of the same sky needs nothing else (the
 // sun and the LB grids stay). Throws Error when the sky is not built or its counts are out of range.
-void setFrameSky(RenderScene& rs, const SkyDesc& d);
+void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane);
 
 // The sun the frame lights with: the scene's direction and `sunRadiance`, or a built Preetham sky's (or a
 // map sky's, with sun_from_map) own sun, radiance() x sun.intensity / pi (a surface shows albedo x radiance

@@ -83,10 +83,10 @@ EnvMap skyToMap(const Sky& sky, int width)
     return renderSkyToMap(sky.view(), w);
 }
 
-std::vector<VirtualLight> skyLights(const Sky& sky, int count, int width)
+std::vector<VirtualLight> skyLights(const Sky& sky, int count, int width, bool upperOnly)
 {
-    if (sky.kind == SkyKind::Map) return virtualLights(mapOf(sky), count, sky.rotationDeg, sky.intensity);
-    return virtualLights(skyToMap(sky, width), count);
+    if (sky.kind == SkyKind::Map) return virtualLights(mapOf(sky), count, sky.rotationDeg, sky.intensity, upperOnly);
+    return virtualLights(skyToMap(sky, width), count, 0.0f, 1.0f, upperOnly);
 }
 
 glm::dvec3 skyTotal(const Sky& sky, int width)

@@ -42,8 +42,9 @@ Sky mapSky(EnvMap map, float rotationDeg, float intensity, bool findSun = true, 
 EnvMap skyToMap(const Sky& sky, int width = 512);
 
 // The sky's virtual directional lights (the sun kept apart: it is sky.sun). A map sky is partitioned at
-// its own resolution with its rotation and intensity; other skies through skyToMap(width).
-std::vector<VirtualLight> skyLights(const Sky& sky, int count, int width = 512);
+// its own resolution with its rotation and intensity; other skies through skyToMap(width). upperOnly: the
+// upper hemisphere's alone (virtualLights), for a scene whose ground plane hides everything below it.
+std::vector<VirtualLight> skyLights(const Sky& sky, int count, int width = 512, bool upperOnly = false);
 
 // Integral of the sky's radiance (without its sun) over the whole sphere, RGB: what the LB boundary
 // distributes; and the same over the share of the sphere nearest to each of `directions` (the LB

@@ -87,7 +87,7 @@ struct Partition {
 
 } // namespace
 
-std::vector<VirtualLight> virtualLights(const EnvMap& map, int count, float rotationDeg, float intensity)
+std::vector<VirtualLight> virtualLights(const EnvMap& map, int count, float rotationDeg, float intensity, bool upperOnly)
 {
     if (count < kMinVirtualLights || count > kMaxVirtualLights)
         throw Error("virtual lights: the count must be in 1 .. 65536, got " + std::to_string(count));
@@ -107,7 +107,9 @@ std::vector<VirtualLight> virtualLights(const EnvMap& map, int count, float rota
             const double l = 0.2126 * double(c.x) + 0.7152 * double(c.y) + 0.0722 * double(c.z);
             p.power[size_t(y) * size_t(map.width) + size_t(x)] = std::max(l, 0.0) * p.omega[size_t(y)];
         }
-    p.split(0, map.width, 0, map.height, count);
+    // Row y's centre lies at polar angle pi (y + 0.5) / height: above the horizon for the first height / 2 rows.
+    const int rows = upperOnly && map.height / 2 > 0 ? map.height / 2 : map.height;
+    p.split(0, map.width, 0, rows, count);
     return lights;
 }
 

@@ -32,8 +32,13 @@ inline constexpr int kMinVirtualLights = 1, kMaxVirtualLights = 65536;
 // lights can come back (only for maps with single pixels holding more than 1/count of the power). The
 // lights come back in the tree's order, so neighbours in the list are neighbours on the sphere; their
 // powers sum to envMapIntegral(map) x intensity (up to float rounding). Rotation: about +Y, degrees, as
-// envMapView. Throws sylva::Error for count outside 1 .. 65536 or a bad map.
-std::vector<VirtualLight> virtualLights(const EnvMap& map, int count, float rotationDeg = 0.0f, float intensity = 1.0f);
+// envMapView. upperOnly: only the rows above the horizon (pixel centres with y > 0) are partitioned, so every
+// light lies above it and the powers sum to the upper hemisphere's integral: the sky a scene with a ground
+// plane can see (every direction below the horizon ends on the ground), all `count` lights spent on it; a map
+// with no row above the horizon (height 1) is partitioned whole. Throws sylva::Error for count outside
+// 1 .. 65536 or a bad map.
+std::vector<VirtualLight> virtualLights(const EnvMap& map, int count, float rotationDeg = 0.0f, float intensity = 1.0f,
+                                        bool upperOnly = false);
 
 // Interleaved sampling over K subsets: subset j holds lights j, j + K, j + 2K, ... (every K-th in the
 // tree's order, so each subset spreads over the whole sky). Pixels are grouped in blocks of

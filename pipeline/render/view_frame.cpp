@@ -83,7 +83,9 @@ ViewFrameUpdate viewFrameUpdate(const Scene& built, const Scene& next)
 {
     ViewFrameUpdate u;
     const SkyDesc &ka = built.skyModel, &kb = next.skyModel;
-    const bool sameSky = ka.kind == kb.kind && ka.built == kb.built && ka.lights == kb.lights && ka.interleave == kb.interleave;
+    // The sky's lights also follow the ground plane (setFrameSky: above the horizon only where it hides the rest).
+    const bool sameSky = ka.kind == kb.kind && ka.built == kb.built && ka.lights == kb.lights && ka.interleave == kb.interleave &&
+                         (!kb.analytic() || groundPlaneShown(built) == groundPlaneShown(next));
     u.rebuild = !sameTerrainHeights(built.terrain, next.terrain) || built.groups.size() != next.groups.size() || !sameSky ||
                 built.render.accel != next.render.accel;
     if (u.rebuild) return u;

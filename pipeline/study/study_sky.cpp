@@ -174,13 +174,13 @@ bool measureSky(const Options& o)
         SkyDesc d = s.skyModel;
         d.lights = baseLights;
         d.interleave = 1;
-        setFrameSky(rs, d);
+        setFrameSky(rs, d, groundPlaneShown(s));
         for (size_t k = 0; k < spps.size(); ++k) full[k] = trace(rs, s, spps[k], 1).image;
         std::vector<Row> rows;
         for (const Pair& p : pairs) {
             d.lights = p.n;
             d.interleave = p.k;
-            setFrameSky(rs, d);
+            setFrameSky(rs, d, groundPlaneShown(s));
             for (size_t k = 0; k < spps.size(); ++k) {
                 const Traced t = trace(rs, s, spps[k], repsFor(spps[k]));
                 Row r{p.n, p.k, spps[k], t.seconds, t.seconds / sunSeconds[k], imageError(t.image, full[k]), imageError(t.image, ref.image), false};

@@ -336,6 +336,61 @@ private Q_SLOTS:
     // Interleaved sampling: on the open ground (every light visible everywhere) K subsets cycled over
     // spp = K samples give the all-lights picture to float rounding; under plants, accumulated samples
     // converge to the all-lights, many-sample picture, closer with more samples.
+    // With the ground plane every direction below the horizon ends on the ground, so the frame's lights are
+    // the upper hemisphere's alone: N of them, all above the horizon, their powers the upper half's integral
+    // (summed here over the map's pixels); without the plane (ground off) the whole sphere's, powers the
+    // whole map's. The lit picture loses nothing (the lower lights were all shadowed), and the N lights
+    // spent on the upper sky place its light closer to the 1024-light picture than the whole sphere's N.
+    void lightsAboveTheHorizonWithTheGround()
+    {
+        const QString file = hdriPath("park.exr");
+        if (!QFile::exists(file)) QSKIP("../shared/data/hdri is absent");
+        Scene s = shrubPatch();
+        useMap(s, file.toStdString(), 32, 1, true);
+        const sky::EnvMap& m = *s.skyModel.built->map;
+        glm::dvec3 upper(0.0), whole(0.0);
+        for (int y = 0; y < m.height; ++y) {
+            const double omega = sky::envMapPixelSolidAngle(m.width, m.height, y);
+            for (int x = 0; x < m.width; ++x) (y < m.height / 2 ? upper : whole) += glm::dvec3(m.at(x, y)) * omega;
+        }
+        whole += upper;
+        QVERIFY(luminance(whole - upper) > 0.05 * luminance(whole));   // the map's lower half holds light
+        for (bool ground : {true, false}) {
+            Scene g = s;
+            g.ground.enabled = ground;
+            const RenderScene rs = buildRenderScene(g, m_shrub, glm::vec3(0.0f));
+            QCOMPARE(rs.skyLights.size(), size_t(32));
+            glm::dvec3 sum(0.0);
+            int below = 0;
+            for (const sky::VirtualLight& l : rs.skyLights) {
+                sum += glm::dvec3(l.power);
+                below += l.direction.y > 0.0f ? 0 : 1;
+            }
+            const glm::dvec3 want = ground ? upper : whole;
+            QVERIFY2(glm::length(sum - want) < 1e-5 * glm::length(want), qPrintable(QString("ground %1").arg(ground)));
+            if (ground) QCOMPARE(below, 0);
+            else QVERIFY(below > 0);
+        }
+        // Against 1024 lights: N lights on the upper sky, and N over the whole sphere (the frame built with
+        // the ground, its lights then set as if it had none).
+        Scene ref = s;
+        ref.skyModel.lights = 1024;
+        const std::vector<glm::vec3> want = picture(ref, m_shrub);
+        for (int n : {16, 64}) {
+            RenderScene rs = buildRenderScene(s, m_shrub, glm::vec3(0.0f));
+            SkyDesc d = s.skyModel;
+            d.lights = n;
+            setFrameSky(rs, d, true);
+            const double eUpper = relativeError(composeMode(renderFilm(rs.view()), RenderMode::Full, composeSky(s)), want);
+            setFrameSky(rs, d, false);
+            const double eWhole = relativeError(composeMode(renderFilm(rs.view()), RenderMode::Full, composeSky(s)), want);
+            qInfo("park.exr on the shrub patch, %d lights: mean pixel error %.4f (upper hemisphere) against %.4f (whole sphere), "
+                  "1024 lights the reference",
+                  n, eUpper, eWhole);
+            QVERIFY2(eUpper < eWhole, qPrintable(QString("%1 lights: %2 >= %3").arg(n).arg(eUpper).arg(eWhole)));
+        }
+    }
+
     void interleavedConverges()
     {
         const QString file = hdriPath("forest.exr");
