@@ -127,7 +127,7 @@ struct SkyDesc {
     std::string path;                    // HDR map (absolute once read; relative to the scene file in it)
     float rotationDeg = 0.0f;            // map: about +Y, adds to every azimuth
     float intensity = 1.0f;              // map: multiplies its pixels (and its sun)
-    int lights = 64;                     // N virtual lights (default measured: docs/ACCURACY.md "Sky light")
+    int lights = 32;                     // N virtual lights (default measured: docs/ACCURACY.md "Sky light")
     int interleave = 16;                 // K subsets: N / K shadow rays per pixel and sample
     bool sunFromMap = true;              // map: its sun found, taken out and made the sun (replacing `sun`)
     // The built sky (pipeline/io/env_map_io: loadSceneSky), shared by the scene's copies; not in the file.

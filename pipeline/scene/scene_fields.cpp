@@ -593,7 +593,7 @@ const Table<Scene>& skyTable()
             .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Map; });
         b.integer("lights", [](auto& s) -> auto& { return s.skyModel.lights; }, sky::kMinVirtualLights, sky::kMaxVirtualLights)
             .doc("integer",
-                 "`preetham`, `hdri`, `uniform`: virtual directional lights the sky is split into (equal power), 1 .. 65536; the default 64 with `interleave` 16 (4 shadow rays a sample) on the default forest under a Preetham sky and two maps: 2.2% light error at 16 spp and 10% at 1 spp, at 1.8x (Preetham) to 2.5x (maps) the sun-only frame's time ([ACCURACY.md](ACCURACY.md) \"Sky light\"; 8 subsets: 1.6% at 3.3x)")
+                 "`preetham`, `hdri`, `uniform`: virtual directional lights the sky is split into (equal power; with the ground plane the upper hemisphere only), 1 .. 65536; the default 32 with `interleave` 16 (2 shadow rays a sample) on the default forest under a Preetham sky and two maps: at most 1.96% light error at 16 spp and 8% at 1 spp, at 1.8x-2.0x the sun-only frame's time ([ACCURACY.md](ACCURACY.md) \"Sky light\"; 64 lights: 1.35% at 2.5x-3.0x)")
             .writtenIf([](const Scene& s) { return s.skyModel.analytic(); })
             .summarized([](const Scene& s) {
                 return s.skyModel.analytic() ? std::to_string(s.skyModel.lights) + " lights / " + std::to_string(s.skyModel.interleave) + " subsets"

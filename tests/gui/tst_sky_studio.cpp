@@ -139,7 +139,7 @@ private Q_SLOTS:
         QVERIFY2(panel.status().contains("missing.exr"), qPrintable(panel.status()));
         for (int i = 0; i < 4; ++i) undo->undo();
         QCOMPARE(doc.scene().skyModel.rotationDeg, 0.0f);
-        QCOMPARE(doc.scene().skyModel.lights, 64);
+        QCOMPARE(doc.scene().skyModel.lights, SkyDesc{}.lights);
         QVERIFY(skyPixels(*doc.scene().skyModel.built) == freshSky(doc.scene()));
         // The scene file keeps the settings: save, read back, the same sky.
         const QString file = m_dir.filePath("sky.sylva.json");
