@@ -195,13 +195,9 @@ void RenderWorker::process(const Request& req, Progress& progress)
         }
     }
 
-    // A sky edit (another built sky, light count or interleave): the frame's sky part is built with the rest.
-    const SkyDesc& sky = scene.skyModel;
-    if (m_frame && !(sky.kind == m_frameSky.kind && sky.built == m_frameSky.built && sky.lights == m_frameSky.lights &&
-                     sky.interleave == m_frameSky.interleave))
-        m_frame.reset();
     // The species' structures are kept while the assets stay; an edit of the landscape or the volumes
-    // updates only its part (viewFrameUpdate), anything else the build reads builds the frame again.
+    // updates only its part (viewFrameUpdate), anything else the build reads (a sky edit among them: another
+    // built sky, light count, interleave, or the ground plane under it) builds the frame again.
     const ViewFrameUpdate update = m_frame ? viewFrameUpdate(m_frameScene, scene) : ViewFrameUpdate{};
     if (!m_frame || m_frameAssets != req.assets || !viewFrameFits(*m_frame, scene) || update.rebuild) {
         m_frame.reset();
@@ -211,7 +207,6 @@ void RenderWorker::process(const Request& req, Progress& progress)
         m_frame = buildViewFrame(scene, copies, sunRadiance(scene.sun));
         m_frameAssets = req.assets;
         m_frameRelight = {};
-        m_frameSky = scene.skyModel;
         m_frameScene = scene;
         ++m_frameBuilds;
         if (interrupted()) throw Cancelled();

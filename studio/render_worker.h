@@ -137,7 +137,6 @@ private:
     std::optional<ViewFrame> m_frame;
     std::vector<AssetsPtr> m_frameAssets;
     Relighting m_frameRelight;            // the relighting m_frame's lighting array holds (inactive: the assets')
-    SkyDesc m_frameSky;                   // the sky m_frame was built with
     std::atomic<int> m_relitFrames{0};
     std::atomic<quint64> m_latestRequest{0};
     std::atomic<bool> m_shieldPass{false};   // the pass in progress is not restarted by a new request
