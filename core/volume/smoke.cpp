@@ -265,9 +265,6 @@ void validateSmoke(const SmokeSettings& s)
 
 namespace {
 
-// 1 / the neighbour count, by count; 0 for count 0 (a cell off the fluid), so a sweep writes 0 there.
-constexpr float kInverseCount[8] = {0.0f, 1.0f, 0.5f, 1.0f / 3.0f, 0.25f, 0.2f, 1.0f / 6.0f, 1.0f / 7.0f};
-
 // The rows around row (i, j) of a grid of n cells: the row itself and its four neighbours along x and y,
 // a row of zeros where the neighbour lies beyond the wall. The operator reads its neighbours without
 // masks: every vector it is applied to is 0 off the fluid, so a solid neighbour adds nothing either.
@@ -297,7 +294,8 @@ struct StencilRows {
     T inner(int k) const { return xm[k] + xp[k] + ym[k] + yp[k] + c[k - 1] + c[k + 1]; }
 };
 
-// 1 / count as kInverseCount holds it (0 for 0), in arithmetic a loop vectorizes: the same float.
+// 1 / the neighbour count, 0 for count 0 (a cell off the fluid, so a sweep writes 0 there), in arithmetic a
+// loop vectorizes.
 [[gnu::always_inline]] inline float inverseCount(uint8_t count)
 {
     const int c = count;
@@ -417,7 +415,7 @@ struct SmokeSim::Solver {
             const float* b = l.b.data() + base;
             const uint8_t* cnt = l.count.data() + base;
             const int nz = l.n.z, first = (i + j + colour) & 1;
-            if (first == 0) x[0] = (b[0] + rows.neighbours(0)) * kInverseCount[cnt[0]];
+            if (first == 0) x[0] = (b[0] + rows.neighbours(0)) * inverseCount(cnt[0]);
             // The row's inside in blocks, 8 lanes at a time: both colours computed into a block buffer,
             // then the sweep's colour stored. A cell of the colour reads only the other colour's cells,
             // which the store leaves as they were, so the blocks see what a cell-by-cell sweep sees.
@@ -428,7 +426,7 @@ struct SmokeSim::Solver {
                 for (int k = k0; k < k1; ++k) v[k - k0] = (b[k] + rows.inner(k)) * inverseCount(cnt[k]);
                 for (int k = k0; k < k1; ++k) x[k] = selectBits((k & 1) == first, v[k - k0], x[k]);
             }
-            if (nz > 1 && ((nz - 1) & 1) == first) x[nz - 1] = (b[nz - 1] + rows.neighbours(nz - 1)) * kInverseCount[cnt[nz - 1]];
+            if (nz > 1 && ((nz - 1) & 1) == first) x[nz - 1] = (b[nz - 1] + rows.neighbours(nz - 1)) * inverseCount(cnt[nz - 1]);
         }
     }
 
@@ -441,7 +439,7 @@ struct SmokeSim::Solver {
             float* x = l.x.data() + base;
             const float* b = l.b.data() + base;
             const uint8_t* cnt = l.count.data() + base;
-            for (int k = 0; k < l.n.z; ++k) x[k] = ((i + j + k) & 1) == 0 ? (b[k] + 0.0f) * kInverseCount[cnt[k]] : 0.0f;
+            for (int k = 0; k < l.n.z; ++k) x[k] = ((i + j + k) & 1) == 0 ? (b[k] + 0.0f) * inverseCount(cnt[k]) : 0.0f;
         }
     }
 
