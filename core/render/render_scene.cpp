@@ -536,6 +536,32 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
         }
     };
 
+    // Every array below at its final size before the first append: grown by doubling instead, they would copy
+    // themselves into fresh memory several times (a page fault per page each time), most of the serial build.
+    {
+        size_t nodes = 0, tris = 0, blocks = 0, wide = 0, verts = 0, faces = 0, light = 0;
+        for (const MeshBuild& geo : meshes) {
+            nodes += geo.bvh.nodes.size();
+            tris += geo.bvh.primOrder.size();
+            wide += geo.bvh.wideNodes.size();
+            for (const BvhNode& node : geo.bvh.nodes)
+                for (int k = 0; k < 4; ++k) blocks += node.count[k] != 0 && node.child[k] != kNoHit ? 1 : 0;
+        }
+        for (const SpeciesAssets& a : assets) {
+            verts += a.mesh.positions.size();
+            faces += a.mesh.triangles.size();
+            light += a.lighting.rgb.size();
+        }
+        rs.blasNodes.reserve(rs.blasNodes.size() + nodes);
+        rs.tris.reserve(rs.tris.size() + tris);
+        rs.blocks.reserve(rs.blocks.size() + blocks);
+        rs.blasWideNodes.reserve(rs.blasWideNodes.size() + wide);
+        rs.normals.reserve(rs.normals.size() + verts);
+        rs.uvs.reserve(rs.uvs.size() + verts);
+        rs.triVerts.reserve(rs.triVerts.size() + faces);
+        rs.triMaterial.reserve(rs.triMaterial.size() + faces);
+        rs.lighting.reserve(rs.lighting.size() + light);
+    }
     for (size_t s = 0; s < ns; ++s) {
         const SpeciesAssets& a = assets[s];
         const TriangleMesh& m = a.mesh;
