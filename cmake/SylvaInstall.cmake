@@ -18,6 +18,8 @@ endforeach()
 add_custom_target(sylva_docs ALL DEPENDS ${SYLVA_MAN_PAGE} ${SYLVA_COMPLETION})
 
 install(TARGETS sylva sylva-studio RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+# OpenImageIO's module (pipeline/io/image_module.h), found relative to the programs' folder.
+install(TARGETS sylva_oiio LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/sylva)
 # The programs carry their resources inside (Qt resources, ":/sylva/..."); the copies here are for
 # people: the default scene to start a scene file from, the colour table with its licence.
 install(FILES ${CMAKE_SOURCE_DIR}/resources/default_forest.sylva.json ${CMAKE_SOURCE_DIR}/resources/README.md

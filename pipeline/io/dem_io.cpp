@@ -5,10 +5,9 @@
 #include <filesystem>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
-
 #include "core/base/error.h"
 #include "core/base/memory.h"
+#include "pipeline/io/image_module.h"
 
 namespace sylva {
 
@@ -21,14 +20,15 @@ HeightField loadDem(const std::string& path, double spacing, double heightScale)
         throw Error(path + ": terrain height scale " + std::to_string(heightScale) + " must be finite and > 0 (metres per DEM unit)");
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw Error(path + ": no such DEM file");
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path + ": cannot read the DEM as an image (" + OIIO::geterror() + ")");
-    const OIIO::ImageSpec& spec = in->spec();
+    std::string error;
+    auto in = image_module::Reader::open(path, false, error);
+    if (!in) throw Error(path + ": cannot read the DEM as an image (" + error + ")");
+    const image_module::Info& spec = in->info();
     const long long w = spec.width, h = spec.height;
-    if (w < 2 || h < 2 || spec.nchannels < 1)
+    if (w < 2 || h < 2 || spec.channels < 1)
         throw Error(path + ": a DEM needs at least 2 x 2 samples, this image has " + std::to_string(w) + " x " + std::to_string(h));
     // Heights (kept) + one row of the read + the pyramid (1/64 of the samples, twice): checked first.
-    const double need = double(w) * double(h) * 4.0 * (1.0 + 2.0 / 64.0) + double(w) * spec.nchannels * 4.0;
+    const double need = double(w) * double(h) * 4.0 * (1.0 + 2.0 / 64.0) + double(w) * spec.channels * 4.0;
     const double avail = availableMemoryBytes();
     if (avail > 0.0 && need > avail)
         throw Error(path + ": a " + std::to_string(w) + " x " + std::to_string(h) + " DEM needs " + std::to_string(int(need / 1048576.0)) +
@@ -36,18 +36,18 @@ HeightField loadDem(const std::string& path, double spacing, double heightScale)
     if (w > (1ll << 30) / h) throw Error(path + ": " + std::to_string(w) + " x " + std::to_string(h) + " samples is more than this build traces (2^30)");
     // Integer formats are read normalized to [0, 1]: their DEM unit is 1 / the type's maximum.
     double unit = 1.0;
-    switch (spec.format.basetype) {
-    case OIIO::TypeDesc::UINT8: unit = 255.0; break;
-    case OIIO::TypeDesc::UINT16: unit = 65535.0; break;
-    case OIIO::TypeDesc::INT16: unit = 32767.0; break;
-    case OIIO::TypeDesc::UINT32: unit = 4294967295.0; break;
-    case OIIO::TypeDesc::INT32: unit = 2147483647.0; break;
+    using image_module::SampleType;
+    switch (spec.type) {
+    case SampleType::UInt8: unit = 255.0; break;
+    case SampleType::UInt16: unit = 65535.0; break;
+    case SampleType::Int16: unit = 32767.0; break;
+    case SampleType::UInt32: unit = 4294967295.0; break;
+    case SampleType::Int32: unit = 2147483647.0; break;
     default: break;   // half, float, double: as stored
     }
-    std::vector<float> heights(size_t(w) * size_t(h));
-    if (!in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, heights.data()))
-        throw Error(path + ": cannot decode the DEM (" + in->geterror() + ")");
-    in->close();
+    std::vector<float> heights;
+    if (!in->read(1, heights, error)) throw Error(path + ": cannot decode the DEM (" + error + ")");
+    in.reset();
     const double scale = unit * heightScale;
     for (size_t k = 0; k < heights.size(); ++k) {
         if (!std::isfinite(heights[k]))

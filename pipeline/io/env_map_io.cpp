@@ -1,15 +1,14 @@
-// Environment maps through OpenImageIO.
+// Environment maps through OpenImageIO (image_module.h).
 #include "pipeline/io/env_map_io.h"
 
 #include <cstdio>
 #include <filesystem>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
-
 #include "core/base/error.h"
 #include "core/scene/scene.h"
 #include "core/sky/sky_light.h"
+#include "pipeline/io/image_module.h"
 #include "pipeline/render/render_job.h"
 
 namespace sylva {
@@ -20,16 +19,16 @@ EnvMapFile readEnvMap(const std::string& path, float spikeRatio)
 {
     if (!fs::exists(path)) throw Error(path + ": no such environment map");
     if (fs::is_directory(path)) throw Error(path + ": is a folder, not an environment map");
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path + ": not an image OpenImageIO can read (" + OIIO::geterror() + ")");
-    const OIIO::ImageSpec& spec = in->spec();
-    const int w = spec.width, h = spec.height, nc = spec.nchannels;
+    std::string error;
+    auto in = image_module::Reader::open(path, false, error);
+    if (!in) throw Error(path + ": not an image OpenImageIO can read (" + error + ")");
+    const image_module::Info& spec = in->info();
+    const int w = spec.width, h = spec.height, nc = spec.channels;
     sky::checkEnvMapShape(w, h, path);
     if (nc <= 0) throw Error(path + ": the image has no channels");
-    std::vector<float> data(size_t(w) * size_t(h) * size_t(nc));
-    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, data.data()))
-        throw Error(path + ": cannot decode the image (" + in->geterror() + ")");
-    in->close();
+    std::vector<float> data;
+    if (!in->read(nc, data, error)) throw Error(path + ": cannot decode the image (" + error + ")");
+    in.reset();
     EnvMapFile f;
     f.map.width = w;
     f.map.height = h;

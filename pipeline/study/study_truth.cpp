@@ -11,8 +11,6 @@
 
 #include <unistd.h>
 
-#include <OpenImageIO/imageio.h>
-
 #include "core/base/error.h"
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
@@ -22,6 +20,7 @@
 #include "pipeline/io/atomic_file.h"
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/io/image_io.h"
+#include "pipeline/io/image_module.h"
 #include "pipeline/lighting_job.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/study/blender_scene.h"
@@ -45,17 +44,18 @@ std::string f(const char* fmt, double v)
 // Channels of a multi-layer EXR by name ("ViewLayer.Combined.R" ...), read with OpenImageIO.
 std::map<std::string, std::vector<float>> readExrChannels(const std::string& path, int& w, int& h)
 {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in) throw Error(path + ": cannot read the Cycles picture: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
+    std::string error;
+    auto in = image_module::Reader::open(path, false, error);
+    if (!in) throw Error(path + ": cannot read the Cycles picture: " + error);
+    const image_module::Info& spec = in->info();
     w = spec.width;
     h = spec.height;
-    const int nc = spec.nchannels;
-    std::vector<float> all(size_t(w) * size_t(h) * size_t(nc));
-    if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, all.data())) throw Error(path + ": " + in->geterror());
+    const int nc = spec.channels;
+    std::vector<float> all;
+    if (!in->read(nc, all, error)) throw Error(path + ": " + error);
     std::map<std::string, std::vector<float>> out;
     for (int c = 0; c < nc; ++c) {
-        std::vector<float>& v = out[spec.channelnames[size_t(c)]];
+        std::vector<float>& v = out[spec.channelNames[size_t(c)]];
         v.resize(size_t(w) * size_t(h));
         for (size_t p = 0; p < v.size(); ++p) v[p] = all[p * size_t(nc) + size_t(c)];
     }

@@ -39,10 +39,10 @@ QProcessEnvironment environment()
     return env;
 }
 
-Run runSylva(const QStringList& args)
+Run runSylva(const QStringList& args, const QProcessEnvironment& env = environment())
 {
     QProcess p;
-    p.setProcessEnvironment(environment());
+    p.setProcessEnvironment(env);
     p.start(SYLVA_CLI_PATH, args);
     p.waitForFinished(600000);
     return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
@@ -153,6 +153,32 @@ private Q_SLOTS:
         QCOMPARE(lines[0], QStringLiteral("sylva " SYLVA_VERSION));
         QVERIFY2(lines.value(1).startsWith(QLatin1String("backends: cpu")), qPrintable(r.out));
         QVERIFY2(runSylva({"--help"}).out.contains(QRegularExpression("\\n  cache +the grid cache")), "sylva --help lists cache");
+    }
+
+    // OpenImageIO (about 260 libraries) is a module loaded when an image is first read or written: sylva
+    // --version loads none of it (the dynamic loader's own log says which libraries it opened), and a
+    // render whose module cannot be found fails before it renders, naming SYLVA_IMAGE_MODULE, with no file.
+    void imageModuleLoadedOnUse()
+    {
+        QProcessEnvironment traced = environment();
+        traced.insert("LD_DEBUG", "libs");
+        const Run v = runSylva({"--version"}, traced);
+        QCOMPARE(v.code, 0);
+        QVERIFY2(v.err.contains(QLatin1String("libsylva_core")) || v.err.contains(QLatin1String("libc.so")), "LD_DEBUG logged nothing");
+        QVERIFY2(!v.err.contains(QLatin1String("libOpenImageIO")), "sylva --version loaded OpenImageIO");
+
+        const QString picture = outDir() + "/no_module.png";
+        QFile::remove(picture);
+        QProcessEnvironment missing = environment();
+        missing.insert("SYLVA_IMAGE_MODULE", outDir() + "/nowhere/libsylva_oiio.so");
+        QElapsedTimer t;
+        t.start();
+        const Run r = runSylva({"render", "--width", "32", "--height", "16", "--no-cache", "-o", picture}, missing);
+        QCOMPARE(r.code, 1);
+        QVERIFY2(r.err.contains(QLatin1String("SYLVA_IMAGE_MODULE")) && r.err.contains(QLatin1String("no such file")), qPrintable(r.err));
+        QVERIFY2(!r.err.contains(QLatin1String("render: done")), qPrintable(r.err));   // failed before rendering
+        QVERIFY(!QFileInfo::exists(picture));
+        qInfo("missing module: exit 1 after %lld ms", (long long)t.elapsed());
     }
 
     // What a second signal runs before it exits: the temporary files of the writers still open go, a

@@ -107,6 +107,9 @@ private Q_SLOTS:
             QVERIFY2(QFileInfo(installed(rel)).size() > 0, rel);
         QVERIFY(QFileInfo(installed("bin/sylva")).isExecutable());
         QVERIFY(QFileInfo(installed("bin/sylva-studio")).isExecutable());
+        // OpenImageIO's module, where the programs look for it relative to their folder (image_module.h)
+        const QString module = installed(QString(SYLVA_INSTALL_LIBDIR) + "/sylva/libsylva_oiio.so");
+        QVERIFY2(QFileInfo(module).size() > 0, qPrintable(module));
     }
 
     // The installed binary, run from a folder outside the build and source trees.
