@@ -153,8 +153,6 @@ int runRender(const Args& args)
     const std::string mpiScene = args.get("--mpi-scene", "broadcast");
     if (mpiScene != "broadcast" && mpiScene != "each")
         throw UsageError("option --mpi-scene: expected broadcast or each, got '" + mpiScene + "'");
-    // The picture's writer loads OpenImageIO (0.4 s) on a thread while the scene loads and builds.
-    if (writesPicture(useMpi)) image_module::preload();
     // Under --mpi the ranks set their own thread limits (rank 0 builds with its node's threads).
     auto threads = useMpi ? nullptr : threadLimit(args);
     const std::string backend = backendName(args);
@@ -170,7 +168,10 @@ int runRender(const Args& args)
         throw UsageError("option --passes: the passes are layers of one multi-layer EXR; use -o NAME.exr, not " + out);
     if (passes && args.has("--band-rows")) throw UsageError("option --passes: a frame in bands cannot be written with passes; drop --band-rows");
     const bool writer = writesPicture(useMpi);
-    if (writer) requireReplaceableFile(out);
+    if (writer) {
+        requireReplaceableFile(out);
+        image_module::requireFindable();   // loaded when the picture is written
+    }
     int bandRows = 0;   // 0: the whole frame at once
     if (args.has("--band-rows")) bandRows = int(parseInteger("--band-rows", args.get("--band-rows"), 1, 32768));
     else if (!frameFitsMemory(r)) bandRows = bandRowsFor(r);

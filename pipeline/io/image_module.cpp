@@ -7,7 +7,6 @@
 #include <cstdlib>
 #include <filesystem>
 #include <mutex>
-#include <thread>
 
 #include "core/base/error.h"
 
@@ -49,11 +48,6 @@ struct State {
     std::mutex mutex;
     const Table* table = nullptr;
     std::string failure;   // the message of a load that failed (not retried)
-    std::thread preloader;
-    ~State()
-    {
-        if (preloader.joinable()) preloader.join();
-    }
 };
 
 State& state()
@@ -105,25 +99,20 @@ const Table& table()
     return *s.table;
 }
 
-void preload()
+void requireFindable()
 {
     State& s = state();
     std::lock_guard<std::mutex> lock(s.mutex);
-    if (s.table || s.preloader.joinable()) return;
+    if (s.table) return;
     if (s.failure.empty()) {
-        // A module that is nowhere to be found fails the command now, not after its render.
         bool any = false;
         for (const std::string& path : candidates()) {
             std::error_code ec;
             any = any || std::filesystem::exists(path, ec);
         }
-        if (!any) loadLocked(s);
+        if (!any) loadLocked(s);   // records the places it looked
     }
     if (!s.failure.empty()) throw Error(s.failure);
-    s.preloader = std::thread([&s] {
-        std::lock_guard<std::mutex> inner(s.mutex);
-        loadLocked(s);
-    });
 }
 
 std::unique_ptr<Reader> Reader::open(const std::string& path, bool unassociatedAlpha, std::string& error)

@@ -45,11 +45,12 @@ constexpr int kAbi = 1;
 // sylva), then where the build put it.
 const Table& table();
 
-// Starts loading the module on a background thread and returns at once, for a command that will write
-// an image at its end (sylva render): the 0.4 s then overlaps the scene's loading and build. table()
-// waits for it; a process that ends first waits for it at exit. Throws Error at once when no module file
-// exists where table() looks.
-void preload();
+// Throws table()'s Error at once when no module file exists where table() looks (nothing is loaded): for
+// a command that writes an image at its end, so a missing module fails it before its work. The module is
+// not loaded early on a thread: beside the loader's 0.35 s the scene's asset loading and build of sylva
+// render ran 0.3-0.5 s longer (the dynamic loader's lock, which thread creation and every dlopen take),
+// and the render's wall time grew from 2.03 to 2.61 s (docs/PERFORMANCE.md "Start").
+void requireFindable();
 
 // An image file open for reading.
 class Reader {
