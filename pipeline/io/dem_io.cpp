@@ -23,7 +23,7 @@ HeightField loadDem(const std::string& path, double spacing, double heightScale)
     std::string error;
     auto in = image_module::Reader::open(path, false, error);
     if (!in) throw Error(path + ": cannot read the DEM as an image (" + error + ")");
-    const image_module::Info& spec = in->info();
+    const image_module::Info spec = in->info();   // a copy: the reader closes before the pixels are used
     const long long w = spec.width, h = spec.height;
     if (w < 2 || h < 2 || spec.channels < 1)
         throw Error(path + ": a DEM needs at least 2 x 2 samples, this image has " + std::to_string(w) + " x " + std::to_string(h));

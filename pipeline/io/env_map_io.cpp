@@ -22,7 +22,7 @@ EnvMapFile readEnvMap(const std::string& path, float spikeRatio)
     std::string error;
     auto in = image_module::Reader::open(path, false, error);
     if (!in) throw Error(path + ": not an image OpenImageIO can read (" + error + ")");
-    const image_module::Info& spec = in->info();
+    const image_module::Info spec = in->info();   // a copy: the reader closes before the pixels are used
     const int w = spec.width, h = spec.height, nc = spec.channels;
     sky::checkEnvMapShape(w, h, path);
     if (nc <= 0) throw Error(path + ": the image has no channels");

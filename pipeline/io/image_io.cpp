@@ -34,7 +34,7 @@ ImageRgba readImage(const std::string& path)
     std::string error;
     auto in = image_module::Reader::open(path, true, error);
     if (!in) throw Error(path + ": cannot read image (" + error + ")");
-    const image_module::Info& spec = in->info();
+    const image_module::Info spec = in->info();   // a copy: the reader closes before the pixels are used
     const int w = spec.width, h = spec.height, nc = spec.channels;
     if (w <= 0 || h <= 0 || nc <= 0 || size_t(w) * size_t(h) > (size_t(1) << 28))
         throw Error(path + ": image has an unsupported size " + std::to_string(w) + "x" + std::to_string(h));
@@ -63,7 +63,7 @@ bool imageHasAlpha(const std::string& path)
     std::string error;
     auto in = image_module::Reader::open(path, false, error);
     if (!in) throw Error(path + ": cannot read image (" + error + ")");
-    const image_module::Info& spec = in->info();
+    const image_module::Info spec = in->info();   // a copy: the reader closes before the pixels are used
     return spec.alphaChannel >= 0 || spec.channels == 2 || spec.channels >= 4;
 }
 

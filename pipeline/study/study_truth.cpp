@@ -47,7 +47,7 @@ std::map<std::string, std::vector<float>> readExrChannels(const std::string& pat
     std::string error;
     auto in = image_module::Reader::open(path, false, error);
     if (!in) throw Error(path + ": cannot read the Cycles picture: " + error);
-    const image_module::Info& spec = in->info();
+    const image_module::Info spec = in->info();   // a copy: the reader closes before the pixels are used
     w = spec.width;
     h = spec.height;
     const int nc = spec.channels;
