@@ -1,9 +1,13 @@
 #include "core/render/scene_bytes.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <memory>
+#include <vector>
+
+#include <tbb/parallel_for.h>
 
 #include "core/base/error.h"
 #include "core/base/version.h"
@@ -31,6 +35,51 @@ RenderScene allocateRenderScene(const RenderSceneHeader& h)
 #undef SYLVA_X
     rs.base = h.base;
     return rs;
+}
+
+PackedFrame packedFrameLayout(const RenderSceneHeader& h)
+{
+    PackedFrame L{};
+    uint64_t at = 0;
+    size_t i = 0;
+#define SYLVA_X(part, where, T, name, stat) L.offset[i] = at, at += (uint64_t(h.counts[i]) * sizeof(T) + 63u) & ~uint64_t(63u), ++i;
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
+    L.bytes = at;
+    return L;
+}
+
+void packRenderScene(const RenderScene& rs, const PackedFrame& layout, void* block)
+{
+    // Pieces of at most 4 MB, so that the threads share the large arrays (the copy is mostly the first touch
+    // of the block's pages).
+    struct Piece {
+        const char* from;
+        char* to;
+        size_t bytes;
+    };
+    constexpr size_t kPiece = size_t(4) << 20;
+    std::vector<Piece> pieces;
+    size_t i = 0;
+    forEachRenderSceneArray(rs, [&](const void* data, size_t bytes) {
+        char* to = static_cast<char*>(block) + layout.offset[i++];
+        for (size_t at = 0; at < bytes; at += kPiece)
+            pieces.push_back({static_cast<const char*>(data) + at, to + at, std::min(kPiece, bytes - at)});
+    });
+    tbb::parallel_for(size_t(0), pieces.size(), [&](size_t k) { std::memcpy(pieces[k].to, pieces[k].from, pieces[k].bytes); });
+}
+
+RenderView packedFrameView(const RenderSceneHeader& h, const PackedFrame& layout, const void* block)
+{
+    RenderView v = h.base;
+    const char* b = static_cast<const char*>(block);
+    size_t i = 0;
+#define SYLVA_X(part, where, T, name, stat) v.name = h.counts[i] ? reinterpret_cast<const T*>(b + layout.offset[i]) : nullptr, ++i;
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
+    v.instanceCount = uint32_t(h.counts[kArray_instances]);
+    v.volumeCount = uint32_t(h.counts[kArray_volumeInstances]);
+    return v;
 }
 
 namespace {

@@ -17,6 +17,12 @@ namespace sylva {
 #define SYLVA_X(part, where, T, name, stat) +1
 inline constexpr size_t kRenderSceneArrays = 0 SYLVA_RENDER_ARRAYS(SYLVA_X);
 #undef SYLVA_X
+// Each array's index in SYLVA_RENDER_ARRAYS order: kArray_instances, kArray_tris, ...
+enum RenderSceneArrayIndex : size_t {
+#define SYLVA_X(part, where, T, name, stat) kArray_##name,
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
+};
 static_assert(std::is_trivially_copyable_v<RenderView>, "the view's settings travel as bytes");
 
 struct RenderSceneHeader {
@@ -38,6 +44,32 @@ void forEachRenderSceneArray(Scene& rs, Fn&& fn)
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
 }
+
+// ---- one frame shared by the processes of a host (sylva render --mpi) ----
+// The arrays packed one after another into one block, each at a 64-byte boundary, so that the ranks on one
+// host map a single copy of the frame (an MPI shared-memory window) instead of holding one each.
+struct PackedFrame {
+    uint64_t offset[kRenderSceneArrays];   // of each array in SYLVA_RENDER_ARRAYS order
+    uint64_t bytes;                        // the whole block
+};
+PackedFrame packedFrameLayout(const RenderSceneHeader& h);
+
+// rs's arrays copied to their places in `block` (layout.bytes bytes; layout from rs's header), in parallel.
+void packRenderScene(const RenderScene& rs, const PackedFrame& layout, void* block);
+
+// fn(data, bytes) for each array's place in a packed block, in SYLVA_RENDER_ARRAYS order (as
+// forEachRenderSceneArray walks a scene: the same pieces, to receive them there).
+template <class Fn>
+void forEachPackedArray(const RenderSceneHeader& h, const PackedFrame& layout, void* block, Fn&& fn)
+{
+    size_t i = 0;
+#define SYLVA_X(part, where, T, name, stat) fn(static_cast<void*>(static_cast<char*>(block) + layout.offset[i]), size_t(h.counts[i]) * sizeof(T)), ++i;
+    SYLVA_RENDER_ARRAYS(SYLVA_X)
+#undef SYLVA_X
+}
+
+// The view of a packed block: what RenderScene::view() gives for the scene it was packed from.
+RenderView packedFrameView(const RenderSceneHeader& h, const PackedFrame& layout, const void* block);
 
 // A frame and its traced film to a file, and back. The file starts with a signature of this build's layout
 // (the program version, every array's element size and the header's size): readRenderSceneFile refuses a file

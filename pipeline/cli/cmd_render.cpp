@@ -183,7 +183,7 @@ int runRender(const Args& args)
     auto compute = openBackend(backend);
     auto cache = openCache(args);
     // The render and its picture, its tracing by `tracer` when given (--mpi: the ranks'), on `ranks` processes.
-    auto renderAndWrite = [&](const FilmRowsTracer& tracer, int ranks) {
+    auto renderAndWrite = [&](const FilmRowsTracer& tracer, int ranks, int hosts) {
         JobLog log;
         AccelStats st;
         RenderTimings timings;
@@ -216,7 +216,10 @@ int runRender(const Args& args)
             st = result.stats;
             timings = result.timings;
         }
-        if (tracer) device = (bandRows > 0 ? device : std::string("cpu")) + ", " + std::to_string(ranks) + (ranks == 1 ? " MPI rank" : " MPI ranks");
+        if (tracer) {
+            device = (bandRows > 0 ? device : std::string("cpu")) + ", " + std::to_string(ranks) + (ranks == 1 ? " MPI rank" : " MPI ranks");
+            if (hosts > 0) device += " on " + std::to_string(hosts) + (hosts == 1 ? " host" : " hosts") + " (a copy of the frame per host)";
+        }
         for (const auto& w : log.warnings) std::fprintf(stderr, "warning: %s\n", w.c_str());
         std::printf("rendered %dx%d, %d spp, mode %s, %zu instances of %zu species (%.0f instanced triangles) on %s\nwrote %s\n",
                     r.width, r.height, r.spp, renderModeName(r.mode), st.instances, scene.species.size(), st.instancedTriangles,
@@ -224,7 +227,7 @@ int runRender(const Args& args)
         if (args.has("--stats")) printStats(st, timings, r, ambient);
         return kOk;
     };
-    if (!useMpi) return renderAndWrite({}, 1);
+    if (!useMpi) return renderAndWrite({}, 1, 0);
 #if SYLVA_HAVE_MPI
     mpi::RenderJob job;
     job.prepare = [&](Progress* progress) {
@@ -285,7 +288,7 @@ Command renderCommand()
              {"--stats", "", "print timings and acceleration structure sizes"},
              {"--mpi", "", "trace the frame across the ranks of an MPI job, tiles from a work queue on rank 0: mpirun -np N sylva render --mpi ... (docs/DISTRIBUTED.md)"},
              {"--mpi-timeout", "S", "with --mpi: end the job when a rank stays silent S seconds (default 10)"},
-             {"--mpi-scene", "broadcast|each", "with --mpi: rank 0 builds the frame and broadcasts it to the other ranks (default), or "
+             {"--mpi-scene", "broadcast|each", "with --mpi: rank 0 builds the frame and hands it to the other ranks, one shared copy per host (default), or "
                                                "every rank builds its own from the species assets (docs/DISTRIBUTED.md)"},
              kOutput, kCache, kNoCache, kThreads, kQuiet},
             0, 1, &runRender};

@@ -6,6 +6,7 @@
 #include "pipeline/mpi/mpi_render.h"
 
 #include <mpi.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 #include <xxhash.h>
 
@@ -98,6 +99,52 @@ const char* g_notWritten = "no picture was written";
     std::_Exit(1);
 }
 
+// Ends this process (exit 1, `message` on stderr) unless disarmed within `seconds`: bounds MPI's blocking
+// calls (the start, collectives over the ranks of a host), which a rank that died or hung before reaching
+// them would hold forever. mpirun then stops the other ranks.
+class Deadline {
+public:
+    Deadline(double seconds, std::string message)
+        : m_thread([this, seconds, message = std::move(message)] {
+              std::unique_lock<std::mutex> lock(m_mutex);
+              if (m_cv.wait_for(lock, std::chrono::duration<double>(seconds), [&] { return m_disarmed; })) return;
+              std::fprintf(stderr, "%s\n", message.c_str());
+              std::fflush(stderr);
+              std::_Exit(1);
+          })
+    {
+    }
+    Deadline(const Deadline&) = delete;
+    Deadline& operator=(const Deadline&) = delete;
+    ~Deadline() { disarm(); }
+
+    void disarm()
+    {
+        if (!m_thread.joinable()) return;
+        {
+            std::lock_guard<std::mutex> lock(m_mutex);
+            m_disarmed = true;
+        }
+        m_cv.notify_all();
+        m_thread.join();
+    }
+
+private:
+    std::mutex m_mutex;
+    std::condition_variable m_cv;
+    bool m_disarmed = false;
+    std::thread m_thread;   // last: it starts once the members above exist
+};
+
+// "sylva render: error: ...; no picture was written" for a Deadline's message.
+std::string jobError(const std::string& what) { return std::string("sylva ") + g_command + ": error: " + what + "; " + g_notWritten; }
+
+int envInt(const char* name, int fallback)
+{
+    const char* v = std::getenv(name);
+    return v && *v ? std::atoi(v) : fallback;
+}
+
 // ---- the build check ----
 
 // XXH3-64 of this process's executable: ranks run the same build only when their files are equal
@@ -171,29 +218,115 @@ void finish(MPI_Request& req, double timeout, const char* what)
     }
 }
 
-// Broadcasts `bytes` bytes from rank 0 in pieces MPI's int counts can hold.
-void broadcastBytes(void* data, size_t bytes, double timeout)
+// Broadcasts `bytes` bytes from rank 0 of `comm` in pieces MPI's int counts can hold.
+void broadcastBytes(void* data, size_t bytes, double timeout, MPI_Comm comm)
 {
     constexpr size_t kPiece = size_t(1) << 28;
     char* p = static_cast<char*>(data);
     for (size_t done = 0; done < bytes; done += kPiece) {
         MPI_Request req;
-        check(MPI_Ibcast(p + done, int(std::min(kPiece, bytes - done)), MPI_BYTE, 0, MPI_COMM_WORLD, &req), "Ibcast");
+        check(MPI_Ibcast(p + done, int(std::min(kPiece, bytes - done)), MPI_BYTE, 0, comm, &req), "Ibcast");
         finish(req, timeout, "the broadcast of the frame's scene");
     }
 }
 
-// What the other ranks need to trace the frame (RenderScene::view()): the header of core/render/scene_bytes.h.
-// The broadcast in three steps. Rank 0 posts the header (renderSceneHeader); the other ranks, once it has
-// come, make room for the arrays (allocateRenderScene: for a large scene mostly the first touch of fresh
-// memory, 0.1-0.5 s for the default forest's 290 MB on the 2-core VM, during which rank 0 traces) and
-// say so (kReady); then the arrays travel (broadcastArrays, 9-11 GB/s over shared memory).
+// What the other ranks need to trace the frame (RenderScene::view()): the header of core/render/scene_bytes.h,
+// then the arrays. The ranks of one host share one copy of them (SharedFrame); rank 0 broadcasts them to the
+// first rank of every other host (Hosts::leaders).
 using SceneHeader = RenderSceneHeader;
 
-// Rank 0's arrays to every rank (MPI_Ibcast takes a non-const buffer; rank 0's is only read).
-void broadcastArrays(const RenderScene& rs, double timeout)
+// The ranks of this rank's host and the first rank of every host. `node`: the ranks that share this host's
+// memory (MPI_COMM_TYPE_SHARED), or with SYLVA_MPI_NODE_SIZE=N every N consecutive ranks (N = 1: a copy of the
+// frame per rank; N > 1 tries the several-host path on one machine). `leaders`: node rank 0 of every host
+// (MPI_COMM_NULL on the others), rank 0 first.
+struct Hosts {
+    MPI_Comm node = MPI_COMM_NULL, leaders = MPI_COMM_NULL;
+    int nodeRank = 0, nodeSize = 1, leaderCount = 1;
+
+    // Collective over MPI_COMM_WORLD.
+    void split(int rank, double timeout)
+    {
+        const Deadline deadline(timeout, jobError("--mpi: the ranks did not all reach the split into hosts within the timeout (a rank hung or died)"));
+        const int per = envInt("SYLVA_MPI_NODE_SIZE", 0);
+        if (per > 0) check(MPI_Comm_split(MPI_COMM_WORLD, rank / per, rank, &node), "Comm_split");
+        else check(MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, rank, MPI_INFO_NULL, &node), "Comm_split_type");
+        MPI_Comm_rank(node, &nodeRank);
+        MPI_Comm_size(node, &nodeSize);
+        check(MPI_Comm_split(MPI_COMM_WORLD, nodeRank == 0 ? 0 : MPI_UNDEFINED, rank, &leaders), "Comm_split");
+        if (leaders != MPI_COMM_NULL) MPI_Comm_size(leaders, &leaderCount);
+    }
+    ~Hosts()
+    {
+        if (leaders != MPI_COMM_NULL) MPI_Comm_free(&leaders);
+        if (node != MPI_COMM_NULL) MPI_Comm_free(&node);
+    }
+};
+
+// A host's copy of the frame's arrays (scene_bytes.h's packed block): an MPI shared-memory window that the
+// host's first rank allocates and every rank of the host maps, so a host holds the frame once whatever its
+// rank count (the second rank of a 2-core machine used to spend 0.2-0.6 s making room for its own copy).
+class SharedFrame {
+public:
+    SharedFrame() = default;
+    SharedFrame(const SharedFrame&) = delete;
+    SharedFrame& operator=(const SharedFrame&) = delete;
+    ~SharedFrame() = default;   // a job that ends early exits without the collective release
+
+    // Collective over hosts.node. Throws Error when the host's shared memory (/dev/shm, where OpenMPI keeps
+    // the window) has no room for `bytes`.
+    void allocate(const Hosts& hosts, uint64_t bytes, double timeout)
+    {
+        if (hosts.nodeRank == 0) checkRoom(bytes, hosts.nodeSize);
+        const Deadline deadline(timeout, jobError("--mpi: the ranks of a host did not all make room for the frame within the timeout (a rank hung or died)"));
+        m_node = hosts.node;
+        void* mine = nullptr;
+        check(MPI_Win_allocate_shared(MPI_Aint(hosts.nodeRank == 0 ? std::max<uint64_t>(bytes, 1) : 0), 1, MPI_INFO_NULL, m_node, &mine, &m_win),
+              "Win_allocate_shared");
+        MPI_Aint size = 0;
+        int unit = 0;
+        check(MPI_Win_shared_query(m_win, 0, &size, &unit, &m_block), "Win_shared_query");
+        // One passive epoch for the frame's life: MPI_Win_sync orders the writes before the host's barrier.
+        check(MPI_Win_lock_all(MPI_MODE_NOCHECK, m_win), "Win_lock_all");
+    }
+
+    void* block() const { return m_block; }
+    void sync() const { check(MPI_Win_sync(m_win), "Win_sync"); }
+
+    // Collective over the host's ranks (each calls it when its tracing is done).
+    void release(double timeout = 30.0)
+    {
+        if (m_win == MPI_WIN_NULL) return;
+        const Deadline deadline(timeout, jobError("--mpi: the ranks of a host did not all finish with the frame within the timeout (a rank hung or died)"));
+        MPI_Win_unlock_all(m_win);
+        MPI_Win_free(&m_win);
+        m_block = nullptr;
+    }
+
+private:
+    static void checkRoom(uint64_t bytes, int ranks)
+    {
+        struct statvfs fs {};
+        if (statvfs("/dev/shm", &fs) != 0) return;   // no /dev/shm: OpenMPI keeps the window elsewhere
+        const uint64_t room = uint64_t(fs.f_bavail) * uint64_t(fs.f_frsize);
+        if (room >= bytes) return;
+        char msg[400];
+        std::snprintf(msg, sizeof msg,
+                      "--mpi: the frame's %.0f MB do not fit in this host's shared memory (/dev/shm has %.0f MB free) that its %d ranks "
+                      "would share; give it more (docker: --shm-size) or set SYLVA_MPI_NODE_SIZE=1 (a copy of the frame per rank)",
+                      double(bytes) / 1e6, double(room) / 1e6, ranks);
+        throw Error(msg);
+    }
+
+    MPI_Comm m_node = MPI_COMM_NULL;
+    MPI_Win m_win = MPI_WIN_NULL;
+    void* m_block = nullptr;
+};
+
+// Rank 0's arrays to the first rank of every other host, array by array as forEachPackedArray receives them
+// (MPI_Ibcast takes a non-const buffer; rank 0's is only read).
+void broadcastArrays(const RenderScene& rs, double timeout, MPI_Comm leaders)
 {
-    forEachRenderSceneArray(const_cast<RenderScene&>(rs), [&](void* data, size_t bytes) { broadcastBytes(data, bytes, timeout); });
+    forEachRenderSceneArray(const_cast<RenderScene&>(rs), [&](void* data, size_t bytes) { broadcastBytes(data, bytes, timeout, leaders); });
 }
 
 std::unique_ptr<tbb::global_control> threadLimit(int threads)
@@ -212,26 +345,31 @@ struct TileMsg {
 // the main thread hands the others to the workers and stores what they send back.
 class TileQueue {
 public:
-    // sendScene: the other ranks wait for the frame's scene (rank 0's main thread broadcasts it while
-    // the first band is traced). beforeTrace: called once, in the render thread, before the tracing.
-    TileQueue(int ranks, int tileEdge, bool sendScene, std::function<void()> beforeTrace)
-        : m_ranks(ranks), m_edge(tileEdge), m_sceneSent(!sendScene || ranks < 2), m_beforeTrace(std::move(beforeTrace))
+    // sendScene: the other ranks wait for the frame's scene (rank 0's main thread sends it while the first
+    // band is traced). packForHost: the ranks on rank 0's host trace from a copy this rank's render thread
+    // packs into their shared window first. beforeTrace: called once, in the render thread, before the tracing.
+    TileQueue(int ranks, int tileEdge, bool sendScene, bool packForHost, std::function<void()> beforeTrace)
+        : m_ranks(ranks), m_edge(tileEdge), m_sceneSent(!sendScene || ranks < 2), m_pack(packForHost && !m_sceneSent),
+          m_beforeTrace(std::move(beforeTrace))
     {
     }
 
     // Render thread: rows [y0, y1) of the scene's view as a film, every tile traced here or by a worker.
     Film trace(const RenderScene& rs, int y0, int y1, Progress* progress)
     {
-        if (m_beforeTrace) {
-            m_beforeTrace();
-            m_beforeTrace = nullptr;
-        }
         // The scene goes out while this thread traces (the other ranks start on it when it has come);
         // trace returns only after it went, so `rs` outlives the broadcast (which ends the job itself
         // when it cannot finish within the timeout).
         {
             std::lock_guard<std::mutex> lock(m_mutex);
             if (!m_sceneSent) m_scene = &rs;
+        }
+        // The host's copy first, with every thread the build had (the host's other ranks wait for it), then
+        // the tracing with this rank's own.
+        if (m_pack) packForHost(rs, progress);
+        if (m_beforeTrace) {
+            m_beforeTrace();
+            m_beforeTrace = nullptr;
         }
         struct AwaitSent {
             TileQueue* q;
@@ -301,6 +439,22 @@ public:
         return film;
     }
 
+    // Main thread: the host's shared window for the frame (layout: the packed block's), for the render thread to fill.
+    void setBlock(void* block, const PackedFrame& layout)
+    {
+        {
+            std::lock_guard<std::mutex> lock(m_mutex);
+            m_block = block;
+            m_layout = layout;
+        }
+        m_changed.notify_all();
+    }
+    bool packed()
+    {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        return m_packed;
+    }
+
     // Main thread: the scene to broadcast, once the render thread has it and until it is sent.
     const RenderScene* sceneToSend()
     {
@@ -361,8 +515,29 @@ private:
         return m_done;
     }
 
+    // Waits for the window (setBlock) and packs the scene into it.
+    void packForHost(const RenderScene& rs, Progress* progress)
+    {
+        std::unique_lock<std::mutex> lock(m_mutex);
+        while (!m_block) {
+            if (Progress::cancelAllRequested() || (progress && progress->isCancelled())) throw Cancelled();
+            m_changed.wait_for(lock, std::chrono::milliseconds(20));
+        }
+        void* const block = m_block;
+        const PackedFrame layout = m_layout;
+        lock.unlock();
+        packRenderScene(rs, layout, block);
+        lock.lock();
+        m_packed = true;
+        m_pack = false;
+    }
+
     const int m_ranks, m_edge;
     bool m_sceneSent;
+    bool m_pack;
+    void* m_block = nullptr;
+    PackedFrame m_layout{};
+    bool m_packed = false;
     const RenderScene* m_scene = nullptr;
     std::function<void()> m_beforeTrace;
     std::mutex m_mutex;
@@ -374,13 +549,14 @@ private:
 };
 
 // Rank 0's main thread: runs the lead's render in a thread and serves the workers until it is done.
-int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::string>& hosts)
+int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::string>& hosts, const Hosts& topology)
 {
+    const int hostCount = topology.leaderCount;
     // Threads: job.threads for the species' lighting and the tracing, the threads of every rank on this
     // node for the build while they wait for the broadcast scene (the render thread's limit).
     std::unique_ptr<tbb::global_control> limit;
     const bool wideBuild = job.broadcastScene && size > 1 && job.threads > 0 && localRanks > 1;
-    TileQueue queue(size, job.tile, job.broadcastScene, [&] {
+    TileQueue queue(size, job.tile, job.broadcastScene, topology.nodeSize > 1, [&] {
         if (wideBuild) limit = threadLimit(job.threads);
     });
     const FilmRowsTracer tracer = [&queue](const RenderScene& rs, int y0, int y1, Progress* p) { return queue.trace(rs, y0, y1, p); };
@@ -418,7 +594,7 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
             limit.reset();
             limit = threadLimit(job.threads * localRanks);
         }
-        return job.lead(tracer, size);
+        return job.lead(tracer, size, job.broadcastScene && size > 1 ? hostCount : 0);
     });
 
     struct Peer {
@@ -459,10 +635,14 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
     bool rendered = false;
     int code = 0;
     std::vector<char> buf;
-    // The scene's broadcast (with job.broadcastScene): the header, then the arrays once every rank is ready.
+    // The scene's way to the other ranks (with job.broadcastScene): the header to every rank; the arrays packed
+    // into the shared window of this host's ranks (its render thread packs them), then the host's barrier lets
+    // them start; the arrays broadcast to the first rank of every other host once each has made room (kReady).
     SceneHeader header{};
-    MPI_Request headerReq = MPI_REQUEST_NULL;
-    bool headerPosted = false;
+    PackedFrame layout{};
+    SharedFrame frame;
+    MPI_Request headerReq = MPI_REQUEST_NULL, hostReq = MPI_REQUEST_NULL;
+    bool headerPosted = false, windowMade = false, hostReleased = false;
     int ready = 0;
     for (;;) {
         bool busy = false;
@@ -514,13 +694,26 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
             try {
                 if (!headerPosted) {
                     header = renderSceneHeader(*rs);
+                    layout = packedFrameLayout(header);
                     check(MPI_Ibcast(&header, int(sizeof header), MPI_BYTE, 0, MPI_COMM_WORLD, &headerReq), "Ibcast");
                     headerPosted = true;
                 }
                 int flag = headerReq == MPI_REQUEST_NULL;
                 if (!flag) check(MPI_Test(&headerReq, &flag, MPI_STATUS_IGNORE), "Test");
-                if (flag && ready == size - 1) {
-                    broadcastArrays(*rs, job.timeoutSeconds);
+                const bool host = topology.nodeSize > 1;
+                if (flag && host && !windowMade) {
+                    frame.allocate(topology, layout.bytes, job.timeoutSeconds);
+                    queue.setBlock(frame.block(), layout);
+                    windowMade = busy = true;
+                }
+                if (flag && host && !hostReleased && queue.packed()) {
+                    frame.sync();
+                    check(MPI_Ibarrier(topology.node, &hostReq), "Ibarrier");
+                    hostReleased = busy = true;
+                }
+                if (flag && (!host || hostReleased) && ready == topology.leaderCount - 1) {
+                    if (topology.leaderCount > 1) broadcastArrays(*rs, job.timeoutSeconds, topology.leaders);
+                    if (hostReq != MPI_REQUEST_NULL) finish(hostReq, job.timeoutSeconds, "the start of this host's ranks on the frame");
                     queue.markSceneSent();
                     busy = true;
                 }
@@ -588,6 +781,7 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
         MPI_Cancel(&q.req);
         MPI_Wait(&q.req, MPI_STATUS_IGNORE);
     }
+    frame.release(job.timeoutSeconds);
     return code;
 }
 
@@ -628,18 +822,43 @@ public:
         }
     }
 
-    // The frame's scene as rank 0 broadcasts it: waits for it (rank 0 pings meanwhile; this rank's
-    // heartbeats go on), then receives its arrays.
-    RenderScene receiveScene()
+    // The frame's scene as rank 0 sends it: waits for its header (rank 0 pings meanwhile; this rank's
+    // heartbeats go on), makes room for its arrays in this host's shared window, and when this rank is the
+    // first of a host other than rank 0's, receives them there from rank 0's broadcast; then waits at the
+    // host's barrier until the host's copy is whole. Returns the view of that copy.
+    RenderView receiveScene(const Hosts& hosts, SharedFrame& frame)
     {
         SceneHeader h{};
         MPI_Request req;
         check(MPI_Ibcast(&h, int(sizeof h), MPI_BYTE, 0, MPI_COMM_WORLD, &req), "Ibcast");
+        await(req);
+        const PackedFrame layout = packedFrameLayout(h);
+        try {
+            frame.allocate(hosts, layout.bytes, m_timeout);
+            if (hosts.nodeRank == 0) {
+                send(nullptr, 0, kReady);
+                forEachPackedArray(h, layout, frame.block(), [&](void* data, size_t bytes) { broadcastBytes(data, bytes, m_timeout, hosts.leaders); });
+                frame.sync();
+            }
+        } catch (const Error& e) {
+            fail(e.what());
+        }
+        if (hosts.nodeSize > 1) {
+            check(MPI_Ibarrier(hosts.node, &req), "Ibarrier");
+            await(req);
+            frame.sync();
+        }
+        return packedFrameView(h, layout, frame.block());
+    }
+
+    // Waits for req with heartbeats both ways (rank 0 pings a rank that waits on it).
+    void await(MPI_Request& req)
+    {
         m_heard = Clock::now();
         for (;;) {
             int flag = 0;
             check(MPI_Test(&req, &flag, MPI_STATUS_IGNORE), "Test");
-            if (flag) break;
+            if (flag) return;
             for (;;) {
                 MPI_Status st;
                 check(MPI_Iprobe(0, kHeartbeat, MPI_COMM_WORLD, &flag, &st), "Iprobe");
@@ -651,14 +870,6 @@ public:
             beat();
             std::this_thread::sleep_for(std::chrono::microseconds(200));
         }
-        RenderScene rs = busy([&] { return allocateRenderScene(h); });
-        send(nullptr, 0, kReady);
-        try {
-            broadcastArrays(rs, m_timeout);
-        } catch (const Error& e) {
-            fail(e.what());
-        }
-        return rs;
     }
 
     // Traces the tiles rank 0 hands out until it says done. A render thread traces them in turn
@@ -837,7 +1048,7 @@ private:
     Clock::time_point m_beat, m_heard;
 };
 
-int work(const RenderJob& job, int rank, int size)
+int work(const RenderJob& job, int rank, int size, const Hosts& hosts)
 {
     const auto limit = threadLimit(job.threads);
     Worker w(rank, job.timeoutSeconds);
@@ -847,20 +1058,17 @@ int work(const RenderJob& job, int rank, int size)
             const int32_t solved = w.busy([&] { return job.lightShare(rank, size, &quiet); });
             w.send(&solved, sizeof solved, kLit);
         }
-        const RenderScene rs = job.broadcastScene ? w.receiveScene() : w.busy([&] { return job.prepare(&quiet); });
-        w.traceTiles(rs.view());
+        SharedFrame frame;
+        RenderScene own;
+        const RenderView view = job.broadcastScene ? w.receiveScene(hosts, frame) : (own = w.busy([&] { return job.prepare(&quiet); })).view();
+        w.traceTiles(view);
+        frame.release(job.timeoutSeconds);
     } catch (const Cancelled&) {
         throw;
     } catch (const Error& e) {
         abortJob(rankName(rank) + " on " + hostName() + ": " + e.what());
     }
     return 0;
-}
-
-int envInt(const char* name, int fallback)
-{
-    const char* v = std::getenv(name);
-    return v && *v ? std::atoi(v) : fallback;
 }
 
 } // namespace
@@ -892,34 +1100,9 @@ int runSession(const char* command, const char* notWritten,
     // The start (MPI_Init and the build check) waits for every rank: one that hangs there, or never
     // starts, ends the job after the start bound (this process exits; mpirun then stops the others).
     const double startBound = 2.0 * timeoutSeconds + 5.0;
-    std::mutex startMutex;
-    std::condition_variable startCv;
-    bool started = false;
-    std::thread watchdog([&] {
-        std::unique_lock<std::mutex> lock(startMutex);
-        if (startCv.wait_for(lock, std::chrono::duration<double>(startBound), [&] { return started; })) return;
-        std::fprintf(stderr, "sylva %s: error: --mpi: the ranks did not all start within %.0f s (a rank hung or could not start); %s\n",
-                     command, startBound, notWritten);
-        std::fflush(stderr);
-        std::_Exit(1);
-    });
-    struct StartDone {
-        std::mutex& m;
-        std::condition_variable& cv;
-        bool& started;
-        std::thread& t;
-        void operator()()
-        {
-            if (!t.joinable()) return;
-            {
-                std::lock_guard<std::mutex> lock(m);
-                started = true;
-            }
-            cv.notify_all();
-            t.join();
-        }
-        ~StartDone() { (*this)(); }
-    } startDone{startMutex, startCv, started, watchdog};
+    char startMessage[160];
+    std::snprintf(startMessage, sizeof startMessage, "--mpi: the ranks did not all start within %.0f s (a rank hung or could not start)", startBound);
+    Deadline start(startBound, jobError(startMessage));
     int provided = 0;
     if (MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided) != MPI_SUCCESS) throw Error("--mpi: MPI_Init failed");
     MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
@@ -945,7 +1128,7 @@ int runSession(const char* command, const char* notWritten,
         MPI_Finalize();
         return 1;
     }
-    startDone();
+    start.disarm();
     const int code = body(rank, size, hosts);
     MPI_Finalize();
     return code;
@@ -962,7 +1145,9 @@ int runRender(const RenderJob& job)
     return runSession("render", "no picture was written", [&](int rank, int size, const std::vector<std::string>& hosts) {
         // The ranks on rank 0's host (they share its cores).
         const int leadNode = int(std::count(hosts.begin(), hosts.end(), hosts.front()));
-        return rank == 0 ? lead(job, size, leadNode, hosts) : work(job, rank, size);
+        Hosts topology;
+        if (job.broadcastScene && size > 1) topology.split(rank, 2.0 * job.timeoutSeconds + 5.0);
+        return rank == 0 ? lead(job, size, leadNode, hosts, topology) : work(job, rank, size, topology);
     }, job.timeoutSeconds);
 }
 

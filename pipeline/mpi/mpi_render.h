@@ -2,9 +2,11 @@
 // MPI (SYLVA_ENABLE_MPI); nothing outside pipeline/mpi includes an MPI header.
 //
 // Rank 0 runs the render exactly as the single-process path does, except that its tracing goes
-// through a FilmRowsTracer: when it starts, rank 0 broadcasts the built frame's arrays (the other
-// ranks wait for them; or, with broadcastScene false, each rank builds its own frame from the species
-// assets in the shared grid cache), then cuts the rows into tiles (mpi_tiles.h: 32 x 32, smaller when a
+// through a FilmRowsTracer: when it starts, rank 0 hands the built frame's arrays to the other ranks
+// (the ranks of a host share one copy in an MPI shared-memory window, which rank 0 fills on its host and
+// the first rank of every other host receives by broadcast; the others wait for it. Or, with
+// broadcastScene false, each rank builds its own frame from the species assets in the shared grid
+// cache), then cuts the rows into tiles (mpi_tiles.h: 32 x 32, smaller when a
 // frame has few per rank, quarters at the end of the queue) and hands them from a work queue to the
 // ranks that ask, two ahead; rank 0 traces tiles too between its messages. A tile is renderFilmRect, shadePixel per pixel, so the picture is bit-identical to a
 // single-process CPU render at any rank count. Rank 0 gathers, composes and writes with the
@@ -38,15 +40,17 @@ struct RenderJob {
     std::function<int(int rank, int ranks, Progress* progress)> lightShare;
     // Ranks other than 0: the frame's scene (prepareRenderScene), the same call as rank 0's.
     std::function<RenderScene(Progress* progress)> prepare;
-    // Rank 0: the whole render and its output, with the tracing through `tracer`. Returns the exit
+    // Rank 0: the whole render and its output, with the tracing through `tracer`; `hosts`: the hosts the
+    // ranks run on, each holding one copy of the frame (0 when every rank builds its own). Returns the exit
     // code; an exception is reported as "sylva render: error: ..." and ends the job with 1.
-    std::function<int(const FilmRowsTracer& tracer, int ranks)> lead;
+    std::function<int(const FilmRowsTracer& tracer, int ranks, int hosts)> lead;
     // Seconds a rank may stay silent before the job ends.
     double timeoutSeconds = 10.0;
     // Tile edge in pixels (halved down to 8 while the frame has fewer than 4 tiles per rank).
     int tile = 32;
-    // How the other ranks get the frame's scene: rank 0 builds it once and broadcasts its arrays when
-    // it starts tracing (true; `prepare` is not called), or every rank builds its own through `prepare`.
+    // How the other ranks get the frame's scene: rank 0 builds it once and hands its arrays out when it
+    // starts tracing, one copy per host (true; `prepare` is not called), or every rank builds its own
+    // through `prepare`.
     bool broadcastScene = true;
     // Threads per rank (--threads; 0: no limit). With broadcastScene, rank 0 builds the scene with the
     // threads of every rank on its node, which wait for the scene meanwhile, then traces with these.

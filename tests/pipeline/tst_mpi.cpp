@@ -94,9 +94,10 @@ class TestMpi : public QObject {
     QTemporaryDir m_dir;
     QString m_cache, m_scene;
 
-    Run mpirun(int ranks, const QStringList& renderArgs, const QStringList& launch = {})
+    // options: more of mpirun's (e.g. -x NAME=VALUE for the ranks' environment).
+    Run mpirun(int ranks, const QStringList& renderArgs, const QStringList& launch = {}, const QStringList& options = {})
     {
-        QStringList a = mpirunArgs(ranks);
+        QStringList a = mpirunArgs(ranks) << options;
         if (launch.isEmpty()) a << SYLVA_CLI_PATH << "render" << "--mpi" << renderArgs;
         else a = launch;
         return test::runProgram(SYLVA_MPIEXEC, a, mpiEnv(m_cache), 120000);
@@ -133,8 +134,10 @@ private Q_SLOTS:
         for (const char* m : {"full", "local", "ambient", "lb"}) QTest::newRow(m) << QString(m);
     }
     // Every mode at 1, 2 and 3 ranks: the PNG file is byte for byte the single process's (96 x 40, 2 spp:
-    // 8-pixel tiles at 3 ranks, so every rank traces several); the scene broadcast by rank 0 (the
-    // default) and, at 2 ranks, built by every rank (--mpi-scene each).
+    // 8-pixel tiles at 3 ranks, so every rank traces several); the scene handed out by rank 0 (the
+    // default: one copy per host, which this machine is) and, at 2 ranks, built by every rank (--mpi-scene
+    // each). Then the several-host paths on this one machine (SYLVA_MPI_NODE_SIZE): 3 ranks as hosts of 2 and 1
+    // (rank 0 fills its host's shared copy, rank 2 receives the broadcast into its own) and 2 ranks as two hosts.
     void picturesEqualSingleProcess()
     {
         QFETCH(QString, mode);
@@ -149,7 +152,19 @@ private Q_SLOTS:
             r = mpirun(ranks, QStringList(common) << "-o" << out);
             QVERIFY2(r.code == 0, qPrintable(r.err));
             QVERIFY2(r.out.contains(QString("%1 MPI rank").arg(ranks)), qPrintable(r.out));
+            if (ranks > 1) QVERIFY2(r.out.contains(QString("%1 MPI ranks on 1 host ").arg(ranks)), qPrintable(r.out));
             QVERIFY2(fileBytes(out) == want, qPrintable(QString("%1 ranks, mode %2: the picture differs").arg(ranks).arg(mode)));
+        }
+        const struct {
+            int ranks, perHost;
+            const char* says;
+        } hosts[] = {{3, 2, "3 MPI ranks on 2 hosts"}, {2, 1, "2 MPI ranks on 2 hosts"}};
+        for (const auto& h : hosts) {
+            const QString out = m_dir.filePath(QString("mpi%1_hosts_%2.png").arg(h.ranks).arg(mode));
+            r = mpirun(h.ranks, QStringList(common) << "-o" << out, {}, {"-x", QString("SYLVA_MPI_NODE_SIZE=%1").arg(h.perHost)});
+            QVERIFY2(r.code == 0, qPrintable(r.err));
+            QVERIFY2(r.out.contains(h.says), qPrintable(r.out));
+            QVERIFY2(fileBytes(out) == want, qPrintable(QString("%1, mode %2: the picture differs").arg(h.says).arg(mode)));
         }
         const QString each = m_dir.filePath(QString("mpi_each_%1.png").arg(mode));
         r = mpirun(2, QStringList(common) << "--mpi-scene" << "each" << "--threads" << "1" << "-o" << each);
