@@ -293,7 +293,7 @@ public:
     void sync() const { check(MPI_Win_sync(m_win), "Win_sync"); }
 
     // Collective over the host's ranks (each calls it when its tracing is done).
-    void release(double timeout = 30.0)
+    void release(double timeout)
     {
         if (m_win == MPI_WIN_NULL) return;
         const Deadline deadline(timeout, jobError("--mpi: the ranks of a host did not all finish with the frame within the timeout (a rank hung or died)"));
