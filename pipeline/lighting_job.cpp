@@ -189,10 +189,12 @@ DensityGrid densityForTriangles(const TriangleMesh& mesh, const VoxelizeSettings
     const CacheKey key = meshKey(mesh, voxel);
     if (cache) {
         std::string why;
-        if (auto hit = cache->loadDensity(key, &why)) {
+        std::optional<DensityGrid> hit = cache->loadDensity(key, &why);
+        if (!hit && cache->beforeCompute()) hit = cache->loadDensity(key, &why);   // a hook may have filled it
+        if (hit) {
             if (log) log->stages.push_back("voxelize (cache hit)");
             if (progress) progress->report(1.0, "density grid from the cache");
-            return *hit;
+            return std::move(*hit);
         }
         if (log && why.find("no cache entry") == std::string::npos) log->warnings.push_back(why);
     }
@@ -214,21 +216,26 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
     lb::validate(params);
     const std::string densityHex = cache ? densityHash(density) : std::string();   // hashing the grid costs time
     const CacheKey key = cache ? lightKey(densityHex, density, params) : CacheKey{};
-    if (cache) {
+    // The entry, or a cached relighting basis of the same grid and optics (the weighted sum, no solve).
+    auto fromCache = [&]() -> std::optional<LightingGrid> {
         std::string why;
         if (auto hit = cache->loadLighting(key, &why)) {
             if (log) log->stages.push_back("light (cache hit)");
             if (progress) progress->report(1.0, "lighting grid from the cache");
-            return *hit;
+            return hit;
         }
         if (log && why.find("no cache entry") == std::string::npos) log->warnings.push_back(why);
-        // A cached relighting basis of the same grid and optics: the weighted sum, no solve.
         if (auto basis = loadBasis(densityHex, density, params, *cache, log)) {
-            LightingGrid grid = relight(*basis, params);
             if (log) log->stages.push_back("light (relit from the cached basis)");
             if (progress) progress->report(1.0, "lighting grid relit from the cached basis");
-            return grid;
+            return relight(*basis, params);
         }
+        return std::nullopt;
+    };
+    if (cache) {
+        std::optional<LightingGrid> hit = fromCache();
+        if (!hit && cache->beforeCompute()) hit = fromCache();   // a hook may have filled it
+        if (hit) return std::move(*hit);
     }
     LightingGrid grid = backend ? backend->solveLighting(density, params, progress, nullptr)
                                 : lb::solveLighting(density, params, progress);

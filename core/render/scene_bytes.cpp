@@ -26,6 +26,14 @@ RenderSceneHeader renderSceneHeader(const RenderScene& rs)
     return h;
 }
 
+RenderSceneHeader hostTracedHeader(const RenderScene& rs)
+{
+    RenderSceneHeader h = renderSceneHeader(rs);
+    if (!rs.blasWideNodes.empty()) h.counts[kArray_blasNodes] = 0;   // traceMesh walks the 8-wide copy
+    if (rs.kdNodes.empty()) h.counts[kArray_tris] = 0;                // only the kd-tree path reads tris
+    return h;
+}
+
 RenderScene allocateRenderScene(const RenderSceneHeader& h)
 {
     RenderScene rs;
@@ -49,7 +57,7 @@ PackedFrame packedFrameLayout(const RenderSceneHeader& h)
     return L;
 }
 
-void packRenderScene(const RenderScene& rs, const PackedFrame& layout, void* block)
+void packRenderScene(const RenderScene& rs, const RenderSceneHeader& h, const PackedFrame& layout, void* block)
 {
     // Pieces of at most 4 MB, so that the threads share the large arrays (the copy is mostly the first touch
     // of the block's pages).
@@ -61,7 +69,7 @@ void packRenderScene(const RenderScene& rs, const PackedFrame& layout, void* blo
     constexpr size_t kPiece = size_t(4) << 20;
     std::vector<Piece> pieces;
     size_t i = 0;
-    forEachRenderSceneArray(rs, [&](const void* data, size_t bytes) {
+    forEachHeaderArray(rs, h, [&](const void* data, size_t bytes) {
         char* to = static_cast<char*>(block) + layout.offset[i++];
         for (size_t at = 0; at < bytes; at += kPiece)
             pieces.push_back({static_cast<const char*>(data) + at, to + at, std::min(kPiece, bytes - at)});

@@ -524,6 +524,15 @@ bool tryRemoveEntry(const GridCache::Entry& e)
 
 } // namespace
 
+bool GridCache::beforeCompute()
+{
+    if (!m_beforeCompute) return false;
+    const std::function<void()> hook = std::move(m_beforeCompute);
+    m_beforeCompute = nullptr;
+    hook();
+    return true;
+}
+
 void GridCache::beforeStore(const std::string& path, uint64_t payloadBytes) const
 {
     const uint64_t bytes = kHeaderSize + payloadBytes;

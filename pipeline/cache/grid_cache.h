@@ -126,6 +126,14 @@ public:
     // Evicts least recently used entries until the entries fit `limit` bytes; returns what it did.
     CleanResult evictTo(uint64_t limit);
 
+    // Called once, before the first voxelization or LB solve that a miss in this cache would start
+    // (densityForTriangles, lightingFor), which then looks in the cache again: `sylva render --mpi`'s rank 0
+    // shares the species' solves out to the ranks there, so a warm cache is read once and waits for no one.
+    void setBeforeCompute(std::function<void()> hook) { m_beforeCompute = std::move(hook); }
+    // Runs that hook and clears it first (a solve inside it computes as usual); true when it ran, and the
+    // caller should look in the cache again. For callers that miss one at a time (a render's preparation).
+    bool beforeCompute();
+
     // For tests: called while a load holds an entry's shared lock, before it reads the payload.
     void setReadHookForTests(std::function<void(const std::string& path)> hook) { m_readHook = std::move(hook); }
     // For tests: called when a load has opened an entry, before it takes the shared lock.
@@ -138,6 +146,7 @@ private:
     uint64_t m_maxBytes = 0;
     std::function<void(const std::string&)> m_readHook;
     std::function<void(const std::string&)> m_openHook;
+    std::function<void()> m_beforeCompute;
 };
 
 // The cache size limit from the user's settings (QSettings "Sylva"/"sylva": $XDG_CONFIG_HOME/Sylva/

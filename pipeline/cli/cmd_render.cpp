@@ -183,7 +183,8 @@ int runRender(const Args& args)
     auto compute = openBackend(backend);
     auto cache = openCache(args);
     // The render and its picture, its tracing by `tracer` when given (--mpi: the ranks'), on `ranks` processes.
-    auto renderAndWrite = [&](const FilmRowsTracer& tracer, int ranks, int hosts) {
+    auto renderAndWrite = [&](const FilmRowsTracer& tracer, int ranks, int hosts, const std::function<void()>& beforeCompute) {
+        if (cache && beforeCompute) cache->setBeforeCompute(beforeCompute);
         JobLog log;
         AccelStats st;
         RenderTimings timings;
@@ -227,7 +228,7 @@ int runRender(const Args& args)
         if (args.has("--stats")) printStats(st, timings, r, ambient);
         return kOk;
     };
-    if (!useMpi) return renderAndWrite({}, 1, 0);
+    if (!useMpi) return renderAndWrite({}, 1, 0, {});
 #if SYLVA_HAVE_MPI
     mpi::RenderJob job;
     job.prepare = [&](Progress* progress) {

@@ -43,8 +43,9 @@ using Clock = std::chrono::steady_clock;
 
 // Message tags. Workers send kHeartbeat, kRequest (the tile they finished, if any, and a request for
 // the next), kFailed (an error text), kLit (its species' lighting is done) and kReady (it holds the
-// memory for the scene's arrays); rank 0 sends kTile, kDone and kHeartbeat (to waiting ranks).
-enum Tag : int { kFailed = 11, kHeartbeat = 12, kRequest = 13, kTile = 14, kDone = 15, kLit = 16, kReady = 17 };
+// memory for the scene's arrays); rank 0 sends kTile, kDone, kHeartbeat (to waiting ranks) and kShare (light
+// your share of the species: rank 0's render missed in the cache).
+enum Tag : int { kFailed = 11, kHeartbeat = 12, kRequest = 13, kTile = 14, kDone = 15, kLit = 16, kReady = 17, kShare = 18 };
 
 constexpr double kHeartbeatSeconds = 0.5;
 
@@ -324,9 +325,9 @@ private:
 
 // Rank 0's arrays to the first rank of every other host, array by array as forEachPackedArray receives them
 // (MPI_Ibcast takes a non-const buffer; rank 0's is only read).
-void broadcastArrays(const RenderScene& rs, double timeout, MPI_Comm leaders)
+void broadcastArrays(const RenderScene& rs, const SceneHeader& h, double timeout, MPI_Comm leaders)
 {
-    forEachRenderSceneArray(const_cast<RenderScene&>(rs), [&](void* data, size_t bytes) { broadcastBytes(data, bytes, timeout, leaders); });
+    forEachHeaderArray(rs, h, [&](const void* data, size_t bytes) { broadcastBytes(const_cast<void*>(data), bytes, timeout, leaders); });
 }
 
 std::unique_ptr<tbb::global_control> threadLimit(int threads)
@@ -436,18 +437,29 @@ public:
             }
             if (done == total) break;
         }
+        if (y1 == v.height) {   // the frame's last rows (FilmRowsTracer): no tile is left for anyone
+            std::lock_guard<std::mutex> lock(m_mutex);
+            m_traced = true;
+        }
         return film;
     }
 
     // Main thread: the host's shared window for the frame (layout: the packed block's), for the render thread to fill.
-    void setBlock(void* block, const PackedFrame& layout)
+    void setBlock(void* block, const SceneHeader& header, const PackedFrame& layout)
     {
         {
             std::lock_guard<std::mutex> lock(m_mutex);
             m_block = block;
+            m_header = header;
             m_layout = layout;
         }
         m_changed.notify_all();
+    }
+    // Main thread: the frame's last tile is in (its picture is being written).
+    bool traced()
+    {
+        std::lock_guard<std::mutex> lock(m_mutex);
+        return m_traced;
     }
     bool packed()
     {
@@ -524,9 +536,10 @@ private:
             m_changed.wait_for(lock, std::chrono::milliseconds(20));
         }
         void* const block = m_block;
+        const SceneHeader header = m_header;
         const PackedFrame layout = m_layout;
         lock.unlock();
-        packRenderScene(rs, layout, block);
+        packRenderScene(rs, header, layout, block);
         lock.lock();
         m_packed = true;
         m_pack = false;
@@ -536,8 +549,9 @@ private:
     bool m_sceneSent;
     bool m_pack;
     void* m_block = nullptr;
+    SceneHeader m_header{};
     PackedFrame m_layout{};
-    bool m_packed = false;
+    bool m_packed = false, m_traced = false;
     const RenderScene* m_scene = nullptr;
     std::function<void()> m_beforeTrace;
     std::mutex m_mutex;
@@ -552,49 +566,70 @@ private:
 int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::string>& hosts, const Hosts& topology)
 {
     const int hostCount = topology.leaderCount;
-    // Threads: job.threads for the species' lighting and the tracing, the threads of every rank on this
-    // node for the build while they wait for the broadcast scene (the render thread's limit).
+    // Threads (the render thread's limit): the threads of every rank on this node for the preparation while
+    // they wait for the broadcast scene, then job.threads for the tracing.
     std::unique_ptr<tbb::global_control> limit;
     const bool wideBuild = job.broadcastScene && size > 1 && job.threads > 0 && localRanks > 1;
+    // The species' lighting shared out (when asked): every rank solves its share into the cache, only when
+    // rank 0's render misses in the cache (before its first solve), so a warm cache is read once, by rank 0.
+    // Rank 0 then asks the others (kShare; they wait for the scene meanwhile, or with every rank building its
+    // own they light their share first anyway), runs its own and waits for theirs. The count of solves is
+    // said before the tracing.
+    const bool askToShare = job.broadcastScene;
+    std::mutex litMutex;
+    int lit = 0;
+    bool shareAsked = false, shareSent = false;
+    std::vector<int> solves(static_cast<size_t>(size), 0);
+    auto awaitLit = [&] {
+        for (;;) {
+            {
+                std::lock_guard<std::mutex> lock(litMutex);
+                if (lit == size - 1) return;
+            }
+            if (Progress::cancelAllRequested()) throw Cancelled();
+            std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        }
+    };
+    std::function<void()> shareLighting;
+    if (job.lightShare)
+        shareLighting = [&] {
+            {
+                std::lock_guard<std::mutex> lock(litMutex);
+                shareAsked = true;   // the main thread sends kShare
+            }
+            const int mine = job.lightShare(0, size, nullptr);
+            awaitLit();
+            std::lock_guard<std::mutex> lock(litMutex);
+            solves[0] = mine;
+        };
+    auto sayLit = [&] {
+        if (!job.lightShare) return;
+        bool asked = true;
+        {
+            std::lock_guard<std::mutex> lock(litMutex);
+            asked = shareAsked || !askToShare;
+        }
+        if (asked) awaitLit();   // else no rank solved (the cache held every grid)
+        std::lock_guard<std::mutex> lock(litMutex);
+        std::string line;
+        int total = 0;
+        for (int r = 0; r < size; ++r) {
+            total += solves[size_t(r)];
+            line += r ? " + " : "";
+            line += std::to_string(solves[size_t(r)]);
+        }
+        std::printf("species lighting on %d %s: %d LB %s (%s by rank), the rest from the cache\n", size, size == 1 ? "rank" : "ranks",
+                    total, total == 1 ? "solve" : "solves", line.c_str());
+        std::fflush(stdout);
+    };
     TileQueue queue(size, job.tile, job.broadcastScene, topology.nodeSize > 1, [&] {
+        sayLit();
         if (wideBuild) limit = threadLimit(job.threads);
     });
     const FilmRowsTracer tracer = [&queue](const RenderScene& rs, int y0, int y1, Progress* p) { return queue.trace(rs, y0, y1, p); };
-    // The species' lighting shared out (when asked): rank 0's share, then a wait for every rank's.
-    std::mutex litMutex;
-    int lit = 0;
-    std::vector<int> solves(static_cast<size_t>(size), 0);
     std::future<int> render = std::async(std::launch::async, [&] {
-        limit = threadLimit(job.threads);
-        if (job.lightShare) {
-            const int mine = job.lightShare(0, size, nullptr);
-            for (;;) {
-                {
-                    std::lock_guard<std::mutex> lock(litMutex);
-                    if (lit == size - 1) {
-                        solves[0] = mine;
-                        std::string line;
-                        int total = 0;
-                        for (int r = 0; r < size; ++r) {
-                            total += solves[size_t(r)];
-                            line += r ? " + " : "";
-                            line += std::to_string(solves[size_t(r)]);
-                        }
-                        std::printf("species lighting on %d %s: %d LB %s (%s by rank), the rest from the cache\n", size,
-                                    size == 1 ? "rank" : "ranks", total, total == 1 ? "solve" : "solves", line.c_str());
-                        std::fflush(stdout);
-                        break;
-                    }
-                }
-                if (Progress::cancelAllRequested()) throw Cancelled();
-                std::this_thread::sleep_for(std::chrono::milliseconds(5));
-            }
-        }
-        if (wideBuild) {
-            limit.reset();
-            limit = threadLimit(job.threads * localRanks);
-        }
-        return job.lead(tracer, size, job.broadcastScene && size > 1 ? hostCount : 0);
+        limit = threadLimit(wideBuild ? job.threads * localRanks : job.threads);
+        return job.lead(tracer, size, job.broadcastScene && size > 1 ? hostCount : 0, shareLighting);
     });
 
     struct Peer {
@@ -642,7 +677,7 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
     PackedFrame layout{};
     SharedFrame frame;
     MPI_Request headerReq = MPI_REQUEST_NULL, hostReq = MPI_REQUEST_NULL;
-    bool headerPosted = false, windowMade = false, hostReleased = false;
+    bool headerPosted = false, windowMade = false, hostReleased = false, frameReleased = false;
     int ready = 0;
     for (;;) {
         bool busy = false;
@@ -690,10 +725,19 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
         } catch (const Error& e) {
             abortJob(e.what());
         }
+        if (askToShare) {
+            bool send = false;
+            {
+                std::lock_guard<std::mutex> lock(litMutex);
+                send = shareAsked && !shareSent;
+                shareSent = shareSent || send;
+            }
+            for (int r = 1; send && r < size; ++r) check(MPI_Send(nullptr, 0, MPI_BYTE, r, kShare, MPI_COMM_WORLD), "Send");
+        }
         if (const RenderScene* rs = queue.sceneToSend()) {
             try {
                 if (!headerPosted) {
-                    header = renderSceneHeader(*rs);
+                    header = hostTracedHeader(*rs);
                     layout = packedFrameLayout(header);
                     check(MPI_Ibcast(&header, int(sizeof header), MPI_BYTE, 0, MPI_COMM_WORLD, &headerReq), "Ibcast");
                     headerPosted = true;
@@ -703,7 +747,7 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
                 const bool host = topology.nodeSize > 1;
                 if (flag && host && !windowMade) {
                     frame.allocate(topology, layout.bytes, job.timeoutSeconds);
-                    queue.setBlock(frame.block(), layout);
+                    queue.setBlock(frame.block(), header, layout);
                     windowMade = busy = true;
                 }
                 if (flag && host && !hostReleased && queue.packed()) {
@@ -712,7 +756,7 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
                     hostReleased = busy = true;
                 }
                 if (flag && (!host || hostReleased) && ready == topology.leaderCount - 1) {
-                    if (topology.leaderCount > 1) broadcastArrays(*rs, job.timeoutSeconds, topology.leaders);
+                    if (topology.leaderCount > 1) broadcastArrays(*rs, header, job.timeoutSeconds, topology.leaders);
                     if (hostReq != MPI_REQUEST_NULL) finish(hostReq, job.timeoutSeconds, "the start of this host's ranks on the frame");
                     queue.markSceneSent();
                     busy = true;
@@ -732,6 +776,9 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
                 abortJob(e.what());
             }
         }
+        // Once the frame's tiles are all in, the workers are let go and the host's window freed (the ranks
+        // free it together) while the render thread still composes and writes the picture.
+        const bool traced = rendered || queue.traced();
         for (int r = 1; r < size; ++r) {
             Peer& p = peers[size_t(r)];
             TileMsg t{};
@@ -741,7 +788,7 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
                 busy = true;
             }
             if (p.done) continue;
-            if (p.wanted > 0 && rendered) {
+            if (p.wanted > 0 && traced) {
                 check(MPI_Send(nullptr, 0, MPI_BYTE, r, kDone, MPI_COMM_WORLD), "Send");
                 p.wanted = 0;
                 p.done = true;
@@ -765,6 +812,10 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
                               hosts[size_t(r)].c_str(), job.timeoutSeconds);
                 abortJob(msg);
             }
+        }
+        if (traced && allDone && !frameReleased) {
+            frame.release(job.timeoutSeconds);
+            frameReleased = true;
         }
         if (rendered && allDone) break;
         if (Progress::cancelAllRequested()) {
@@ -825,13 +876,14 @@ public:
     // The frame's scene as rank 0 sends it: waits for its header (rank 0 pings meanwhile; this rank's
     // heartbeats go on), makes room for its arrays in this host's shared window, and when this rank is the
     // first of a host other than rank 0's, receives them there from rank 0's broadcast; then waits at the
-    // host's barrier until the host's copy is whole. Returns the view of that copy.
-    RenderView receiveScene(const Hosts& hosts, SharedFrame& frame)
+    // host's barrier until the host's copy is whole. Returns the view of that copy. onShare: run when rank 0
+    // asks for this rank's share of the species' lighting (kShare) while it prepares the scene.
+    RenderView receiveScene(const Hosts& hosts, SharedFrame& frame, const std::function<void()>& onShare)
     {
         SceneHeader h{};
         MPI_Request req;
         check(MPI_Ibcast(&h, int(sizeof h), MPI_BYTE, 0, MPI_COMM_WORLD, &req), "Ibcast");
-        await(req);
+        await(req, onShare);
         const PackedFrame layout = packedFrameLayout(h);
         try {
             frame.allocate(hosts, layout.bytes, m_timeout);
@@ -851,14 +903,24 @@ public:
         return packedFrameView(h, layout, frame.block());
     }
 
-    // Waits for req with heartbeats both ways (rank 0 pings a rank that waits on it).
-    void await(MPI_Request& req)
+    // Waits for req with heartbeats both ways (rank 0 pings a rank that waits on it); onShare (when given)
+    // runs when rank 0 sends kShare.
+    void await(MPI_Request& req, const std::function<void()>& onShare = {})
     {
         m_heard = Clock::now();
         for (;;) {
             int flag = 0;
             check(MPI_Test(&req, &flag, MPI_STATUS_IGNORE), "Test");
             if (flag) return;
+            if (onShare) {
+                check(MPI_Iprobe(0, kShare, MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE), "Iprobe");
+                if (flag) {
+                    check(MPI_Recv(nullptr, 0, MPI_BYTE, 0, kShare, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "Recv");
+                    onShare();
+                    m_heard = Clock::now();
+                    continue;
+                }
+            }
             for (;;) {
                 MPI_Status st;
                 check(MPI_Iprobe(0, kHeartbeat, MPI_COMM_WORLD, &flag, &st), "Iprobe");
@@ -1054,13 +1116,17 @@ int work(const RenderJob& job, int rank, int size, const Hosts& hosts)
     Worker w(rank, job.timeoutSeconds);
     try {
         Progress quiet([](double, const std::string&) {});
-        if (job.lightShare) {
+        // The species' lighting share: when rank 0 asks (its render missed in the cache) while it prepares the
+        // scene to broadcast, or first when this rank builds its own scene from the cache.
+        auto share = [&] {
             const int32_t solved = w.busy([&] { return job.lightShare(rank, size, &quiet); });
             w.send(&solved, sizeof solved, kLit);
-        }
+        };
+        if (job.lightShare && !job.broadcastScene) share();
         SharedFrame frame;
         RenderScene own;
-        const RenderView view = job.broadcastScene ? w.receiveScene(hosts, frame) : (own = w.busy([&] { return job.prepare(&quiet); })).view();
+        const RenderView view = job.broadcastScene ? w.receiveScene(hosts, frame, job.lightShare ? std::function<void()>(share) : nullptr)
+                                                   : (own = w.busy([&] { return job.prepare(&quiet); })).view();
         w.traceTiles(view);
         frame.release(job.timeoutSeconds);
     } catch (const Cancelled&) {

@@ -34,16 +34,19 @@ bool launchedByMpi();
 int launchRank();
 
 struct RenderJob {
-    // Every rank first (when set): the LB solves of the species the rank shares out (species s on rank
-    // s mod N) into the shared grid cache, so that loading them afterwards is a cache hit everywhere.
-    // Returns the number of LB solves it ran (0 for species the cache held).
+    // The LB solves of the species the rank shares out (species s on rank s mod N) into the shared grid
+    // cache, so that loading them afterwards is a cache hit everywhere; returns the number of LB solves it
+    // ran (0 for species the cache held). When set, it runs only when rank 0's render misses in the cache
+    // (through `lead`'s beforeCompute): rank 0 asks the others, runs its own and waits for theirs. (With
+    // broadcastScene false the other ranks run it first, before their own preparation.)
     std::function<int(int rank, int ranks, Progress* progress)> lightShare;
     // Ranks other than 0: the frame's scene (prepareRenderScene), the same call as rank 0's.
     std::function<RenderScene(Progress* progress)> prepare;
     // Rank 0: the whole render and its output, with the tracing through `tracer`; `hosts`: the hosts the
-    // ranks run on, each holding one copy of the frame (0 when every rank builds its own). Returns the exit
-    // code; an exception is reported as "sylva render: error: ..." and ends the job with 1.
-    std::function<int(const FilmRowsTracer& tracer, int ranks, int hosts)> lead;
+    // ranks run on, each holding one copy of the frame (0 when every rank builds its own); beforeCompute
+    // (set with lightShare): for GridCache::setBeforeCompute, the species' lighting shared out. Returns the
+    // exit code; an exception is reported as "sylva render: error: ..." and ends the job with 1.
+    std::function<int(const FilmRowsTracer& tracer, int ranks, int hosts, const std::function<void()>& beforeCompute)> lead;
     // Seconds a rank may stay silent before the job ends.
     double timeoutSeconds = 10.0;
     // Tile edge in pixels (halved down to 8 while the frame has fewer than 4 tiles per rank).

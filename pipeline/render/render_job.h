@@ -87,7 +87,8 @@ struct RenderOutput {
 // tracer: traces the frame's rows in place of the backend (sylva render --mpi hands them to the ranks as tiles).
 inline constexpr size_t kFrameBytesPerPixel = sizeof(SampleParts) + sizeof(glm::vec3);
 // Rows y0 (inclusive) to y1 (exclusive) of scene.view() as a film: renderFilmRows's contract (the whole
-// scene, not only its view: render --mpi sends the built scene to the other ranks).
+// scene, not only its view: render --mpi sends the built scene to the other ranks). A frame's rows are
+// traced once, top to bottom: the call whose rows end at the frame's last row is the frame's last.
 using FilmRowsTracer = std::function<Film(const RenderScene& scene, int y0, int y1, Progress* progress)>;
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr,
                          Backend* backend = nullptr, const FilmRowsTracer& tracer = {});

@@ -111,6 +111,49 @@ private Q_SLOTS:
         QVERIFY(third.rgb == good.rgb);
     }
 
+    // GridCache::setBeforeCompute (sylva render --mpi's rank 0): the hook runs once, only when a miss would
+    // compute, and what it stored is then loaded, not computed again. Here it solves through a second cache
+    // object on the same folder, as another rank would; its grids are the ones a plain solve gives.
+    void beforeComputeRunsOnceOnAMiss()
+    {
+        const std::string dir = (m_dir + "/cache-hook").toStdString();
+        DensityJob job{m_mesh, {}, {}};
+        job.voxel.longestAxisNodes = 18;
+        lb::LbParams p = lb::paramsFromPreset(*lb::findPreset("leaf"));
+        p.sun = {0.3f, 1.0f, -0.2f};
+        GridCache cache(dir), other(dir);
+        int runs = 0;
+        std::vector<std::string> otherStages;
+        cache.setBeforeCompute([&] {
+            ++runs;
+            JobLog o;
+            lightingFor(densityForMesh(job, &other, nullptr, &o), p, &other, nullptr, &o);
+            otherStages = o.stages;
+        });
+        JobLog log;
+        const DensityGrid d = densityForMesh(job, &cache, nullptr, &log);
+        const LightingGrid l = lightingFor(d, p, &cache, nullptr, &log);
+        QCOMPARE(runs, 1);
+        QCOMPARE(otherStages, (std::vector<std::string>{"import", "voxelize", "light"}));
+        QCOMPARE(log.stages, (std::vector<std::string>{"import", "voxelize (cache hit)", "light (cache hit)"}));
+        const DensityGrid dRef = densityForMesh(job, nullptr, nullptr, nullptr);
+        QVERIFY(d.density == dRef.density);
+        QVERIFY(l.rgb == lightingFor(dRef, p, nullptr, nullptr, nullptr).rgb);
+        // Cleared once it ran: the next miss (another sun) solves here.
+        p.sun = {-0.5f, 1.0f, 0.0f};
+        JobLog next;
+        lightingFor(d, p, &cache, nullptr, &next);
+        QCOMPARE(runs, 1);
+        QCOMPARE(next.stages, (std::vector<std::string>{"light"}));
+        // A warm cache never runs it.
+        GridCache warm(dir);
+        warm.setBeforeCompute([&] { ++runs; });
+        JobLog hit;
+        lightingFor(densityForMesh(job, &warm, nullptr, &hit), p, &warm, nullptr, &hit);
+        QCOMPARE(runs, 1);
+        QCOMPARE(hit.stages, (std::vector<std::string>{"import", "voxelize (cache hit)", "light (cache hit)"}));
+    }
+
     // The sidecar parameters (`sylva light`, the studio's grid export) are valid JSON holding the
     // parameters as given, steps or tolerance, and a preset name that cannot break the object.
     void paramsJson()

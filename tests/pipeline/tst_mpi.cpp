@@ -222,16 +222,25 @@ private Q_SLOTS:
 
     // Species lighting across the ranks: with an empty cache, 2 ranks share the 5 species' LB solves
     // (rank 0 species 0, 2 and 4, rank 1 species 1 and 3), each solved once, and the picture equals a
-    // single process's from that cache; a second run solves none.
+    // single process's from that cache; a second run solves none. Both ways of getting the scene: rank 0
+    // asks the others for their share when its render misses (broadcast), or every rank lights its share
+    // before building its own scene (each).
+    void speciesLitAcrossRanks_data()
+    {
+        QTest::addColumn<QString>("scene");
+        QTest::newRow("broadcast") << "broadcast";
+        QTest::newRow("each") << "each";
+    }
     void speciesLitAcrossRanks()
     {
+        QFETCH(QString, scene);
         QTemporaryDir fresh;
-        const QString out = m_dir.filePath("shared_lit.png"), ref = m_dir.filePath("shared_lit_single.png");
+        const QString out = m_dir.filePath("shared_lit_" + scene + ".png"), ref = m_dir.filePath("shared_lit_single_" + scene + ".png");
         const QStringList common{m_scene, "--cache", fresh.path(), "--width", "48", "--height", "24", "--quiet"};
-        Run r = mpirun(2, QStringList(common) << "-o" << out);
+        Run r = mpirun(2, QStringList(common) << "--mpi-scene" << scene << "-o" << out);
         QVERIFY2(r.code == 0, qPrintable(r.err));
         QVERIFY2(r.out.contains("species lighting on 2 ranks: 5 LB solves (3 + 2 by rank)"), qPrintable(r.out));
-        r = mpirun(2, QStringList(common) << "-o" << out);
+        r = mpirun(2, QStringList(common) << "--mpi-scene" << scene << "-o" << out);
         QVERIFY2(r.code == 0, qPrintable(r.err));
         QVERIFY2(r.out.contains("species lighting on 2 ranks: 0 LB solves (0 + 0 by rank)"), qPrintable(r.out));
         r = single(QStringList(common) << "-o" << ref);

@@ -4,6 +4,9 @@
 #include <QTest>
 
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
 #include <random>
 
 #include <OpenImageIO/imagebuf.h>
@@ -11,6 +14,7 @@
 
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
+#include "core/render/scene_bytes.h"
 #include "core/render/shade.h"
 #include "core/render/tonemap.h"
 #include "pipeline/cache/grid_cache.h"
@@ -303,6 +307,54 @@ private Q_SLOTS:
         Hit h{};
         QVERIFY(!traceScene<true>(v, through, h));
         QVERIFY(traceScene<true>(v, blocked, h));
+    }
+
+    // The frame the other ranks of `sylva render --mpi` trace: hostTracedHeader's arrays packed into one block
+    // leave out what the host's traversal never reads (the 4-wide mesh BVH beside its 8-wide copy; outside
+    // kd-tree runs the triangles in slot order) and trace the same film as the whole scene, bit for bit.
+    void hostTracedFrameTracesAlike_data()
+    {
+        QTest::addColumn<int>("accel");
+        QTest::newRow("bvh") << int(AccelKind::Bvh);
+        QTest::newRow("kdtree") << int(AccelKind::KdTree);
+    }
+    void hostTracedFrameTracesAlike()
+    {
+        QFETCH(int, accel);
+        InstanceDesc a, b, c;
+        a.position = {-2.0, 0.0, 0.0};
+        b.position = {2.5, 0.0, 3.0};
+        b.rotationDeg = {0.0f, 70.0f, 0.0f};
+        c.position = {0.0, 0.0, 6.0};
+        c.scale = 1.4f;
+        Scene s = sceneFor({a, b, c}, true);
+        s.render.accel = AccelKind(accel);
+        s.render.spp = 2;
+        const RenderScene rs = buildRenderScene(s, test::oneShrub(), glm::vec3(1.0f));
+        const RenderSceneHeader full = renderSceneHeader(rs), host = hostTracedHeader(rs);
+        const bool kd = AccelKind(accel) == AccelKind::KdTree;
+        QVERIFY(full.counts[kArray_blasNodes] > 0 && full.counts[kArray_tris] > 0);
+        QCOMPARE(full.counts[kArray_blasWideNodes] > 0, !kd);   // kd-tree runs build no 8-wide copy (and keep the 4-wide BVH)
+        QCOMPARE(host.counts[kArray_blasNodes], kd ? full.counts[kArray_blasNodes] : uint64_t(0));
+        QCOMPARE(host.counts[kArray_tris], kd ? full.counts[kArray_tris] : uint64_t(0));
+        for (size_t i = 0; i < kRenderSceneArrays; ++i)
+            if (i != kArray_blasNodes && i != kArray_tris) QCOMPARE(host.counts[i], full.counts[i]);
+        const PackedFrame layout = packedFrameLayout(host);
+        QVERIFY(kd ? layout.bytes == packedFrameLayout(full).bytes : layout.bytes < packedFrameLayout(full).bytes);
+        std::unique_ptr<void, void (*)(void*)> block(std::aligned_alloc(64, (layout.bytes + 63) / 64 * 64), std::free);
+        QVERIFY(block);
+        packRenderScene(rs, host, layout, block.get());
+        const RenderView packed = packedFrameView(host, layout, block.get());
+        QCOMPARE(!packed.blasNodes, !kd);
+        const RenderView whole = rs.view();
+        const int w = whole.width, h = whole.height;
+        std::vector<SampleParts> mine(size_t(w) * size_t(h)), theirs(mine.size());
+        renderFilmRect(whole, 0, 0, w, h, mine.data());
+        renderFilmRect(packed, 0, 0, w, h, theirs.data());
+        int plant = 0;
+        for (const SampleParts& p : mine) plant += p.depth < kSkyDepth && p.albedo != glm::vec3(0.0f) ? 1 : 0;
+        QVERIFY2(plant > w * h / 20, "the frame should see the shrubs and the ground");
+        QVERIFY(std::memcmp(mine.data(), theirs.data(), mine.size() * sizeof(SampleParts)) == 0);
     }
 
     // The cut-out coordinates packed into the triangle blocks (16 bits above whole units) give the
