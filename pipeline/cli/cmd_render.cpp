@@ -184,7 +184,15 @@ int runRender(const Args& args)
     auto cache = openCache(args);
     // The render and its picture, its tracing by `tracer` when given (--mpi: the ranks'), on `ranks` processes.
     auto renderAndWrite = [&](const FilmRowsTracer& tracer, int ranks, int hosts, const std::function<void()>& beforeCompute) {
-        if (cache && beforeCompute) cache->setBeforeCompute(beforeCompute);
+        // The hook holds the MPI lead's state: it leaves the cache with this render.
+        struct Hook {
+            GridCache* cache;
+            ~Hook()
+            {
+                if (cache) cache->setBeforeCompute({});
+            }
+        } hook{cache && beforeCompute ? cache.get() : nullptr};
+        if (hook.cache) hook.cache->setBeforeCompute(beforeCompute);
         JobLog log;
         AccelStats st;
         RenderTimings timings;

@@ -597,7 +597,12 @@ int lead(const RenderJob& job, int size, int localRanks, const std::vector<std::
                 std::lock_guard<std::mutex> lock(litMutex);
                 shareAsked = true;   // the main thread sends kShare
             }
-            const int mine = job.lightShare(0, size, nullptr);
+            int mine = 0;
+            {
+                // This rank's own threads, as every other rank solves with (the preparation has its node's).
+                const auto own = threadLimit(job.threads);
+                mine = job.lightShare(0, size, nullptr);
+            }
             awaitLit();
             std::lock_guard<std::mutex> lock(litMutex);
             solves[0] = mine;
