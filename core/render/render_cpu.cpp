@@ -9,8 +9,61 @@
 
 #include "core/base/error.h"
 #include "core/render/tonemap.h"
+#include "core/render/trace_packet.h"
 
 namespace sylva {
+
+namespace {
+
+// The loops' tiles: 8 x 8 pixels, one packet of camera rays.
+constexpr int kTile = 8;
+static_assert(kTile * kTile <= kPacketRays);
+
+// The pixels [x0, x1) x [y0, y1) of the frame (at most kPacketRays) into out (row length `stride`): exactly
+// shadePixel's parts for each. A landscape's tile traces each sample's camera rays as one packet, then the
+// sun's shadow rays of the surfaces they found as another (trace_packet.h: the same answers as ray by ray);
+// other scenes, where packets do not pay, shade pixel by pixel.
+void shadeTile(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts* out, size_t stride)
+{
+    const int w = x1 - x0, n = w * (y1 - y0);
+    if (!v.landscapeEnabled) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) out[size_t(y - y0) * stride + size_t(x - x0)] = shadePixel(v, x, y);
+        return;
+    }
+    SampleParts sum[kPacketRays];
+    Ray cam[kPacketRays], shadow[kPacketRays];
+    Hit hit[kPacketRays], shadowHit[kPacketRays];
+    SurfacePoint surface[kPacketRays];
+    bool found[kPacketRays], occluded[kPacketRays];
+    int shadowOf[kPacketRays];
+    const int sBegin = v.sampleBegin, sEnd = sampleEndOf(v);
+    for (int i = 0; i < n; ++i) sum[i] = pixelSumStart();
+    for (int s = sBegin; s < sEnd; ++s) {
+        for (int i = 0; i < n; ++i) cam[i] = sampleRay(v, x0 + i % w, y0 + i / w, s);
+        traceScenePacket<false>(v, cam, n, hit, found);
+        int shadows = 0;
+        for (int i = 0; i < n; ++i) {
+            shadowOf[i] = -1;
+            if (!found[i]) continue;
+            surface[i] = surfaceStage(v, cam[i], hit[i]);
+            if (!castsSunRay(v, surface[i])) continue;
+            shadowOf[i] = shadows;
+            shadow[shadows++] = sunShadowRay(v, surface[i]);
+        }
+        traceScenePacket<true>(v, shadow, shadows, shadowHit, occluded);
+        for (int i = 0; i < n; ++i) {
+            const int seen = shadowOf[i] < 0 ? 0 : (occluded[shadowOf[i]] ? 0 : 1);
+            pixelSumAdd(sum[i], shadeFound(v, cam[i], found[i], hit[i], surface[i], x0 + i % w, y0 + i / w, s, seen));
+        }
+    }
+    for (int i = 0; i < n; ++i) {
+        pixelSumAverage(sum[i], sEnd - sBegin);
+        out[size_t(i / w) * stride + size_t(i % w)] = sum[i];
+    }
+}
+
+} // namespace
 
 Film renderFilm(const RenderView& v, Progress* progress) { return renderFilmRows(v, 0, v.height, progress); }
 
@@ -23,7 +76,6 @@ Film renderFilmRows(const RenderView& v, int y0Frame, int y1Frame, Progress* pro
     film.width = v.width;
     film.height = y1Frame - y0Frame;
     film.pixels.resize(size_t(v.width) * size_t(film.height));
-    constexpr int kTile = 8;
     const int tilesX = (v.width + kTile - 1) / kTile, tilesY = (film.height + kTile - 1) / kTile;
     const int tiles = tilesX * tilesY;
     std::atomic<int> done{0};
@@ -33,9 +85,7 @@ Film renderFilmRows(const RenderView& v, int y0Frame, int y1Frame, Progress* pro
         for (int tile = r.begin(); tile < r.end(); ++tile) {
             const int x0 = (tile % tilesX) * kTile, y0 = (tile / tilesX) * kTile;
             const int x1 = std::min(x0 + kTile, v.width), y1 = std::min(y0 + kTile, film.height);
-            for (int y = y0; y < y1; ++y)
-                for (int x = x0; x < x1; ++x)
-                    film.pixels[size_t(y) * size_t(v.width) + size_t(x)] = shadePixel(v, x, y0Frame + y);
+            shadeTile(v, x0, y0Frame + y0, x1, y0Frame + y1, &film.pixels[size_t(y0) * size_t(v.width) + size_t(x0)], size_t(v.width));
         }
         const int d = done.fetch_add(int(r.size())) + int(r.size());
         if (progress && (d % std::max(1, tiles / 100) < int(r.size()) || d == tiles)) {
@@ -56,9 +106,12 @@ void renderFilmRect(const RenderView& v, int x0, int y0, int x1, int y1, SampleP
         throw Error("renderFilmRect: the rectangle [" + std::to_string(x0) + ", " + std::to_string(x1) + ") x [" + std::to_string(y0) +
                     ", " + std::to_string(y1) + ") is outside the " + std::to_string(v.width) + "x" + std::to_string(v.height) + " frame");
     const int w = x1 - x0;
-    tbb::parallel_for(tbb::blocked_range<int>(y0, y1), [&](const tbb::blocked_range<int>& r) {
-        for (int y = r.begin(); y < r.end(); ++y)
-            for (int x = x0; x < x1; ++x) out[size_t(y - y0) * size_t(w) + size_t(x - x0)] = shadePixel(v, x, y);
+    const int tilesX = (w + kTile - 1) / kTile, tiles = tilesX * ((y1 - y0 + kTile - 1) / kTile);
+    tbb::parallel_for(tbb::blocked_range<int>(0, tiles), [&](const tbb::blocked_range<int>& r) {
+        for (int tile = r.begin(); tile < r.end(); ++tile) {
+            const int tx = x0 + (tile % tilesX) * kTile, ty = y0 + (tile / tilesX) * kTile;
+            shadeTile(v, tx, ty, std::min(tx + kTile, x1), std::min(ty + kTile, y1), out + size_t(ty - y0) * size_t(w) + size_t(tx - x0), size_t(w));
+        }
     });
 }
 

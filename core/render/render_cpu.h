@@ -15,7 +15,8 @@ struct Film {
     std::vector<SampleParts> pixels;
 };
 
-// Traces every pixel of v.width x v.height with v.spp samples, in parallel over 8x8 tiles.
+// Traces every pixel of v.width x v.height with v.spp samples, in parallel over 8x8 tiles (a landscape's
+// camera rays and their sun shadow rays a tile at a time as packets, core/render/trace_packet.h).
 // Reports progress per tile row; throws Cancelled when cancelled.
 Film renderFilm(const RenderView& v, Progress* progress = nullptr);
 
@@ -24,8 +25,8 @@ Film renderFilm(const RenderView& v, Progress* progress = nullptr);
 Film renderFilmRows(const RenderView& v, int y0, int y1, Progress* progress = nullptr);
 
 // The rectangle [x0, x1) x [y0, y1) of the frame (frame pixels) into out, row-major, (x1 - x0) x (y1 - y0)
-// parts: exactly the pixels renderFilm computes there (shadePixel per pixel; nothing depends on the
-// rectangle), in parallel over its rows. The tiles of `sylva render --mpi` (pipeline/mpi). Throws Error
+// parts: exactly the pixels renderFilm computes there (shadePixel's parts per pixel, a landscape's 8x8 tiles
+// traced as packets with the same answers; nothing depends on the rectangle), in parallel over its tiles. The tiles of `sylva render --mpi` (pipeline/mpi). Throws Error
 // for a rectangle outside the frame.
 void renderFilmRect(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts* out);
 

@@ -303,12 +303,19 @@ SYLVA_HD SYLVA_INLINE SampleParts backgroundStage(const RenderView& v, const Ray
     return out;
 }
 
-SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& s, int px = 0, int py = 0, int sample = 0)
+// Whether the light stage casts a shadow ray toward the sun from surface s (sunShadowRay: that ray).
+SYLVA_HD SYLVA_INLINE bool castsSunRay(const RenderView& v, const SurfacePoint& s) { return v.shadows && glm::dot(s.ng, v.sunDir) > 0.0f; }
+SYLVA_HD SYLVA_INLINE Ray sunShadowRay(const RenderView& v, const SurfacePoint& s) { return Ray{offsetPoint(s.p, s.ng, s.extent), 0.0f, v.sunDir, 1e30f}; }
+
+// sunSeen: -1 traces the sun's shadow ray here; 0 or 1 is its answer traced by the caller (a packet of a
+// tile's shadow rays, core/render/render_cpu.cpp), used only where castsSunRay.
+SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& s, int px = 0, int py = 0, int sample = 0, int sunSeen = -1)
 {
     SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
     const float nl = glm::dot(s.ng, v.sunDir);
+    auto sunLit = [&] { return sunSeen >= 0 ? (!v.shadows || sunSeen != 0) : sunVisible(v, offsetPoint(s.p, s.ng, s.extent)); };
     if (s.ground) {   // the plane or the terrain: Lambertian, lit by the sun and the uniform sky
-        if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng, s.extent))) {
+        if (nl > 0.0f && sunLit()) {
             out.local = s.albedo * v.sunRadiance * nl;
             if (v.volumeCount > 0) out.local *= sunThroughVolumes(v, s.p);   // cloud shadows
         }
@@ -316,7 +323,7 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
         out.indirect = s.albedo * v.sky;
         return out;
     }
-    if (nl > 0.0f && sunVisible(v, offsetPoint(s.p, s.ng, s.extent))) {
+    if (nl > 0.0f && sunLit()) {
         glm::vec3 c = s.albedo * nl;
         if (s.shininess > 0.0f && (s.specular.x > 0.0f || s.specular.y > 0.0f || s.specular.z > 0.0f)) {
             const glm::vec3 r = 2.0f * nl * s.ng - v.sunDir;
@@ -331,14 +338,22 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
     return out;
 }
 
+// The stages after intersect for a camera ray whose first hit is known (found; hit and its surface sp where
+// found), sample s of pixel (px, py); sunSeen as lightStage takes it.
+SYLVA_HD inline SampleParts shadeFound(const RenderView& v, const Ray& ray, bool found, const Hit& hit, const SurfacePoint& sp, int px, int py, int s,
+                                       int sunSeen = -1)
+{
+    SampleParts out = found ? lightStage(v, sp, px, py, s, sunSeen) : backgroundStage(v, ray);
+    volumeStage(v, ray, found ? hit.t : ray.tmax, out);
+    return out;
+}
+
 // Shades one camera ray, sample s of pixel (px, py) (which subset of the sky lights it uses): the stages in order.
 SYLVA_HD inline SampleParts shadeRay(const RenderView& v, const Ray& ray, int px = 0, int py = 0, int s = 0)
 {
     Hit hit{};
     const bool found = intersectStage(v, ray, hit);
-    SampleParts out = found ? lightStage(v, surfaceStage(v, ray, hit), px, py, s) : backgroundStage(v, ray);
-    volumeStage(v, ray, found ? hit.t : ray.tmax, out);
-    return out;
+    return shadeFound(v, ray, found, hit, found ? surfaceStage(v, ray, hit) : SurfacePoint{}, px, py, s);
 }
 
 // Camera ray through image position (x, y) in pixels (y down, 0..width/height), camera-relative.
@@ -381,29 +396,49 @@ SYLVA_HD SYLVA_INLINE glm::vec2 samplePosition(int px, int py, int s, int spp)
     return glm::vec2(float(px) + jx, float(py) + jy);
 }
 
-// All samples of one pixel (or those of v.sampleBegin .. sampleEnd), box-filtered.
-SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
+// A pixel's box filter: the samples summed in order (the depth their minimum), then averaged.
+SYLVA_HD SYLVA_INLINE SampleParts pixelSumStart()
 {
-    SampleParts sum{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, glm::vec3(0.0f), kSkyDepth, glm::vec3(0.0f)};
-    const int sBegin = v.sampleBegin, sEnd = v.sampleEnd > 0 ? v.sampleEnd : v.spp;
-    for (int s = sBegin; s < sEnd; ++s) {
-        const glm::vec2 pos = samplePosition(px, py, s, v.spp);
-        const SampleParts p = shadeRay(v, cameraRay(v, pos.x, pos.y), px, py, s);
-        sum.local += p.local;
-        sum.indirect += p.indirect;
-        sum.albedo += p.albedo;
-        sum.skyCover += p.skyCover;
-        sum.normal += p.normal;
-        sum.depth = fminf(sum.depth, p.depth);
-        sum.background += p.background;
-    }
-    const float inv = 1.0f / float(sEnd > sBegin ? sEnd - sBegin : 1);
+    return SampleParts{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 0.0f, glm::vec3(0.0f), kSkyDepth, glm::vec3(0.0f)};
+}
+SYLVA_HD SYLVA_INLINE void pixelSumAdd(SampleParts& sum, const SampleParts& p)
+{
+    sum.local += p.local;
+    sum.indirect += p.indirect;
+    sum.albedo += p.albedo;
+    sum.skyCover += p.skyCover;
+    sum.normal += p.normal;
+    sum.depth = fminf(sum.depth, p.depth);
+    sum.background += p.background;
+}
+SYLVA_HD SYLVA_INLINE void pixelSumAverage(SampleParts& sum, int samples)
+{
+    const float inv = 1.0f / float(samples > 0 ? samples : 1);
     sum.local *= inv;
     sum.indirect *= inv;
     sum.albedo *= inv;
     sum.skyCover *= inv;
     sum.normal *= inv;
     sum.background *= inv;
+}
+
+// The samples a pixel takes in this view: v.sampleBegin .. sampleEnd (all spp when sampleEnd is 0).
+SYLVA_HD SYLVA_INLINE int sampleEndOf(const RenderView& v) { return v.sampleEnd > 0 ? v.sampleEnd : v.spp; }
+
+// Camera ray of sample s of pixel (px, py).
+SYLVA_HD SYLVA_INLINE Ray sampleRay(const RenderView& v, int px, int py, int s)
+{
+    const glm::vec2 pos = samplePosition(px, py, s, v.spp);
+    return cameraRay(v, pos.x, pos.y);
+}
+
+// All samples of one pixel (or those of v.sampleBegin .. sampleEnd), box-filtered.
+SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
+{
+    SampleParts sum = pixelSumStart();
+    const int sBegin = v.sampleBegin, sEnd = sampleEndOf(v);
+    for (int s = sBegin; s < sEnd; ++s) pixelSumAdd(sum, shadeRay(v, sampleRay(v, px, py, s), px, py, s));
+    pixelSumAverage(sum, sEnd - sBegin);
     return sum;
 }
 

@@ -279,17 +279,17 @@ SYLVA_HD inline bool traceLevel(Query& q, const BvhNode* nodes, const BvhNode8* 
 
 namespace sylva {
 
-// Closest hit along the ray (camera-relative world frame) over the ground plane, the terrain and the top level's instances,
-// descending through instance groups to meshes traced through their BVHs (Kd = false) or kd-trees
-// (Kd = true; groups and the top level always use BVHs). AnyHit stops at the first accepted hit (shadow
-// rays). Cut-outs are tested up to alphaTestLimit. Returns true on a hit.
-template <bool AnyHit, bool Kd>
-SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hit)
+namespace trace_detail {
+
+// The ground plane and the terrain, asked first (seed 002 section 4.1): their hit shortens the ray (tmax)
+// before the plants are traversed. Starts the hit record. Returns true when an any-hit query is answered.
+template <bool AnyHit>
+SYLVA_HD inline bool traceGround(const RenderView& v, const Ray& ray, Hit& hit, float& tmax)
 {
     hit.prim = kNoHit;
     hit.inst = kNoHit;
     hit.depth = 0;
-    float tmax = ray.tmax;
+    tmax = ray.tmax;
     if (v.groundEnabled && ray.dir.y != 0.0f) {
         const float tg = (v.groundY - ray.org.y) / ray.dir.y;
         if (tg > ray.tmin && tg < tmax) {
@@ -300,7 +300,6 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
             hit.u = hit.v = 0.0f;
         }
     }
-    // The terrain next (seed 002 section 4.1): its hit shortens the ray before the plants are traversed.
     if (v.terrainEnabled) {
         const Ray local{ray.org - v.terrainBase, ray.tmin, ray.dir, tmax};
         uint32_t tri = kNoHit;
@@ -315,17 +314,37 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
             hit.v = w;
         }
     }
+    return false;
+}
+
+// The top level's instances, asked last (below the closest hit so far, tmax): the query's answer.
+template <bool AnyHit, bool Kd>
+SYLVA_HD inline bool traceTopLevel(const RenderView& v, const Ray& ray, Hit& hit, float& tmax)
+{
+    if (v.instanceCount == 0) return AnyHit ? false : hit.prim != kNoHit;
+    Query q{v, ray.tmin, alphaTestLimit(v, ray), hit, {}};
+    const bool stopped = traceLevel<AnyHit, Kd, 0>(q, v.tlasNodes, v.tlasWideNodes, v.tlasOrder, v.instances, ray.org, ray.dir, tmax);
+    if (AnyHit) return stopped;
+    return hit.prim != kNoHit;
+}
+
+} // namespace trace_detail
+
+// Closest hit along the ray (camera-relative world frame) over the ground plane, the terrain and the top level's instances,
+// descending through instance groups to meshes traced through their BVHs (Kd = false) or kd-trees
+// (Kd = true; groups and the top level always use BVHs). AnyHit stops at the first accepted hit (shadow
+// rays). Cut-outs are tested up to alphaTestLimit. Returns true on a hit.
+template <bool AnyHit, bool Kd>
+SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hit)
+{
+    float tmax;
+    if (trace_detail::traceGround<AnyHit>(v, ray, hit, tmax)) return true;
     // The landscape's cells and tiles (seed 002 sections 4.1, 4.2), below the ground's hit.
     if (v.landscapeEnabled) {
         trace_detail::Query lq{v, ray.tmin, alphaTestLimit(v, ray), hit, {}};
         if (trace_detail::traceLandscape<AnyHit, Kd>(lq, ray.org, ray.dir, tmax) && AnyHit) return true;
     }
-    if (v.instanceCount == 0) return AnyHit ? false : hit.prim != kNoHit;
-    trace_detail::Query q{v, ray.tmin, alphaTestLimit(v, ray), hit, {}};
-    const bool stopped = trace_detail::traceLevel<AnyHit, Kd, 0>(q, v.tlasNodes, v.tlasWideNodes, v.tlasOrder, v.instances,
-                                                                 ray.org, ray.dir, tmax);
-    if (AnyHit) return stopped;
-    return hit.prim != kNoHit;
+    return trace_detail::traceTopLevel<AnyHit, Kd>(v, ray, hit, tmax);
 }
 
 // The query the shading code calls: dispatches on the acceleration structure of the run.

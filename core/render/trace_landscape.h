@@ -52,31 +52,97 @@ SYLVA_HD inline InstanceRecord landPlantInstance(const RenderView& v, uint32_t c
     return r;
 }
 
-// The plants of cell `cell`'s tile along the ray (camera-relative o, d): the tile's 2D tree, every node as
-// tall as its plants raised over the ground's range under it (the cell's plane, LandCell); each plant reached
-// is lifted onto the ground, thinned, box-tested and traced in its mesh. Returns true when an any-hit query
-// found a hit.
+// A cell's tile frame (tile metres, the cell corner at the origin, t unchanged) and the bounds of its tile's
+// boxes there: every node as tall as its plants raised over the ground's range under it (the cell's plane
+// within its deviation, clipped to the cell's range, LandCell). Shared by the single-ray and packet walks.
+struct LandCellFrame {
+    glm::vec3 corner;   // camera-relative
+    float ik;           // 1 / tileScale
+    float gLo, gHi;     // the cell's ground range (the cell corner lies at the terrain frame's y = 0)
+    float p0, px, pz, pe;   // the ground plane y = p0 + px x + pz z within pe
+
+    SYLVA_HD SYLVA_INLINE LandCellFrame(const RenderView& v, const LandCell& c, uint32_t cx, uint32_t cz)
+        : corner(landCellCorner(v, cx, cz)), ik(v.land.invTileScale), gLo(c.ground.x * ik), gHi(c.ground.y * ik), p0(c.plane.x * ik),
+          px(c.plane.y * ik), pz(c.plane.z * ik), pe(c.plane.w * ik)
+    {
+    }
+    // A node's box: its rectangle, its plants' vertical extent raised anywhere in the ground's range under it.
+    SYLVA_HD SYLVA_INLINE void nodeBox(const TileNode& n, glm::vec3& lo, glm::vec3& hi) const
+    {
+        const float x0 = px * n.lox, x1 = px * n.hix, z0 = pz * n.loz, z1 = pz * n.hiz;
+        const float l = maxf(p0 + minf(x0, x1) + minf(z0, z1) - pe, gLo), h = minf(p0 + maxf(x0, x1) + maxf(z0, z1) + pe, gHi);
+        lo = glm::vec3(n.lox, l + n.ylo, n.loz);
+        hi = glm::vec3(n.hix, h + n.yhi, n.hiz);
+    }
+    // A plant's box raised anywhere in the ground's range at its root (the plane's bound): tested before the
+    // height field is read, so most plants of a leaf are rejected without it.
+    SYLVA_HD SYLVA_INLINE void plantBox(const TilePlant& p, glm::vec3& lo, glm::vec3& hi) const
+    {
+        const float g = p0 + px * p.x + pz * p.z, l = maxf(g - pe, gLo), h = minf(g + pe, gHi);
+        lo = glm::vec3(p.x + p.lo.x, l + p.lo.y, p.z + p.lo.z);
+        hi = glm::vec3(p.x + p.hi.x, h + p.hi.y, p.z + p.hi.z);
+    }
+};
+
+// The ray's segment in cell (cx, cz)'s column (its rectangle, any height), in the camera-relative frame (o and
+// iw = safeReciprocal(d)): t0 and t1 narrowed to it; false when the ray misses the column. A plant that
+// crosses a cell's edge has a copy in each cell it reaches (core/terrain/landscape.cpp), so a cell's tile
+// answers for its own column only: neighbours compute their common side's t alike, the segment is taken
+// half-open ([t0, t1] with t0 excluded by the meshes' t > tmin) and a ray along a side belongs to the cell
+// that starts there. Every point of the ray is then the business of one cell (the columns tile the plane), and
+// which copy is hit does not depend on the order the cells are visited in.
+SYLVA_HD SYLVA_INLINE bool landCellSegment(const RenderView& v, uint32_t cx, uint32_t cz, const glm::vec3& o, const glm::vec3& iw, float& t0, float& t1)
+{
+    // The border cells' columns reach out beyond the grid, where their plants overhang the terrain's edge.
+    const glm::vec3 a = landCellCorner(v, cx, cz), b = landCellCorner(v, cx + 1, cz + 1);
+    const float big = 3.0e38f;
+    const float x0 = cx == 0 ? -big : a.x, x1 = cx + 1 == v.land.cellsX ? big : b.x;
+    const float z0 = cz == 0 ? -big : a.z, z1 = cz + 1 == v.land.cellsZ ? big : b.z;
+    auto axis = [&](float lo, float hi, float org, float inv) {
+        if (inv == 1e30f || inv == -1e30f) return lo <= org && org < hi;
+        const float ta = (lo - org) * inv, tb = (hi - org) * inv;
+        t0 = maxf(t0, minf(ta, tb));
+        t1 = minf(t1, maxf(ta, tb));
+        return true;
+    };
+    return axis(x0, x1, o.x, iw.x) && axis(z0, z1, o.z, iw.z) && t0 <= t1;
+}
+
+// The distance limit within a cell: the closest hit so far or the column's far side, inclusive.
+SYLVA_HD SYLVA_INLINE float landCellLimit(float tmax, float t1) { return minf(tmax, nextafterf(t1, 3.0e38f)); }
+
+// Plant k (tilePlants) of `cell`, rooted at its lifted root: the ray (op: the plant-centred tile frame, dt: the
+// tile frame's direction) traced in its mesh. Returns true when an any-hit query found a hit.
 template <bool AnyHit, bool Kd>
-SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, const glm::vec3& d, float& tmax)
+SYLVA_HD SYLVA_INLINE bool traceLandPlant(Query& q, uint32_t cell, uint32_t k, const TilePlant& p, const glm::vec3& op, const glm::vec3& dt, float& tmax)
+{
+    InstanceRecord in{};
+    in.row[0] = p.row[0];
+    in.row[1] = p.row[1];
+    in.row[2] = p.row[2];
+    const GeometryRecord& geo = q.v.geometries[p.geometry];
+    SYLVA_COUNT(g_plantMeshEntries);
+    q.path[1] = cell;
+    q.path[2] = k;
+    return traceMesh<AnyHit, Kd, 2>(q, geo, toLocalPoint(in, op), toLocalDir(in, dt), tmax);
+}
+
+// The plants of cell (cx, cz)'s tile along the ray (camera-relative o, d) within [q.tmin, tmax]: the tile's 2D
+// tree in the cell's frame (LandCellFrame); each plant reached is lifted onto the ground, thinned, box-tested
+// and traced in its mesh. A hit shortens tmax. Returns true when an any-hit query found a hit.
+template <bool AnyHit, bool Kd>
+SYLVA_HD inline bool traceLandTile(Query& q, uint32_t cell, uint32_t cx, uint32_t cz, const LandCell& c, const TileRecord& tile, const glm::vec3& o,
+                                   const glm::vec3& d, float& tmax)
 {
     const RenderView& v = q.v;
-    const LandCell c = v.landCells[cell];
-    const TileRecord& tile = v.tileRecords[c.tile];
-    if (tile.plantCount == 0) return false;
-    SYLVA_COUNT(g_landCellVisits);
-    const uint32_t cx = cell % v.land.cellsX, cz = cell / v.land.cellsX;
-    const float ik = v.land.invTileScale;
-    const glm::vec3 corner = landCellCorner(v, cx, cz);
-    const glm::vec3 ot = (o - corner) * ik, dt = d * ik;   // the tile frame (t unchanged)
+    const LandCellFrame f(v, c, cx, cz);
+    const float ik = f.ik;
+    const glm::vec3 ot = (o - f.corner) * ik, dt = d * ik;   // the tile frame (t unchanged)
     const glm::vec3 inv = safeReciprocal(dt);
-    const float gLo = c.ground.x * ik, gHi = c.ground.y * ik;   // the cell corner lies at the terrain frame's y = 0
-    // The ground under tile-frame (x, z): the cell's plane within its deviation, clipped to the cell's range.
-    const float p0 = c.plane.x * ik, px = c.plane.y * ik, pz = c.plane.z * ik, pe = c.plane.w * ik;
-    // A node's box: its rectangle, its plants' vertical extent raised anywhere in the ground's range under it.
     auto entry = [&](const TileNode& n) {
-        const float x0 = px * n.lox, x1 = px * n.hix, z0 = pz * n.loz, z1 = pz * n.hiz;
-        const float lo = maxf(p0 + minf(x0, x1) + minf(z0, z1) - pe, gLo), hi = minf(p0 + maxf(x0, x1) + maxf(z0, z1) + pe, gHi);
-        return rayBoxEntry(glm::vec3(n.lox, lo + n.ylo, n.loz), glm::vec3(n.hix, hi + n.yhi, n.hiz), ot, inv, q.tmin, tmax);
+        glm::vec3 lo, hi;
+        f.nodeBox(n, lo, hi);
+        return rayBoxEntry(lo, hi, ot, inv, q.tmin, tmax);
     };
     // Every node's box is tested once, by its parent (the root here): the stack keeps the entry distance of
     // each deferred child, re-checked against the closest hit when it comes up.
@@ -110,30 +176,19 @@ SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, 
             for (uint32_t k = n.first; k < n.first + n.count; ++k) {
                 const TilePlant& p = v.tilePlants[k];
                 SYLVA_COUNT(g_plantBoxTests);
-                // The plant's box raised anywhere in the ground's range at its root (the plane's bound; tile frame)
-                // first: most plants of a leaf are rejected before the height field is read.
-                const float g = p0 + px * p.x + pz * p.z, lo = maxf(g - pe, gLo), hi = minf(g + pe, gHi);
-                if (!(rayBoxEntry(glm::vec3(p.x + p.lo.x, lo + p.lo.y, p.z + p.lo.z), glm::vec3(p.x + p.hi.x, hi + p.hi.y, p.z + p.hi.z), ot, inv,
-                                  q.tmin, tmax) <= tmax))
-                    continue;
+                glm::vec3 lo, hi;
+                f.plantBox(p, lo, hi);
+                if (!(rayBoxEntry(lo, hi, ot, inv, q.tmin, tmax) <= tmax)) continue;
                 // Its root on the ground, its box there, and only then whether it grows (density, snow, rock).
                 SYLVA_COUNT(g_plantRootReads);
                 float y;
                 uint32_t tri;
                 if (!landPlantHeight(v.land, heights, cx, cz, p, y, tri)) continue;
-                const glm::vec3 root = corner + glm::vec3(v.land.tileScale * p.x, y, v.land.tileScale * p.z);
+                const glm::vec3 root = f.corner + glm::vec3(v.land.tileScale * p.x, y, v.land.tileScale * p.z);
                 const glm::vec3 op = (o - root) * ik;   // the plant-centred tile frame
                 if (!(rayBoxEntry(p.lo, p.hi, op, inv, q.tmin, tmax) <= tmax)) continue;
                 if (!landPlantKept(v.land, heights, v.terrainSnowY, v.terrainRockCos, p, y, tri)) continue;
-                InstanceRecord in{};
-                in.row[0] = p.row[0];
-                in.row[1] = p.row[1];
-                in.row[2] = p.row[2];
-                const GeometryRecord& geo = v.geometries[p.geometry];
-                SYLVA_COUNT(g_plantMeshEntries);
-                q.path[1] = cell;
-                q.path[2] = k;
-                if (traceMesh<AnyHit, Kd, 2>(q, geo, toLocalPoint(in, op), toLocalDir(in, dt), tmax)) return true;
+                if (traceLandPlant<AnyHit, Kd>(q, cell, k, p, op, dt, tmax)) return true;
             }
         }
         // The nearest deferred node still in reach.
@@ -144,6 +199,36 @@ SYLVA_HD inline bool traceLandCell(Query& q, uint32_t cell, const glm::vec3& o, 
         }
         node = stackNode[top];
     }
+}
+
+// The box of the cell tree's node n over cells [x0, x1) x [z0, z1): camera-relative, its ground and tiles' range.
+SYLVA_HD SYLVA_INLINE void landNodeBox(const RenderView& v, const LandNode& n, uint32_t x0, uint32_t z0, uint32_t x1, uint32_t z1, glm::vec3& lo,
+                                       glm::vec3& hi)
+{
+    const glm::vec3 a = landCellCorner(v, x0, z0), b = landCellCorner(v, x1, z1);
+    lo = glm::vec3(a.x, v.landBase.y + n.range.x, a.z);
+    hi = glm::vec3(b.x, v.landBase.y + n.range.y, b.z);
+}
+
+// Cell `cell`'s plants along the ray's segment in its column (landCellSegment; iw = safeReciprocal(d)). A hit
+// shortens tmax. Returns true when an any-hit query found a hit.
+template <bool AnyHit, bool Kd>
+SYLVA_HD inline bool traceLandCell(const Query& q, uint32_t cell, const glm::vec3& o, const glm::vec3& d, const glm::vec3& iw, float& tmax)
+{
+    const RenderView& v = q.v;
+    const LandCell c = v.landCells[cell];
+    const TileRecord& tile = v.tileRecords[c.tile];
+    if (tile.plantCount == 0) return false;
+    const uint32_t cx = cell % v.land.cellsX, cz = cell / v.land.cellsX;
+    float t0 = q.tmin, t1 = tmax;
+    if (!landCellSegment(v, cx, cz, o, iw, t0, t1)) return false;
+    SYLVA_COUNT(g_landCellVisits);
+    Query cq{v, t0, q.tAlpha, q.hit, {q.path[0], 0, 0}};
+    const float limit = landCellLimit(tmax, t1);
+    float t = limit;
+    const bool stopped = traceLandTile<AnyHit, Kd>(cq, cell, cx, cz, c, tile, o, d, t);
+    if (t < limit) tmax = t;   // the column's closest hit is the ray's closest so far
+    return stopped;
 }
 
 // The landscape's plants along the ray: its cells' 2D kd-tree top-down, near child first, a node skipped
@@ -165,11 +250,11 @@ SYLVA_HD inline bool traceLandscape(Query& q, const glm::vec3& o, const glm::vec
         const Entry e = stack[--top];
         const LandNode& n = v.landNodes[e.node];
         SYLVA_COUNT(g_landNodeVisits);
-        const glm::vec3 lo = landCellCorner(v, e.x0, e.z0), hi = landCellCorner(v, e.x1, e.z1);
-        if (!(rayBoxEntry(glm::vec3(lo.x, v.landBase.y + n.range.x, lo.z), glm::vec3(hi.x, v.landBase.y + n.range.y, hi.z), o, inv, q.tmin, tmax) <= tmax))
-            continue;
+        glm::vec3 lo, hi;
+        landNodeBox(v, n, e.x0, e.z0, e.x1, e.z1, lo, hi);
+        if (!(rayBoxEntry(lo, hi, o, inv, q.tmin, tmax) <= tmax)) continue;
         if (n.child == 0) {
-            if (traceLandCell<AnyHit, Kd>(q, e.z0 * v.land.cellsX + e.x0, o, d, tmax)) return true;
+            if (traceLandCell<AnyHit, Kd>(q, e.z0 * v.land.cellsX + e.x0, o, d, inv, tmax)) return true;
             continue;
         }
         Entry a{n.child, e.x0, e.z0, e.x1, e.z1}, b{n.child + 1, e.x0, e.z0, e.x1, e.z1};

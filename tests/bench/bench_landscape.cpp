@@ -2,7 +2,9 @@
 // stretched to 82 km, 64^2 .. 512^2 cells, 640 x 480, one primary and one shadow ray per pixel (alpha-tested
 // leaves), a panorama over the terrain. Per cell count: build time, memory, potentially visible instances and
 // triangles (with and without the density rule's thinning), primary, shadow and frame time; the scaling
-// time(512^2) / time(64^2). Ends with name=value lines.
+// time(512^2) / time(64^2); the same rays traced ray by ray (traceScene) and an 8x8 tile at a time (traceScenePacket,
+// as the CPU renderer traces a landscape), and with --embree beside Embree 3's single rays and streams. Ends with
+// name=value lines.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +22,7 @@
 
 #include "core/render/render_scene.h"
 #include "core/render/shade.h"
+#include "core/render/trace_packet.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/io/dem_io.h"
 #include "pipeline/render/render_job.h"
@@ -35,8 +38,8 @@ namespace {
 
 struct Row {
     int cells;
-    double build, landscapeBuild, mb, landscapeMb, instances, triangles, keptFraction, primary, shadow;
-    size_t hits, occluded;
+    double build, landscapeBuild, mb, landscapeMb, instances, triangles, keptFraction, primary, shadow, primaryPacket, shadowPacket;
+    size_t hits, occluded, packetDiffer;
 };
 
 // The share of plants the density rule keeps: every plant of every 8th cell along each axis.
@@ -271,12 +274,22 @@ int main(int argc, char** argv)
         r.instances = st.landscape.instances;
         r.triangles = st.landscape.triangles;
         r.keptFraction = keptFraction(v);
+        // The camera rays in the renderer's order: 8 x 8 pixel tiles (camStart: each tile's first ray), for every
+        // tracer alike; the shadow rays of a tile follow one another too (shStart).
         const size_t np = size_t(width) * size_t(height);
-        std::vector<Ray> cam(np);
+        std::vector<Ray> cam;
+        std::vector<size_t> camStart;
+        cam.reserve(np);
+        for (int ty = 0; ty < height; ty += 8)
+            for (int tx = 0; tx < width; tx += 8) {
+                camStart.push_back(cam.size());
+                for (int y = ty; y < std::min(ty + 8, height); ++y)
+                    for (int x = tx; x < std::min(tx + 8, width); ++x) cam.push_back(cameraRay(v, float(x) + 0.5f, float(y) + 0.5f));
+            }
+        camStart.push_back(np);
+        const size_t tiles = camStart.size() - 1;
         std::vector<Hit> hits(np);
         std::vector<char> got(np);
-        for (int y = 0; y < height; ++y)
-            for (int x = 0; x < width; ++x) cam[size_t(y) * width + x] = cameraRay(v, float(x) + 0.5f, float(y) + 0.5f);
         r.primary = bench::timeReps(reps, [&] {
                         tbb::parallel_for(tbb::blocked_range<size_t>(0, np, 64), [&](const tbb::blocked_range<size_t>& b) {
                             for (size_t i = b.begin(); i != b.end(); ++i) got[i] = traceScene<false>(v, cam[i], hits[i]);
@@ -284,12 +297,17 @@ int main(int argc, char** argv)
                     }).median;
         // Shadow rays as the renderer casts them (offset off the surface it shades).
         std::vector<Ray> sh;
-        for (size_t i = 0; i < np; ++i) {
-            if (!got[i]) continue;
-            ++r.hits;
-            const SurfacePoint s = surfaceStage(v, cam[i], hits[i]);
-            sh.push_back(Ray{offsetPoint(s.p, s.ng, s.extent), 0.0f, v.sunDir, 1e30f});
+        std::vector<size_t> shStart;
+        for (size_t t = 0; t < tiles; ++t) {
+            shStart.push_back(sh.size());
+            for (size_t i = camStart[t]; i < camStart[t + 1]; ++i) {
+                if (!got[i]) continue;
+                ++r.hits;
+                const SurfacePoint s = surfaceStage(v, cam[i], hits[i]);
+                sh.push_back(Ray{offsetPoint(s.p, s.ng, s.extent), 0.0f, v.sunDir, 1e30f});
+            }
         }
+        shStart.push_back(sh.size());
         std::vector<char> occ(sh.size());
         r.shadow = bench::timeReps(reps, [&] {
                        tbb::parallel_for(tbb::blocked_range<size_t>(0, sh.size(), 64), [&](const tbb::blocked_range<size_t>& b) {
@@ -300,6 +318,29 @@ int main(int argc, char** argv)
                        });
                    }).median;
         for (char c : occ) r.occluded += c != 0;
+        // The same rays a tile at a time through traceScenePacket; every answer compared with the ray alone.
+        std::vector<Hit> hitsP(np);
+        std::unique_ptr<bool[]> gotP(new bool[np]), occP(new bool[std::max<size_t>(sh.size(), 1)]);
+        std::vector<Hit> shHits(sh.size());
+        auto primaryPackets = [&] {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& b) {
+                for (size_t t = b.begin(); t != b.end(); ++t)
+                    traceScenePacket<false>(v, &cam[camStart[t]], int(camStart[t + 1] - camStart[t]), &hitsP[camStart[t]], &gotP[camStart[t]]);
+            });
+        };
+        auto shadowPackets = [&] {
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& b) {
+                for (size_t t = b.begin(); t != b.end(); ++t)
+                    if (shStart[t + 1] > shStart[t])
+                        traceScenePacket<true>(v, &sh[shStart[t]], int(shStart[t + 1] - shStart[t]), &shHits[shStart[t]], &occP[shStart[t]]);
+            });
+        };
+        r.primaryPacket = bench::timeReps(reps, primaryPackets).median;
+        r.shadowPacket = bench::timeReps(reps, shadowPackets).median;
+        r.packetDiffer = 0;
+        for (size_t i = 0; i < np; ++i)
+            r.packetDiffer += (got[i] != 0) != gotP[i] || (gotP[i] && (hits[i].t != hitsP[i].t || hits[i].prim != hitsP[i].prim));
+        for (size_t i = 0; i < sh.size(); ++i) r.packetDiffer += (occ[i] != 0) != occP[i];
 #if defined(SYLVA_TRAVERSAL_STATS)
         countPerRay("primary", n, np, [&] {
             for (size_t i = 0; i < np; ++i) {
@@ -318,6 +359,10 @@ int main(int argc, char** argv)
                     "visible (%.3g after thinning, %.0f%% kept); primary %.3f s (%zu hits), shadow %.3f s (%zu occluded), frame %.3f s\n",
                     n, r.build, r.landscapeBuild, r.mb, r.landscapeMb, r.instances, r.triangles, r.triangles * r.keptFraction, 100.0 * r.keptFraction,
                     r.primary, r.hits, r.shadow, r.occluded, r.primary + r.shadow);
+        std::printf("%4d^2 cells, 8x8 packets: primary %.3f s, shadow %.3f s, frame %.3f s (%.2fx the single rays'); %zu of %zu answers differ from "
+                    "the single rays'\n",
+                    n, r.primaryPacket, r.shadowPacket, r.primaryPacket + r.shadowPacket, (r.primary + r.shadow) / (r.primaryPacket + r.shadowPacket),
+                    r.packetDiffer, np + sh.size());
         std::fflush(stdout);
         rows.push_back(r);
 #ifdef SYLVA_HAVE_EMBREE
@@ -371,6 +416,50 @@ int main(int argc, char** argv)
                                         }
                                     });
                                 }).median;
+        // Ours a tile at a time (traceScenePacket), and Embree's stream mode on the same tiles: a tile's rays as one
+        // rtcIntersect1M / rtcOccluded1M call with the coherent flag (Embree regroups a stream into packets itself).
+        const double ourPrimaryPacket = bench::timeReps(reps, primaryPackets).median;
+        const double ourShadowPacket = bench::timeReps(reps, shadowPackets).median;
+        std::vector<float> tEmS(np);
+        std::vector<char> occEmS(sh.size());
+        const double emPrimaryStream = bench::timeReps(reps, [&] {
+                                           tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& b) {
+                                               RTCIntersectContext ctx;
+                                               rtcInitIntersectContext(&ctx);
+                                               ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+                                               RTCRayHit rh[64];
+                                               for (size_t t = b.begin(); t != b.end(); ++t) {
+                                                   const size_t i0 = camStart[t], count = camStart[t + 1] - i0;
+                                                   for (size_t k = 0; k < count; ++k) {
+                                                       embreeRay(rh[k].ray, cam[i0 + k]);
+                                                       rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                                                       rh[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+                                                   }
+                                                   rtcIntersect1M(em.top, &ctx, rh, unsigned(count), sizeof(RTCRayHit));
+                                                   for (size_t k = 0; k < count; ++k)
+                                                       tEmS[i0 + k] = rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID ? rh[k].ray.tfar : -1.0f;
+                                               }
+                                           });
+                                       }).median;
+        const double emShadowStream = bench::timeReps(reps, [&] {
+                                          tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& b) {
+                                              RTCIntersectContext ctx;
+                                              rtcInitIntersectContext(&ctx);
+                                              ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+                                              RTCRay ray[64];
+                                              for (size_t t = b.begin(); t != b.end(); ++t) {
+                                                  const size_t i0 = shStart[t], count = shStart[t + 1] - i0;
+                                                  if (count == 0) continue;
+                                                  for (size_t k = 0; k < count; ++k) embreeRay(ray[k], sh[i0 + k]);
+                                                  rtcOccluded1M(em.top, &ctx, ray, unsigned(count), sizeof(RTCRay));
+                                                  for (size_t k = 0; k < count; ++k) occEmS[i0 + k] = ray[k].tfar < 0.0f;
+                                              }
+                                          });
+                                      }).median;
+        size_t streamDiffer = 0;
+        for (size_t i = 0; i < np; ++i)
+            streamDiffer += (tEm[i] >= 0.0f) != (tEmS[i] >= 0.0f) || (tEm[i] >= 0.0f && std::fabs(tEm[i] - tEmS[i]) > 1e-3f * std::max(tEm[i], tEmS[i]));
+        for (size_t i = 0; i < sh.size(); ++i) streamDiffer += occEm[i] != occEmS[i];
         size_t primaryDiffer = 0, shadowDiffer = 0;
         for (size_t i = 0; i < np; ++i) {
             const bool a = got[i] != 0, b = tEm[i] >= 0.0f;
@@ -385,6 +474,15 @@ int main(int argc, char** argv)
                     n, em.instances, em.buildSeconds, r.mb, double(em.bytes) / 1e6, double(em.resident) / 1e6, r.mb * 1e6 / double(em.bytes),
                     r.mb * 1e6 / double(std::max(em.resident, 1ll)), ourPrimary, emPrimary, ourShadow,
                     emShadow, ours / theirs, emPrimary / ourPrimary, emShadow / ourShadow, primaryDiffer, np, shadowDiffer, sh.size());
+        const double oursPacket = raysAll / (ourPrimaryPacket + ourShadowPacket), theirsStream = raysAll / (emPrimaryStream + emShadowStream);
+        std::printf("%4d^2 cells, 8x8 tiles: ours packets primary %.3f s, shadow %.3f s; Embree stream primary %.3f s, shadow %.3f s (%zu answers "
+                    "differ from its single rays); rays/s ours packets / Embree single = %.3f (primary %.3f, shadow %.3f), / Embree stream = %.3f "
+                    "(primary %.3f, shadow %.3f)\n",
+                    n, ourPrimaryPacket, ourShadowPacket, emPrimaryStream, emShadowStream, streamDiffer, oursPacket / theirs, emPrimary / ourPrimaryPacket,
+                    emShadow / ourShadowPacket, oursPacket / theirsStream, emPrimaryStream / ourPrimaryPacket, emShadowStream / ourShadowPacket);
+        std::printf("cells%d_packet_rays_per_s_ratio=%.4f\ncells%d_packet_vs_stream_ratio=%.4f\ncells%d_packet_primary_ratio=%.4f\n"
+                    "cells%d_packet_shadow_ratio=%.4f\n",
+                    n, oursPacket / theirs, n, oursPacket / theirsStream, n, emPrimary / ourPrimaryPacket, n, emShadow / ourShadowPacket);
         std::printf("cells%d_embree_resident_mb=%.3f\n", n, double(em.resident) / 1e6);
         std::printf("cells%d_embree_instances=%zu\ncells%d_embree_mb=%.3f\ncells%d_memory_ratio=%.5f\ncells%d_rays_per_s_ratio=%.4f\n"
                     "cells%d_primary_ratio=%.4f\ncells%d_shadow_ratio=%.4f\ncells%d_primary_differ=%zu\ncells%d_shadow_differ=%zu\n",
@@ -393,15 +491,23 @@ int main(int argc, char** argv)
         std::fflush(stdout);
 #endif
     }
-    std::printf("\n| cells | triangles (thinned) | instances (thinned) | frame s | primary s | shadow s | build s | MB |\n|---|---|---|---|---|---|---|---|\n");
+    std::printf("\n| cells | triangles (thinned) | instances (thinned) | frame s | primary s | shadow s | frame s, 8x8 packets | build s | MB |\n"
+                "|---|---|---|---|---|---|---|---|---|\n");
     for (const Row& r : rows)
-        std::printf("| %d^2 | %.3g | %.3g | %.3f | %.3f | %.3f | %.2f | %.1f |\n", r.cells, r.triangles * r.keptFraction, r.instances * r.keptFraction,
-                    r.primary + r.shadow, r.primary, r.shadow, r.build, r.mb);
+        std::printf("| %d^2 | %.3g | %.3g | %.3f | %.3f | %.3f | %.3f | %.2f | %.1f |\n", r.cells, r.triangles * r.keptFraction, r.instances * r.keptFraction,
+                    r.primary + r.shadow, r.primary, r.shadow, r.primaryPacket + r.shadowPacket, r.build, r.mb);
     for (const Row& r : rows)
         std::printf("cells%d_frame_s=%.4f\ncells%d_build_s=%.4f\ncells%d_landscape_build_s=%.4f\ncells%d_mb=%.3f\ncells%d_triangles=%.4g\ncells%d_"
                     "triangles_thinned=%.4g\n",
                     r.cells, r.primary + r.shadow, r.cells, r.build, r.cells, r.landscapeBuild, r.cells, r.mb, r.cells, r.triangles, r.cells,
                     r.triangles * r.keptFraction);
-    if (rows.size() >= 2) std::printf("scaling=%.4f\n", (rows.back().primary + rows.back().shadow) / (rows.front().primary + rows.front().shadow));
+    for (const Row& r : rows)
+        std::printf("cells%d_packet_frame_s=%.4f\ncells%d_packet_speedup=%.4f\ncells%d_packet_differ=%zu\n", r.cells, r.primaryPacket + r.shadowPacket,
+                    r.cells, (r.primary + r.shadow) / (r.primaryPacket + r.shadowPacket), r.cells, r.packetDiffer);
+    if (rows.size() >= 2) {
+        std::printf("scaling=%.4f\n", (rows.back().primary + rows.back().shadow) / (rows.front().primary + rows.front().shadow));
+        std::printf("packet_scaling=%.4f\n",
+                    (rows.back().primaryPacket + rows.back().shadowPacket) / (rows.front().primaryPacket + rows.front().shadowPacket));
+    }
     return 0;
 }

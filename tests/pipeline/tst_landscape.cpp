@@ -11,6 +11,7 @@
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <random>
 #include <vector>
 
@@ -23,6 +24,7 @@
 #include "core/render/render_scene.h"
 #include "core/render/shade.h"
 #include "core/render/tonemap.h"
+#include "core/render/trace_packet.h"
 #include "core/terrain/landscape.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/io/dem_io.h"
@@ -247,6 +249,131 @@ private Q_SLOTS:
             for (size_t i = 0; i < ia.size(); ++i) pix += glm::any(glm::greaterThan(glm::abs(ia[i] - ib[i]), glm::vec3(0.02f)));
             QVERIFY2(pix <= int(ia.size()) / 200, qPrintable(QString("%1 pixels differ").arg(pix)));
         }
+    }
+
+    // Packets (traceScenePacket) answer every ray as traceScene does alone, closest and any hit, BVH and kd-tree:
+    // a camera tile's rays (coherent), the sun's shadow rays from their hits, 64 random rays in all directions
+    // (the packet's order then suits none of them), rays straight down and along the axes (zero direction
+    // components), and packets of every size from 1 to 64.
+    void packetsAnswerAsSingleRays_data()
+    {
+        QTest::addColumn<int>("accel");
+        QTest::newRow("bvh") << int(AccelKind::Bvh);
+        QTest::newRow("kdtree") << int(AccelKind::KdTree);
+    }
+    void packetsAnswerAsSingleRays()
+    {
+        QFETCH(int, accel);
+        Scene land = landscape(97, hills, 6, 20.0);
+        land.render.accel = AccelKind(accel);
+        const RenderScene rs = buildRenderScene(land, m_assets, glm::vec3(1.0f));
+        const RenderView v = rs.view();
+        QVERIFY(v.landscapeEnabled);
+        std::mt19937 rng(11);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        int rays = 0, plantHits = 0, occluded = 0, differ = 0;
+        // Every ray of the packet against itself alone; a closest hit must agree in t and in what was hit.
+        auto check = [&](const std::vector<Ray>& packet) {
+            const int n = int(packet.size());
+            const size_t count = packet.size();
+            std::vector<Hit> hp(count), sp(count);
+            std::unique_ptr<bool[]> fp(new bool[size_t(n)]), op(new bool[size_t(n)]);
+            traceScenePacket<false>(v, packet.data(), n, hp.data(), fp.get());
+            traceScenePacket<true>(v, packet.data(), n, sp.data(), op.get());
+            for (int i = 0; i < n; ++i) {
+                Hit h{}, a{};
+                const bool f = traceScene<false>(v, packet[size_t(i)], h), o = traceScene<true>(v, packet[size_t(i)], a);
+                ++rays;
+                plantHits += f && h.inst == kLandscapeInst;
+                occluded += o;
+                const Hit& g = hp[size_t(i)];
+                const bool same = f == fp[size_t(i)] && o == op[size_t(i)] &&
+                                  (!f || (h.t == g.t && h.prim == g.prim && h.inst == g.inst &&
+                                          (h.inst != kLandscapeInst || (h.nested[0] == g.nested[0] && h.nested[1] == g.nested[1]))));
+                if (!same && differ++ < 5)
+                    qWarning("ray %d of a packet of %d: (%d %d, t %g, inst %x, prim %u, cell %u, plant %u) alone, (%d %d, t %g, inst %x, prim %u, cell %u, "
+                             "plant %u) in the packet",
+                             i, n, int(f), int(o), double(h.t), h.inst, h.prim, h.nested[0], h.nested[1], int(fp[size_t(i)]), int(op[size_t(i)]),
+                             double(g.t), g.inst, g.prim, g.nested[0], g.nested[1]);
+            }
+        };
+        // Camera tiles, and the sun's shadow rays from the surfaces they hit.
+        for (int ty = 0; ty < v.height; ty += 8)
+            for (int tx = 0; tx < v.width; tx += 8) {
+                std::vector<Ray> cam, sun;
+                for (int y = ty; y < std::min(ty + 8, v.height); ++y)
+                    for (int x = tx; x < std::min(tx + 8, v.width); ++x) cam.push_back(sampleRay(v, x, y, 0));
+                check(cam);
+                for (const Ray& r : cam) {
+                    Hit h{};
+                    if (traceScene<false>(v, r, h)) sun.push_back(sunShadowRay(v, surfaceStage(v, r, h)));
+                }
+                check(sun);
+            }
+        // Incoherent packets over the terrain, every size from 1 to 64.
+        for (int size = 1; size <= kPacketRays; ++size) {
+            std::vector<Ray> packet;
+            for (int i = 0; i < size; ++i) {
+                const glm::vec3 p(u(rng) * 96.0f, 3.0f + 14.0f * u(rng), u(rng) * 96.0f);
+                Ray r;
+                r.org = p - glm::vec3(land.camera.position);
+                r.dir = glm::normalize(glm::vec3(u(rng) - 0.5f, u(rng) - 0.7f, u(rng) - 0.5f));
+                r.tmin = 0.0f;
+                r.tmax = 1e30f;
+                packet.push_back(r);
+            }
+            check(packet);
+        }
+        // Zero direction components: straight down, and level along x and z.
+        for (int k = 0; k < 3; ++k) {
+            std::vector<Ray> packet;
+            for (int i = 0; i < 40; ++i) {
+                Ray r;
+                r.org = glm::vec3(8.0f + 2.0f * float(i), k == 0 ? 12.0f : 1.5f + 0.1f * float(i), 10.0f + 1.7f * float(i)) - glm::vec3(land.camera.position);
+                r.dir = k == 0 ? glm::vec3(0.0f, -1.0f, 0.0f) : (k == 1 ? glm::vec3(1.0f, 0.0f, 0.0f) : glm::vec3(0.0f, 0.0f, -1.0f));
+                r.tmin = 0.0f;
+                r.tmax = 1e30f;
+                packet.push_back(r);
+            }
+            check(packet);
+        }
+        qInfo("%d rays: %d hit plants, %d occluded; %d answered differently in a packet", rays, plantHits, occluded, differ);
+        QVERIFY(plantHits > rays / 10);
+        QVERIFY(occluded > rays / 4);
+        QCOMPARE(differ, 0);
+    }
+
+    // The CPU loop traces a landscape's tiles as packets: the film is bit for bit what shadePixel gives pixel by
+    // pixel (2 jittered samples, sun shadows), whole and as a rectangle not aligned with the 8 x 8 tiles.
+    void packetFilmEqualsPixelByPixel()
+    {
+        Scene land = landscape(97, hills, 6, 20.0);
+        land.render.spp = 2;
+        land.render.width = 45;
+        land.render.height = 29;
+        const RenderScene rs = buildRenderScene(land, m_assets, glm::vec3(1.0f));
+        const RenderView v = rs.view();
+        QVERIFY(v.landscapeEnabled && v.shadows);
+        const Film film = renderFilm(v);
+        const int x0 = 3, y0 = 5, x1 = 40, y1 = 26;
+        std::vector<SampleParts> rect(size_t(x1 - x0) * size_t(y1 - y0));
+        renderFilmRect(v, x0, y0, x1, y1, rect.data());
+        int differ = 0, plantPixels = 0;
+        auto same = [](const SampleParts& a, const SampleParts& b) {
+            return a.local == b.local && a.indirect == b.indirect && a.albedo == b.albedo && a.skyCover == b.skyCover && a.normal == b.normal &&
+                   a.depth == b.depth && a.background == b.background;
+        };
+        for (int y = 0; y < v.height; ++y)
+            for (int x = 0; x < v.width; ++x) {
+                const SampleParts p = shadePixel(v, x, y);
+                differ += !same(p, film.pixels[size_t(y) * size_t(v.width) + size_t(x)]);
+                if (x >= x0 && x < x1 && y >= y0 && y < y1) differ += !same(p, rect[size_t(y - y0) * size_t(x1 - x0) + size_t(x - x0)]);
+                Hit h{};
+                plantPixels += traceScene<false>(v, sampleRay(v, x, y, 0), h) && h.inst == kLandscapeInst;
+            }
+        qInfo("%d of %d pixels show plants; %d pixels differ", plantPixels, v.width * v.height, differ);
+        QVERIFY(plantPixels > v.width * v.height / 10);
+        QCOMPARE(differ, 0);
     }
 
     // Wang tiling of 64 x 64 cells with the 2 x 2 colour set: every shared edge matches; a tile repeats its left
