@@ -27,19 +27,23 @@ struct PacketFrame {
     alignas(32) float ix[kPacketRays], iy[kPacketRays], iz[kPacketRays];
     uint64_t zeroAxis = 0;   // rays with a zero direction component: box-tested one by one (rayBoxEntry's rule)
 
-    // Origins (o - base) * scale and reciprocal directions d * scale, for the first n rays (the others zero).
-    void set(int n, const glm::vec3* o, const glm::vec3* d, const glm::vec3& base, float scale)
+    // Reciprocal directions d * scale for the first n rays (the others zero): once for a packet in a frame's
+    // scale (the tile frames of all cells share theirs).
+    void setDirections(int n, const glm::vec3* d, float scale)
     {
         zeroAxis = 0;
         for (int i = 0; i < kPacketRays; ++i) {
-            if (i >= n) {
-                ox[i] = oy[i] = oz[i] = ix[i] = iy[i] = iz[i] = 0.0f;
-                continue;
-            }
-            const glm::vec3 po = (o[i] - base) * scale, inv = safeReciprocal(d[i] * scale);
-            ox[i] = po.x, oy[i] = po.y, oz[i] = po.z;
+            const glm::vec3 inv = i < n ? safeReciprocal(d[i] * scale) : glm::vec3(0.0f);
             ix[i] = inv.x, iy[i] = inv.y, iz[i] = inv.z;
-            if (fabsf(inv.x) == 1e30f || fabsf(inv.y) == 1e30f || fabsf(inv.z) == 1e30f) zeroAxis |= uint64_t(1) << i;
+            if (i < n && (fabsf(inv.x) == 1e30f || fabsf(inv.y) == 1e30f || fabsf(inv.z) == 1e30f)) zeroAxis |= uint64_t(1) << i;
+        }
+    }
+    // Origins (o - base) * scale for the first n rays (the others zero).
+    void setOrigins(int n, const glm::vec3* o, const glm::vec3& base, float scale)
+    {
+        for (int i = 0; i < kPacketRays; ++i) {
+            const glm::vec3 po = i < n ? (o[i] - base) * scale : glm::vec3(0.0f);
+            ox[i] = po.x, oy[i] = po.y, oz[i] = po.z;
         }
     }
     glm::vec3 org(int i) const { return glm::vec3(ox[i], oy[i], oz[i]); }
@@ -128,7 +132,7 @@ struct LandPacket {
                     float* segMax)
     {
         const LandCellFrame f(v, c, cx, cz);
-        tile.set(n, o, d, f.corner, f.ik);
+        tile.setOrigins(n, o, f.corner, f.ik);   // its directions: set once (tracePacket)
         auto test = [&](const TileNode& node, uint64_t m) {
             glm::vec3 lo, hi;
             f.nodeBox(node, lo, hi);
@@ -259,7 +263,9 @@ inline void tracePacket(const RenderView& v, const Ray* rays, int n, Hit* hits, 
         P.meanDir += r.dir;
     }
     if (live != 0) {
-        P.world.set(n, o, d, glm::vec3(0.0f), 1.0f);
+        P.world.setOrigins(n, o, glm::vec3(0.0f), 1.0f);
+        P.world.setDirections(n, d, 1.0f);
+        P.tile.setDirections(n, d, v.land.invTileScale);
         P.walk(live);
     }
     for (int i = 0; i < n; ++i) {

@@ -8,7 +8,7 @@
 // broadcastScene false, each rank builds its own frame from the species assets in the shared grid
 // cache), then cuts the rows into tiles (mpi_tiles.h: 32 x 32, smaller when a
 // frame has few per rank, quarters at the end of the queue) and hands them from a work queue to the
-// ranks that ask, two ahead; rank 0 traces tiles too between its messages. A tile is renderFilmRect, shadePixel per pixel, so the picture is bit-identical to a
+// ranks that ask, two ahead; rank 0 traces tiles too between its messages. A tile is renderFilmRect, shadePixel's parts per pixel, so the picture is bit-identical to a
 // single-process CPU render at any rank count. Rank 0 gathers, composes and writes with the
 // single-process writer.
 //
