@@ -201,13 +201,34 @@ SYLVA_HD inline bool traceLandTile(Query& q, uint32_t cell, uint32_t cx, uint32_
     }
 }
 
-// The box of the cell tree's node n over cells [x0, x1) x [z0, z1): camera-relative, its ground and tiles' range.
-SYLVA_HD SYLVA_INLINE void landNodeBox(const RenderView& v, const LandNode& n, uint32_t x0, uint32_t z0, uint32_t x1, uint32_t z1, glm::vec3& lo,
-                                       glm::vec3& hi)
+// A node of the cells' 2D kd-tree and the cells it covers, [x0, x1) x [z0, z1).
+struct LandRange {
+    uint32_t node, x0, z0, x1, z1;
+};
+
+// The node's box: camera-relative, its ground and tiles' range.
+SYLVA_HD SYLVA_INLINE void landNodeBox(const RenderView& v, const LandRange& r, glm::vec3& lo, glm::vec3& hi)
 {
-    const glm::vec3 a = landCellCorner(v, x0, z0), b = landCellCorner(v, x1, z1);
+    const LandNode& n = v.landNodes[r.node];
+    const glm::vec3 a = landCellCorner(v, r.x0, r.z0), b = landCellCorner(v, r.x1, r.z1);
     lo = glm::vec3(a.x, v.landBase.y + n.range.x, a.z);
     hi = glm::vec3(b.x, v.landBase.y + n.range.y, b.z);
+}
+
+// An inner node's children (its longer side halved), the near one first along direction d.
+SYLVA_HD SYLVA_INLINE void landChildren(const LandNode& n, const LandRange& r, const glm::vec3& d, LandRange& nearChild, LandRange& farChild)
+{
+    LandRange a{n.child, r.x0, r.z0, r.x1, r.z1}, b{n.child + 1, r.x0, r.z0, r.x1, r.z1};
+    bool farIsLow;
+    if (r.x1 - r.x0 >= r.z1 - r.z0) {
+        a.x1 = b.x0 = (r.x0 + r.x1) / 2;
+        farIsLow = d.x < 0.0f;
+    } else {
+        a.z1 = b.z0 = (r.z0 + r.z1) / 2;
+        farIsLow = d.z < 0.0f;
+    }
+    nearChild = farIsLow ? b : a;
+    farChild = farIsLow ? a : b;
 }
 
 // Cell `cell`'s plants along the ray's segment in its column (landCellSegment; iw = safeReciprocal(d)). A hit
@@ -239,35 +260,23 @@ SYLVA_HD inline bool traceLandscape(Query& q, const glm::vec3& o, const glm::vec
 {
     const RenderView& v = q.v;
     const glm::vec3 inv = safeReciprocal(d);
-    struct Entry {
-        uint32_t node, x0, z0, x1, z1;
-    };
-    Entry stack[96];
+    LandRange stack[96];
     int top = 0;
-    stack[top++] = Entry{0, 0, 0, v.land.cellsX, v.land.cellsZ};
+    stack[top++] = LandRange{0, 0, 0, v.land.cellsX, v.land.cellsZ};
     q.path[0] = kLandscapeInst;
     while (top > 0) {
-        const Entry e = stack[--top];
+        const LandRange e = stack[--top];
         const LandNode& n = v.landNodes[e.node];
         SYLVA_COUNT(g_landNodeVisits);
         glm::vec3 lo, hi;
-        landNodeBox(v, n, e.x0, e.z0, e.x1, e.z1, lo, hi);
+        landNodeBox(v, e, lo, hi);
         if (!(rayBoxEntry(lo, hi, o, inv, q.tmin, tmax) <= tmax)) continue;
         if (n.child == 0) {
             if (traceLandCell<AnyHit, Kd>(q, e.z0 * v.land.cellsX + e.x0, o, d, inv, tmax)) return true;
             continue;
         }
-        Entry a{n.child, e.x0, e.z0, e.x1, e.z1}, b{n.child + 1, e.x0, e.z0, e.x1, e.z1};
-        bool farIsLow;
-        if (e.x1 - e.x0 >= e.z1 - e.z0) {
-            a.x1 = b.x0 = (e.x0 + e.x1) / 2;
-            farIsLow = d.x < 0.0f;
-        } else {
-            a.z1 = b.z0 = (e.z0 + e.z1) / 2;
-            farIsLow = d.z < 0.0f;
-        }
-        stack[top++] = farIsLow ? a : b;
-        stack[top++] = farIsLow ? b : a;
+        landChildren(n, e, d, stack[top + 1], stack[top]);   // the far one deferred
+        top += 2;
     }
     return false;
 }

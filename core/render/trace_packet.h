@@ -205,37 +205,28 @@ struct LandPacket {
     // The cell tree, top-down, near child first along the packet's direction (traceLandscape for each ray).
     void walk(uint64_t active)
     {
-        struct Entry {
-            uint32_t node, x0, z0, x1, z1;
-            uint64_t mask;
-        };
-        Entry stack[96];
+        LandRange stack[96];
+        uint64_t stackMask[96];
         int top = 0;
-        stack[top++] = Entry{0, 0, 0, v.land.cellsX, v.land.cellsZ, active};
+        stack[top] = LandRange{0, 0, 0, v.land.cellsX, v.land.cellsZ};
+        stackMask[top++] = active;
         while (top > 0) {
-            const Entry e = stack[--top];
-            const uint64_t live = e.mask & ~done;
+            --top;
+            const LandRange e = stack[top];
+            const uint64_t live = stackMask[top] & ~done;
             if (live == 0) continue;
             const LandNode& nd = v.landNodes[e.node];
             glm::vec3 lo, hi;
-            landNodeBox(v, nd, e.x0, e.z0, e.x1, e.z1, lo, hi);
+            landNodeBox(v, e, lo, hi);
             const uint64_t m = packetBoxMask(lo, hi, world, tmin, tmax, live);
             if (m == 0) continue;
             if (nd.child == 0) {
                 cell(e.z0 * v.land.cellsX + e.x0, m);
                 continue;
             }
-            Entry a{nd.child, e.x0, e.z0, e.x1, e.z1, m}, b{nd.child + 1, e.x0, e.z0, e.x1, e.z1, m};
-            bool farIsLow;
-            if (e.x1 - e.x0 >= e.z1 - e.z0) {
-                a.x1 = b.x0 = (e.x0 + e.x1) / 2;
-                farIsLow = meanDir.x < 0.0f;
-            } else {
-                a.z1 = b.z0 = (e.z0 + e.z1) / 2;
-                farIsLow = meanDir.z < 0.0f;
-            }
-            stack[top++] = farIsLow ? a : b;
-            stack[top++] = farIsLow ? b : a;
+            landChildren(nd, e, meanDir, stack[top + 1], stack[top]);   // the far one deferred
+            stackMask[top] = stackMask[top + 1] = m;
+            top += 2;
         }
     }
 };
