@@ -19,13 +19,19 @@ SYLVA_HD SYLVA_INLINE glm::vec3 landCellCorner(const RenderView& v, uint32_t cx,
     return v.landBase + glm::vec3(float(int(cx) - v.landBaseCell.x) * v.land.cellSize, 0.0f, float(int(cz) - v.landBaseCell.y) * v.land.cellSize);
 }
 
+// Plant p's root (camera-relative) in the cell whose corner is `corner`, standing at DEM-frame height y.
+SYLVA_HD SYLVA_INLINE glm::vec3 landRootAt(const RenderView& v, const glm::vec3& corner, const TilePlant& p, float y)
+{
+    return corner + glm::vec3(v.land.tileScale * p.x, y, v.land.tileScale * p.z);
+}
+
 // Plant `plant` (tilePlants) of cell `cell`: whether it grows there, and its root (camera-relative).
 SYLVA_HD inline bool landPlantRoot(const RenderView& v, uint32_t cell, const TilePlant& p, glm::vec3& root)
 {
     const uint32_t cx = cell % v.land.cellsX, cz = cell / v.land.cellsX;
     float y;
     if (!landPlantGrows(v.land, landHeights(v), v.terrainSnowY, v.terrainRockCos, cx, cz, p, y)) return false;
-    root = landCellCorner(v, cx, cz) + glm::vec3(v.land.tileScale * p.x, y, v.land.tileScale * p.z);
+    root = landRootAt(v, landCellCorner(v, cx, cz), p, y);
     return true;
 }
 
@@ -184,7 +190,7 @@ SYLVA_HD inline bool traceLandTile(Query& q, uint32_t cell, uint32_t cx, uint32_
                 float y;
                 uint32_t tri;
                 if (!landPlantHeight(v.land, heights, cx, cz, p, y, tri)) continue;
-                const glm::vec3 root = f.corner + glm::vec3(v.land.tileScale * p.x, y, v.land.tileScale * p.z);
+                const glm::vec3 root = landRootAt(v, f.corner, p, y);
                 const glm::vec3 op = (o - root) * ik;   // the plant-centred tile frame
                 if (!(rayBoxEntry(p.lo, p.hi, op, inv, q.tmin, tmax) <= tmax)) continue;
                 if (!landPlantKept(v.land, heights, v.terrainSnowY, v.terrainRockCos, p, y, tri)) continue;

@@ -153,6 +153,7 @@ struct LandPacket {
                 if (ma != 0 && mb != 0) {
                     // The child whose centre lies behind along the packet's direction first.
                     const bool aFirst = (b.lox + b.hix - a.lox - a.hix) * meanDir.x + (b.loz + b.hiz - a.loz - a.hiz) * meanDir.z >= 0.0f;
+                    SYLVA_KERNEL_ASSERT(top < 64);
                     stackNode[top] = aFirst ? nd.first + 1 : nd.first;
                     stackMask[top] = aFirst ? mb : ma;
                     ++top;
@@ -174,7 +175,7 @@ struct LandPacket {
                     float y;
                     uint32_t tri;
                     if (!landPlantHeight(v.land, heights, cx, cz, p, y, tri)) continue;
-                    const glm::vec3 root = f.corner + glm::vec3(v.land.tileScale * p.x, y, v.land.tileScale * p.z);
+                    const glm::vec3 root = landRootAt(v, f.corner, p, y);
                     int kept = -1;
                     for (; m != 0; m &= m - 1) {
                         const int i = __builtin_ctzll(m);
