@@ -50,7 +50,9 @@ PackedFrame packedFrameLayout(const RenderSceneHeader& h)
     PackedFrame L{};
     uint64_t at = 0;
     size_t i = 0;
-#define SYLVA_X(part, where, T, name, stat) L.offset[i] = at, at += (uint64_t(h.counts[i]) * sizeof(T) + 63u) & ~uint64_t(63u), ++i;
+#define SYLVA_X(part, where, T, name, stat)                                                                                                    \
+    static_assert(alignof(T) <= 64, "an array's type is aligned beyond the packed frame's 64-byte boundaries");                                \
+    L.offset[i] = at, at += (uint64_t(h.counts[i]) * sizeof(T) + 63u) & ~uint64_t(63u), ++i;
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
     L.bytes = at;

@@ -53,7 +53,8 @@ void forEachRenderSceneArray(Scene& rs, Fn&& fn)
 
 // ---- one frame shared by the processes of a host (sylva render --mpi) ----
 // The arrays packed one after another into one block, each at a 64-byte boundary, so that the ranks on one
-// host map a single copy of the frame (an MPI shared-memory window) instead of holding one each.
+// host map a single copy of the frame (an MPI shared-memory window) instead of holding one each. The block
+// itself must start at a 64-byte boundary (types such as TilePlant are over-aligned).
 struct PackedFrame {
     uint64_t offset[kRenderSceneArrays];   // of each array in SYLVA_RENDER_ARRAYS order
     uint64_t bytes;                        // the whole block

@@ -281,11 +281,16 @@ public:
         const Deadline deadline(timeout, jobError("--mpi: the ranks of a host did not all make room for the frame within the timeout (a rank hung or died)"));
         m_node = hosts.node;
         void* mine = nullptr;
-        check(MPI_Win_allocate_shared(MPI_Aint(hosts.nodeRank == 0 ? std::max<uint64_t>(bytes, 1) : 0), 1, MPI_INFO_NULL, m_node, &mine, &m_win),
+        // 64 bytes more than the frame: OpenMPI's segment starts 8 bytes into a page, and the packed arrays want
+        // their 64-byte boundaries (types such as TilePlant are over-aligned). The segment's offset within a page
+        // is the same on every rank, so each rounds its mapping's address up to the same place.
+        check(MPI_Win_allocate_shared(MPI_Aint(hosts.nodeRank == 0 ? bytes + kBlockAlign : 0), 1, MPI_INFO_NULL, m_node, &mine, &m_win),
               "Win_allocate_shared");
         MPI_Aint size = 0;
         int unit = 0;
-        check(MPI_Win_shared_query(m_win, 0, &size, &unit, &m_block), "Win_shared_query");
+        void* base = nullptr;
+        check(MPI_Win_shared_query(m_win, 0, &size, &unit, &base), "Win_shared_query");
+        m_block = reinterpret_cast<void*>((reinterpret_cast<uintptr_t>(base) + kBlockAlign - 1) & ~uintptr_t(kBlockAlign - 1));
         // One passive epoch for the frame's life: MPI_Win_sync orders the writes before the host's barrier.
         check(MPI_Win_lock_all(MPI_MODE_NOCHECK, m_win), "Win_lock_all");
     }
@@ -318,9 +323,10 @@ private:
         throw Error(msg);
     }
 
+    static constexpr uint64_t kBlockAlign = 64;   // packedFrameLayout's boundary
     MPI_Comm m_node = MPI_COMM_NULL;
     MPI_Win m_win = MPI_WIN_NULL;
-    void* m_block = nullptr;
+    void* m_block = nullptr;   // the window's segment, rounded up to kBlockAlign
 };
 
 // Rank 0's arrays to the first rank of every other host, array by array as forEachPackedArray receives them
