@@ -13,6 +13,10 @@ inline thread_local uint64_t g_bvhNodeVisits = 0, g_bvhLeafVisits = 0, g_triangl
 inline thread_local uint64_t g_terrainBlockVisits = 0, g_terrainCellTests = 0;
 inline thread_local uint64_t g_landNodeVisits = 0, g_landCellVisits = 0, g_tileNodeVisits = 0;
 inline thread_local uint64_t g_plantBoxTests = 0, g_plantRootReads = 0, g_plantMeshEntries = 0;
+// Packets (trace_packet.h): box tests of the cell tree, cells entered, tile nodes and plant boxes tested (each a test
+// of all the packet's live rays; *_lanes: the rays tested), plant roots read.
+inline thread_local uint64_t g_pkLandTests = 0, g_pkLandLanes = 0, g_pkCells = 0, g_pkCellLanes = 0, g_pkTileTests = 0, g_pkTileLanes = 0;
+inline thread_local uint64_t g_pkPlantTests = 0, g_pkPlantLanes = 0, g_pkRootReads = 0;
 #define SYLVA_COUNT(counter) (++(counter))
 #define SYLVA_COUNT_ADD(counter, n) ((counter) += (n))
 #else

@@ -77,16 +77,17 @@ struct TileNode {
 
 // A plant of a tile: the map from its plant-centred tile frame (root at the origin, tile metres) to its
 // geometry (rotation about +Y and 1 / scale, as an InstanceRecord's rows), its root (x, z) in the tile
-// frame and its box in the plant-centred frame. densityId = id_inst + id_tile of eq. 2. 96 bytes.
-struct TilePlant {
-    glm::vec4 row[3];
-    uint32_t geometry;
-    float scale;
+// frame and its box in the plant-centred frame. densityId = id_inst + id_tile of eq. 2. 96 bytes; what a box
+// test reads (x, z, lo, hi: the first 32 bytes, the array 32-byte aligned) lies in one cache line.
+struct alignas(32) TilePlant {
     float x, z;
     glm::vec3 lo;
-    uint32_t densityId;
     glm::vec3 hi;
+    uint32_t densityId;
     uint32_t species;
+    uint32_t geometry;
+    float scale;
+    glm::vec4 row[3];
 };
 static_assert(sizeof(TilePlant) == 96);
 

@@ -187,6 +187,21 @@ void countPerRay(const char* what, int cells, size_t rays, Fn&& trace)
     std::printf("\n");
     for (size_t k = 0; k < std::size(c); ++k) std::printf("cells%d_%s_%s_per_ray=%.3f\n", cells, what, name[k], double(*c[k]) / double(std::max<size_t>(rays, 1)));
 }
+
+// The work per packet (the packet counters of core/base/traversal_stats.h), counted on this thread.
+template <class Fn>
+void countPerPacket(const char* what, int cells, size_t packets, Fn&& trace)
+{
+    uint64_t* const c[] = {&g_pkLandTests, &g_pkLandLanes, &g_pkCells, &g_pkCellLanes, &g_pkTileTests, &g_pkTileLanes, &g_pkPlantTests, &g_pkPlantLanes,
+                           &g_pkRootReads, &g_plantMeshEntries};
+    const char* const name[] = {"land_tests", "land_lanes", "cells", "cell_lanes", "tile_tests", "tile_lanes", "plant_tests", "plant_lanes", "root_reads",
+                                "plant_mesh_entries"};
+    for (uint64_t* p : c) *p = 0;
+    trace();
+    std::printf("%4d^2 cells, %s packets (%zu), per packet:", cells, what, packets);
+    for (size_t k = 0; k < std::size(c); ++k) std::printf(" %s %.2f", name[k], double(*c[k]) / double(std::max<size_t>(packets, 1)));
+    std::printf("\n");
+}
 #endif
 
 } // namespace
@@ -353,6 +368,15 @@ int main(int argc, char** argv)
                 Hit h{};
                 traceScene<true>(v, sh[i], h);
             }
+        });
+        countPerPacket("primary", n, tiles, [&] {
+            for (size_t t = 0; t < tiles; ++t)
+                traceScenePacket<false>(v, &cam[camStart[t]], int(camStart[t + 1] - camStart[t]), &hitsP[camStart[t]], &gotP[camStart[t]]);
+        });
+        countPerPacket("shadow", n, tiles, [&] {
+            for (size_t t = 0; t < tiles; ++t)
+                if (shStart[t + 1] > shStart[t])
+                    traceScenePacket<true>(v, &sh[shStart[t]], int(shStart[t + 1] - shStart[t]), &shHits[shStart[t]], &occP[shStart[t]]);
         });
 #endif
         std::printf("%4d^2 cells: build %.2f s (landscape %.3f s), %.1f MB (landscape %.1f MB); %.3g instances, %.3g triangles potentially "
