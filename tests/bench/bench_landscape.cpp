@@ -3,8 +3,8 @@
 // leaves), a panorama over the terrain. Per cell count: build time, memory, potentially visible instances and
 // triangles (with and without the density rule's thinning), primary, shadow and frame time; the scaling
 // time(512^2) / time(64^2); the same rays traced ray by ray (traceScene) and an 8x8 tile at a time (traceScenePacket,
-// as the CPU renderer traces a landscape), and with --embree beside Embree 3's single rays and streams. Ends with
-// name=value lines.
+// as the CPU renderer traces a landscape), and with --embree beside Embree 3's single rays and streams; the scaling
+// again from the first and last counts' frames timed in turn (--pairs). Ends with name=value lines.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -40,6 +40,49 @@ struct Row {
     int cells;
     double build, landscapeBuild, mb, landscapeMb, instances, triangles, keptFraction, primary, shadow, primaryPacket, shadowPacket;
     size_t hits, occluded, packetDiffer;
+};
+
+// The first and last cell counts' scenes and rays, kept for the scaling's paired timing: the two frames alternate,
+// so drift in the machine's speed (this VM's drifts by 1.5x) falls on both alike.
+struct KeptFrame {
+    int cells = 0;
+    std::unique_ptr<RenderScene> rs;
+    std::vector<Ray> cam, sh;
+    std::vector<size_t> camStart, shStart;
+
+    // One frame of packets, primary then shadow, seconds.
+    double packetFrame()
+    {
+        const RenderView v = rs->view();
+        std::vector<Hit> hits(cam.size()), shHits(sh.size());
+        std::unique_ptr<bool[]> got(new bool[std::max<size_t>(cam.size(), 1)]), occ(new bool[std::max<size_t>(sh.size(), 1)]);
+        const double t0 = bench::now();
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, camStart.size() - 1, 1), [&](const tbb::blocked_range<size_t>& b) {
+            for (size_t t = b.begin(); t != b.end(); ++t)
+                traceScenePacket<false>(v, &cam[camStart[t]], int(camStart[t + 1] - camStart[t]), &hits[camStart[t]], &got[camStart[t]]);
+        });
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, shStart.size() - 1, 1), [&](const tbb::blocked_range<size_t>& b) {
+            for (size_t t = b.begin(); t != b.end(); ++t)
+                if (shStart[t + 1] > shStart[t])
+                    traceScenePacket<true>(v, &sh[shStart[t]], int(shStart[t + 1] - shStart[t]), &shHits[shStart[t]], &occ[shStart[t]]);
+        });
+        return bench::now() - t0;
+    }
+    // The same frame a ray at a time (traceScene), seconds.
+    double singleFrame()
+    {
+        const RenderView v = rs->view();
+        const double t0 = bench::now();
+        for (const std::vector<Ray>* rays : {&cam, &sh})
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, rays->size(), 64), [&](const tbb::blocked_range<size_t>& b) {
+                for (size_t i = b.begin(); i != b.end(); ++i) {
+                    Hit h{};
+                    if (rays == &cam) traceScene<false>(v, (*rays)[i], h);
+                    else traceScene<true>(v, (*rays)[i], h);
+                }
+            });
+        return bench::now() - t0;
+    }
 };
 
 // The share of plants the density rule keeps: every plant of every 8th cell along each axis.
@@ -209,7 +252,7 @@ void countPerPacket(const char* what, int cells, size_t packets, Fn&& trace)
 int main(int argc, char** argv)
 {
     std::string scenePath = std::string(SYLVA_SOURCE_DIR) + "/resources/landscape.sylva.json";
-    int reps = 3, threads = 0, width = 640, height = 480;
+    int reps = 3, threads = 0, width = 640, height = 480, pairs = -1;
     double spacing = 41.0, plantSpacing = 0.36;
     std::vector<int> cellCounts = {64, 128, 256, 512};
     std::vector<int> embreeCells;   // --embree: these cell counts flattened into Embree beside ours
@@ -221,6 +264,7 @@ int main(int argc, char** argv)
         else if (s == "--spacing" && more) spacing = std::atof(argv[++a]);
         else if (s == "--plant-spacing" && more) plantSpacing = std::atof(argv[++a]);
         else if (s == "--reps" && more) reps = std::max(1, std::atoi(argv[++a]));
+        else if (s == "--pairs" && more) pairs = std::max(0, std::atoi(argv[++a]));
         else if (s == "--threads" && more) threads = std::max(1, std::atoi(argv[++a]));
         else if (s == "--width" && more) width = std::max(8, std::atoi(argv[++a]));
         else if (s == "--height" && more) height = std::max(8, std::atoi(argv[++a]));
@@ -234,11 +278,12 @@ int main(int argc, char** argv)
             for (std::string item; std::getline(ss, item, ',');) cellCounts.push_back(std::max(1, std::atoi(item.c_str())));
         } else {
             std::printf("usage: bench_landscape [--scene PATH] [--spacing M] [--plant-spacing F] [--cells 64,128,256,512] [--reps N]\n"
-                        "                       [--threads N] [--width W] [--height H] [--embree 16,32,64] [--embree-cap-gb G]\n"
+                        "                       [--threads N] [--width W] [--height H] [--embree 16,32,64] [--embree-cap-gb G] [--pairs N]\n"
                         "  default: resources/landscape.sylva.json, its DEM stretched to 41 m spacing (82 km), the tiles' plant\n"
                         "  spacings x 0.36 (the seed's plant density), 640x480, one primary + one shadow ray per pixel;\n"
                         "  --embree: the landscape flattened into Embree 3 at those cell counts (terrain mesh + every plant an\n"
-                        "  instance, built until Embree holds more than the cap, default 8 GB), same rays, side by side\n");
+                        "  instance, built until Embree holds more than the cap, default 8 GB), same rays, side by side;\n"
+                        "  --pairs: the first and last cell counts' frames timed in turn for the scaling (default 3 x reps)\n");
             return s == "--help" ? 0 : 2;
         }
     }
@@ -272,11 +317,14 @@ int main(int argc, char** argv)
                 scenePath.c_str(), hf.layout.nx, hf.layout.nz, spacing, W / 1000.0, D / 1000.0, plantSpacing, width, height, threadsUsed, reps,
                 assetSeconds);
 
+    if (pairs < 0) pairs = 3 * reps;
     std::vector<Row> rows;
+    KeptFrame kept[2];
     for (int n : cellCounts) {
         scene.terrain.cells = n;
         const double t0 = bench::now();
-        const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
+        auto owned = std::make_unique<RenderScene>(buildRenderScene(scene, assets, sunRadiance(scene.sun)));
+        const RenderScene& rs = *owned;
         const double build = bench::now() - t0;
         const RenderView v = rs.view();
         const AccelStats& st = rs.stats();
@@ -389,6 +437,8 @@ int main(int argc, char** argv)
                     r.packetDiffer, np + sh.size());
         std::fflush(stdout);
         rows.push_back(r);
+        if (cellCounts.size() >= 2 && (n == cellCounts.front() || n == cellCounts.back()))
+            kept[n == cellCounts.back()] = KeptFrame{n, std::move(owned), cam, sh, camStart, shStart};
 #ifdef SYLVA_HAVE_EMBREE
         if (std::find(embreeCells.begin(), embreeCells.end(), n) == embreeCells.end()) continue;
         // The same rays through Embree holding the landscape flattened; ours timed again beside it (same run).
@@ -532,6 +582,27 @@ int main(int argc, char** argv)
         std::printf("scaling=%.4f\n", (rows.back().primary + rows.back().shadow) / (rows.front().primary + rows.front().shadow));
         std::printf("packet_scaling=%.4f\n",
                     (rows.back().primaryPacket + rows.back().shadowPacket) / (rows.front().primaryPacket + rows.front().shadowPacket));
+    }
+    if (kept[0].rs && kept[1].rs && pairs > 0) {
+        // The scaling again, each pair's frames taken one right after the other, packets and single rays.
+        auto median = [](std::vector<double> x) {
+            std::sort(x.begin(), x.end());
+            return x.size() % 2 ? x[x.size() / 2] : 0.5 * (x[x.size() / 2 - 1] + x[x.size() / 2]);
+        };
+        for (const bool packets : {true, false}) {
+            std::vector<double> t0, t1, ratio;
+            for (int k = 0; k < pairs; ++k) {
+                t0.push_back(packets ? kept[0].packetFrame() : kept[0].singleFrame());
+                t1.push_back(packets ? kept[1].packetFrame() : kept[1].singleFrame());
+                ratio.push_back(t1.back() / t0.back());
+            }
+            const auto [lo, hi] = std::minmax_element(ratio.begin(), ratio.end());
+            std::printf("paired %s frames, %d pairs: %d^2 %.3f s, %d^2 %.3f s (medians); time(%d^2) / time(%d^2) %.3f (median of the pairs' "
+                        "ratios, %.3f-%.3f)\n",
+                        packets ? "packet" : "single-ray", pairs, kept[0].cells, median(t0), kept[1].cells, median(t1), kept[1].cells, kept[0].cells,
+                        median(ratio), *lo, *hi);
+            std::printf("%s_paired=%.4f\n", packets ? "packet_scaling" : "scaling", median(ratio));
+        }
     }
     return 0;
 }
