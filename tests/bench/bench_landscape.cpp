@@ -42,30 +42,47 @@ struct Row {
     size_t hits, occluded, packetDiffer;
 };
 
-// The first and last cell counts' scenes and rays, kept for the scaling's paired timing: the two frames alternate,
-// so drift in the machine's speed (this VM's drifts by 1.5x) falls on both alike.
-struct KeptFrame {
+// A cell count's scene and its frame's rays in the renderer's order (8x8 tiles; camStart / shStart: each tile's
+// first camera / shadow ray), traced a tile at a time into hits / got and shHits / occ. The first and last counts'
+// are kept for the scaling's paired timing: their frames alternate, so drift in the machine's speed (this VM's
+// drifts by 1.5x) falls on both alike.
+struct FrameRun {
     int cells = 0;
     std::unique_ptr<RenderScene> rs;
     std::vector<Ray> cam, sh;
     std::vector<size_t> camStart, shStart;
+    std::vector<Hit> hits, shHits;
+    std::unique_ptr<bool[]> got, occ;
 
-    // One frame of packets, primary then shadow, seconds.
-    double packetFrame()
+    FrameRun(int n, std::unique_ptr<RenderScene> scene, std::vector<Ray> camera, std::vector<Ray> shadow, std::vector<size_t> camTiles,
+             std::vector<size_t> shTiles)
+        : cells(n), rs(std::move(scene)), cam(std::move(camera)), sh(std::move(shadow)), camStart(std::move(camTiles)), shStart(std::move(shTiles)),
+          hits(cam.size()), shHits(sh.size()), got(new bool[std::max<size_t>(cam.size(), 1)]), occ(new bool[std::max<size_t>(sh.size(), 1)])
+    {
+    }
+    void primaryPackets()
     {
         const RenderView v = rs->view();
-        std::vector<Hit> hits(cam.size()), shHits(sh.size());
-        std::unique_ptr<bool[]> got(new bool[std::max<size_t>(cam.size(), 1)]), occ(new bool[std::max<size_t>(sh.size(), 1)]);
-        const double t0 = bench::now();
         tbb::parallel_for(tbb::blocked_range<size_t>(0, camStart.size() - 1, 1), [&](const tbb::blocked_range<size_t>& b) {
             for (size_t t = b.begin(); t != b.end(); ++t)
                 traceScenePacket<false>(v, &cam[camStart[t]], int(camStart[t + 1] - camStart[t]), &hits[camStart[t]], &got[camStart[t]]);
         });
+    }
+    void shadowPackets()
+    {
+        const RenderView v = rs->view();
         tbb::parallel_for(tbb::blocked_range<size_t>(0, shStart.size() - 1, 1), [&](const tbb::blocked_range<size_t>& b) {
             for (size_t t = b.begin(); t != b.end(); ++t)
                 if (shStart[t + 1] > shStart[t])
                     traceScenePacket<true>(v, &sh[shStart[t]], int(shStart[t + 1] - shStart[t]), &shHits[shStart[t]], &occ[shStart[t]]);
         });
+    }
+    // One frame of packets, primary then shadow, seconds.
+    double packetFrame()
+    {
+        const double t0 = bench::now();
+        primaryPackets();
+        shadowPackets();
         return bench::now() - t0;
     }
     // The same frame a ray at a time (traceScene), seconds.
@@ -319,7 +336,7 @@ int main(int argc, char** argv)
 
     if (pairs < 0) pairs = 3 * reps;
     std::vector<Row> rows;
-    KeptFrame kept[2];
+    std::unique_ptr<FrameRun> kept[2];
     for (int n : cellCounts) {
         scene.terrain.cells = n;
         const double t0 = bench::now();
@@ -381,29 +398,18 @@ int main(int argc, char** argv)
                        });
                    }).median;
         for (char c : occ) r.occluded += c != 0;
-        // The same rays a tile at a time through traceScenePacket; every answer compared with the ray alone.
-        std::vector<Hit> hitsP(np);
-        std::unique_ptr<bool[]> gotP(new bool[np]), occP(new bool[std::max<size_t>(sh.size(), 1)]);
-        std::vector<Hit> shHits(sh.size());
-        auto primaryPackets = [&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& b) {
-                for (size_t t = b.begin(); t != b.end(); ++t)
-                    traceScenePacket<false>(v, &cam[camStart[t]], int(camStart[t + 1] - camStart[t]), &hitsP[camStart[t]], &gotP[camStart[t]]);
-            });
-        };
-        auto shadowPackets = [&] {
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, tiles, 1), [&](const tbb::blocked_range<size_t>& b) {
-                for (size_t t = b.begin(); t != b.end(); ++t)
-                    if (shStart[t + 1] > shStart[t])
-                        traceScenePacket<true>(v, &sh[shStart[t]], int(shStart[t + 1] - shStart[t]), &shHits[shStart[t]], &occP[shStart[t]]);
-            });
-        };
+        // The same rays a tile at a time through traceScenePacket; every answer compared with the ray alone. The
+        // run owns the scene from here (rs stays where it is).
+        auto run = std::make_unique<FrameRun>(n, std::move(owned), cam, sh, camStart, shStart);
+        FrameRun& R = *run;
+        auto primaryPackets = [&] { R.primaryPackets(); };
+        auto shadowPackets = [&] { R.shadowPackets(); };
         r.primaryPacket = bench::timeReps(reps, primaryPackets).median;
         r.shadowPacket = bench::timeReps(reps, shadowPackets).median;
         r.packetDiffer = 0;
         for (size_t i = 0; i < np; ++i)
-            r.packetDiffer += (got[i] != 0) != gotP[i] || (gotP[i] && (hits[i].t != hitsP[i].t || hits[i].prim != hitsP[i].prim));
-        for (size_t i = 0; i < sh.size(); ++i) r.packetDiffer += (occ[i] != 0) != occP[i];
+            r.packetDiffer += (got[i] != 0) != R.got[i] || (R.got[i] && (hits[i].t != R.hits[i].t || hits[i].prim != R.hits[i].prim));
+        for (size_t i = 0; i < sh.size(); ++i) r.packetDiffer += (occ[i] != 0) != R.occ[i];
 #if defined(SYLVA_TRAVERSAL_STATS)
         countPerRay("primary", n, np, [&] {
             for (size_t i = 0; i < np; ++i) {
@@ -417,15 +423,12 @@ int main(int argc, char** argv)
                 traceScene<true>(v, sh[i], h);
             }
         });
-        countPerPacket("primary", n, tiles, [&] {
-            for (size_t t = 0; t < tiles; ++t)
-                traceScenePacket<false>(v, &cam[camStart[t]], int(camStart[t + 1] - camStart[t]), &hitsP[camStart[t]], &gotP[camStart[t]]);
-        });
-        countPerPacket("shadow", n, tiles, [&] {
-            for (size_t t = 0; t < tiles; ++t)
-                if (shStart[t + 1] > shStart[t])
-                    traceScenePacket<true>(v, &sh[shStart[t]], int(shStart[t + 1] - shStart[t]), &shHits[shStart[t]], &occP[shStart[t]]);
-        });
+        {
+            // Serially, on this thread (the counters are per thread).
+            tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
+            countPerPacket("primary", n, tiles, primaryPackets);
+            countPerPacket("shadow", n, tiles, shadowPackets);
+        }
 #endif
         std::printf("%4d^2 cells: build %.2f s (landscape %.3f s), %.1f MB (landscape %.1f MB); %.3g instances, %.3g triangles potentially "
                     "visible (%.3g after thinning, %.0f%% kept); primary %.3f s (%zu hits), shadow %.3f s (%zu occluded), frame %.3f s\n",
@@ -438,7 +441,7 @@ int main(int argc, char** argv)
         std::fflush(stdout);
         rows.push_back(r);
         if (cellCounts.size() >= 2 && (n == cellCounts.front() || n == cellCounts.back()))
-            kept[n == cellCounts.back()] = KeptFrame{n, std::move(owned), cam, sh, camStart, shStart};
+            kept[n == cellCounts.back()] = std::move(run);   // R stays valid
 #ifdef SYLVA_HAVE_EMBREE
         if (std::find(embreeCells.begin(), embreeCells.end(), n) == embreeCells.end()) continue;
         // The same rays through Embree holding the landscape flattened; ours timed again beside it (same run).
@@ -583,7 +586,7 @@ int main(int argc, char** argv)
         std::printf("packet_scaling=%.4f\n",
                     (rows.back().primaryPacket + rows.back().shadowPacket) / (rows.front().primaryPacket + rows.front().shadowPacket));
     }
-    if (kept[0].rs && kept[1].rs && pairs > 0) {
+    if (kept[0] && kept[1] && pairs > 0) {
         // The scaling again, each pair's frames taken one right after the other, packets and single rays.
         auto median = [](std::vector<double> x) {
             std::sort(x.begin(), x.end());
@@ -592,14 +595,14 @@ int main(int argc, char** argv)
         for (const bool packets : {true, false}) {
             std::vector<double> t0, t1, ratio;
             for (int k = 0; k < pairs; ++k) {
-                t0.push_back(packets ? kept[0].packetFrame() : kept[0].singleFrame());
-                t1.push_back(packets ? kept[1].packetFrame() : kept[1].singleFrame());
+                t0.push_back(packets ? kept[0]->packetFrame() : kept[0]->singleFrame());
+                t1.push_back(packets ? kept[1]->packetFrame() : kept[1]->singleFrame());
                 ratio.push_back(t1.back() / t0.back());
             }
             const auto [lo, hi] = std::minmax_element(ratio.begin(), ratio.end());
             std::printf("paired %s frames, %d pairs: %d^2 %.3f s, %d^2 %.3f s (medians); time(%d^2) / time(%d^2) %.3f (median of the pairs' "
                         "ratios, %.3f-%.3f)\n",
-                        packets ? "packet" : "single-ray", pairs, kept[0].cells, median(t0), kept[1].cells, median(t1), kept[1].cells, kept[0].cells,
+                        packets ? "packet" : "single-ray", pairs, kept[0]->cells, median(t0), kept[1]->cells, median(t1), kept[1]->cells, kept[0]->cells,
                         median(ratio), *lo, *hi);
             std::printf("%s_paired=%.4f\n", packets ? "packet_scaling" : "scaling", median(ratio));
         }
