@@ -38,11 +38,11 @@ struct PacketFrame {
             if (i < n && (fabsf(inv.x) == 1e30f || fabsf(inv.y) == 1e30f || fabsf(inv.z) == 1e30f)) zeroAxis |= uint64_t(1) << i;
         }
     }
-    // Origins (o - base) * scale for the first n rays (the others zero).
-    void setOrigins(int n, const glm::vec3* o, const glm::vec3& base, float scale)
+    // Origins for the first n rays (the others zero); the tile frame's are packed per cell (CellLanes).
+    void setOrigins(int n, const glm::vec3* o)
     {
         for (int i = 0; i < kPacketRays; ++i) {
-            const glm::vec3 po = i < n ? (o[i] - base) * scale : glm::vec3(0.0f);
+            const glm::vec3 po = i < n ? o[i] : glm::vec3(0.0f);
             ox[i] = po.x, oy[i] = po.y, oz[i] = po.z;
         }
     }
@@ -165,19 +165,19 @@ struct LandPacket {
     // shortens segMax.
     void tilePlants(uint32_t cell, uint32_t cx, uint32_t cz, const LandCellFrame& f, const TileRecord& tr, CellLanes& L)
     {
-        auto test = [&](const TileNode& node, uint64_t m) {
-            glm::vec3 lo, hi;
-            f.nodeBox(node, lo, hi);
-            SYLVA_COUNT(g_pkTileTests);
-            SYLVA_COUNT_ADD(g_pkTileLanes, __builtin_popcountll(m));
-            return packetBoxMask(lo, hi, L.f, L.segMin, L.segMax, m);
-        };
         uint32_t stackNode[64];
         uint64_t stackMask[64];
         int top = 0;
         uint32_t node = tr.nodeOffset;
         uint64_t stopped = 0;   // lanes of L whose any-hit query is answered
-        uint64_t cur = test(v.tileNodes[node], L.count == kPacketRays ? ~uint64_t(0) : (uint64_t(1) << L.count) - 1);
+        uint64_t cur = L.count == kPacketRays ? ~uint64_t(0) : (uint64_t(1) << L.count) - 1;
+        {
+            glm::vec3 lo, hi;
+            f.nodeBox(v.tileNodes[node], lo, hi);
+            SYLVA_COUNT(g_pkTileTests);
+            SYLVA_COUNT_ADD(g_pkTileLanes, __builtin_popcountll(cur));
+            cur = packetBoxMask(lo, hi, L.f, L.segMin, L.segMax, cur);
+        }
         const HeightFieldView heights = landHeights(v);
         while (cur != 0) {
             const TileNode& nd = v.tileNodes[node];
@@ -303,7 +303,7 @@ inline void tracePacket(const RenderView& v, const Ray* rays, int n, Hit* hits, 
         P.meanDir += r.dir;
     }
     if (live != 0) {
-        P.world.setOrigins(n, o, glm::vec3(0.0f), 1.0f);
+        P.world.setOrigins(n, o);
         P.world.setDirections(n, d, 1.0f);
         P.tile.setDirections(n, d, v.land.invTileScale);
         P.walk(live);
