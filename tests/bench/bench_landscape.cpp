@@ -3,8 +3,10 @@
 // leaves), a panorama over the terrain. Per cell count: build time, memory, potentially visible instances and
 // triangles (with and without the density rule's thinning), primary, shadow and frame time; the scaling
 // time(512^2) / time(64^2); the same rays traced ray by ray (traceScene) and an 8x8 tile at a time (traceScenePacket,
-// as the CPU renderer traces a landscape), and with --embree beside Embree 3's single rays and streams; the scaling
-// again from the first and last counts' frames timed in turn (--pairs). Ends with name=value lines.
+// as the CPU renderer traces a landscape), and with --embree beside Embree 3's single rays and streams; the frame as
+// the renderer renders it (renderFilm: those packets, the surface stage and shading with the species' LB lighting,
+// the seed's frame time); the scaling again from the first and last counts' frames timed in turn (--pairs). Ends
+// with name=value lines.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +22,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 
+#include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/render/shade.h"
 #include "core/render/trace_packet.h"
@@ -38,7 +41,7 @@ namespace {
 
 struct Row {
     int cells;
-    double build, landscapeBuild, mb, landscapeMb, instances, triangles, keptFraction, primary, shadow, primaryPacket, shadowPacket;
+    double build, landscapeBuild, mb, landscapeMb, instances, triangles, keptFraction, primary, shadow, primaryPacket, shadowPacket, rendered;
     size_t hits, occluded, packetDiffer;
 };
 
@@ -83,6 +86,14 @@ struct FrameRun {
         const double t0 = bench::now();
         primaryPackets();
         shadowPackets();
+        return bench::now() - t0;
+    }
+    // The frame as the renderer makes it (renderFilm at 1 sample a pixel: its camera rays and their sun rays as packets
+    // an 8x8 tile at a time, the surface stage, shading and the film), seconds: the seed's frame time.
+    double renderFrame()
+    {
+        const double t0 = bench::now();
+        const Film film = renderFilm(rs->view());
         return bench::now() - t0;
     }
     // The same frame a ray at a time (traceScene), seconds.
@@ -274,6 +285,7 @@ int main(int argc, char** argv)
     std::vector<int> cellCounts = {64, 128, 256, 512};
     std::vector<int> embreeCells;   // --embree: these cell counts flattened into Embree beside ours
     double embreeCapGb = 8.0;
+    bool lit = true;   // --unlit: the species without their LB lighting grids (the rendered frame shades without them)
     for (int a = 1; a < argc; ++a) {
         const std::string s = argv[a];
         const bool more = a + 1 < argc;
@@ -285,6 +297,7 @@ int main(int argc, char** argv)
         else if (s == "--threads" && more) threads = std::max(1, std::atoi(argv[++a]));
         else if (s == "--width" && more) width = std::max(8, std::atoi(argv[++a]));
         else if (s == "--height" && more) height = std::max(8, std::atoi(argv[++a]));
+        else if (s == "--unlit") lit = false;
         else if (s == "--embree" && more) {
             std::stringstream ss(argv[++a]);
             for (std::string item; std::getline(ss, item, ',');) embreeCells.push_back(std::max(1, std::atoi(item.c_str())));
@@ -296,11 +309,14 @@ int main(int argc, char** argv)
         } else {
             std::printf("usage: bench_landscape [--scene PATH] [--spacing M] [--plant-spacing F] [--cells 64,128,256,512] [--reps N]\n"
                         "                       [--threads N] [--width W] [--height H] [--embree 16,32,64] [--embree-cap-gb G] [--pairs N]\n"
+                        "                       [--unlit]\n"
                         "  default: resources/landscape.sylva.json, its DEM stretched to 41 m spacing (82 km), the tiles' plant\n"
                         "  spacings x 0.36 (the seed's plant density), 640x480, one primary + one shadow ray per pixel;\n"
                         "  --embree: the landscape flattened into Embree 3 at those cell counts (terrain mesh + every plant an\n"
                         "  instance, built until Embree holds more than the cap, default 8 GB), same rays, side by side;\n"
-                        "  --pairs: the first and last cell counts' frames timed in turn for the scaling (default 3 x reps)\n");
+                        "  --pairs: the first and last cell counts' frames timed in turn for the scaling (default 3 x reps);\n"
+                        "  the rendered frame (renderFilm, the renderer's whole frame at 1 sample a pixel) shades with the species'\n"
+                        "  LB lighting grids from the cache, as sylva render does; --unlit: without them\n");
             return s == "--help" ? 0 : 2;
         }
     }
@@ -327,7 +343,7 @@ int main(int argc, char** argv)
 
     const double ta = bench::now();
     GridCache cache;
-    const std::vector<SpeciesAssets> assets = loadSpeciesAssets(scene, &cache, false);
+    const std::vector<SpeciesAssets> assets = loadSpeciesAssets(scene, &cache, lit);
     const double assetSeconds = bench::now() - ta;
     std::printf("landscape benchmark: %s, DEM %u x %u at %.0f m (%.1f x %.1f km), plant spacing x %.2f, %dx%d, 1 primary + 1 shadow ray a "
                 "pixel, alpha leaves, %d threads, %d reps (median); assets %.1f s\n",
@@ -406,6 +422,7 @@ int main(int argc, char** argv)
         auto shadowPackets = [&] { R.shadowPackets(); };
         r.primaryPacket = bench::timeReps(reps, primaryPackets).median;
         r.shadowPacket = bench::timeReps(reps, shadowPackets).median;
+        r.rendered = bench::timeReps(reps, [&] { R.renderFrame(); }).median;
         r.packetDiffer = 0;
         for (size_t i = 0; i < np; ++i)
             r.packetDiffer += (got[i] != 0) != R.got[i] || (R.got[i] && (hits[i].t != R.hits[i].t || hits[i].prim != R.hits[i].prim));
@@ -438,6 +455,7 @@ int main(int argc, char** argv)
                     "the single rays'\n",
                     n, r.primaryPacket, r.shadowPacket, r.primaryPacket + r.shadowPacket, (r.primary + r.shadow) / (r.primaryPacket + r.shadowPacket),
                     r.packetDiffer, np + sh.size());
+        std::printf("%4d^2 cells, rendered (renderFilm, %s): frame %.3f s\n", n, lit ? "LB lighting" : "unlit", r.rendered);
         std::fflush(stdout);
         rows.push_back(r);
         if (cellCounts.size() >= 2 && (n == cellCounts.front() || n == cellCounts.back()))
@@ -568,43 +586,49 @@ int main(int argc, char** argv)
         std::fflush(stdout);
 #endif
     }
-    std::printf("\n| cells | triangles (thinned) | instances (thinned) | frame s | primary s | shadow s | frame s, 8x8 packets | build s | MB |\n"
-                "|---|---|---|---|---|---|---|---|---|\n");
+    std::printf("\n| cells | triangles (thinned) | instances (thinned) | frame s | primary s | shadow s | frame s, 8x8 packets | frame s, "
+                "rendered | build s | MB |\n"
+                "|---|---|---|---|---|---|---|---|---|---|\n");
     for (const Row& r : rows)
-        std::printf("| %d^2 | %.3g | %.3g | %.3f | %.3f | %.3f | %.3f | %.2f | %.1f |\n", r.cells, r.triangles * r.keptFraction, r.instances * r.keptFraction,
-                    r.primary + r.shadow, r.primary, r.shadow, r.primaryPacket + r.shadowPacket, r.build, r.mb);
+        std::printf("| %d^2 | %.3g | %.3g | %.3f | %.3f | %.3f | %.3f | %.3f | %.2f | %.1f |\n", r.cells, r.triangles * r.keptFraction,
+                    r.instances * r.keptFraction, r.primary + r.shadow, r.primary, r.shadow, r.primaryPacket + r.shadowPacket, r.rendered, r.build, r.mb);
     for (const Row& r : rows)
         std::printf("cells%d_frame_s=%.4f\ncells%d_build_s=%.4f\ncells%d_landscape_build_s=%.4f\ncells%d_mb=%.3f\ncells%d_triangles=%.4g\ncells%d_"
                     "triangles_thinned=%.4g\n",
                     r.cells, r.primary + r.shadow, r.cells, r.build, r.cells, r.landscapeBuild, r.cells, r.mb, r.cells, r.triangles, r.cells,
                     r.triangles * r.keptFraction);
     for (const Row& r : rows)
-        std::printf("cells%d_packet_frame_s=%.4f\ncells%d_packet_speedup=%.4f\ncells%d_packet_differ=%zu\n", r.cells, r.primaryPacket + r.shadowPacket,
-                    r.cells, (r.primary + r.shadow) / (r.primaryPacket + r.shadowPacket), r.cells, r.packetDiffer);
+        std::printf("cells%d_packet_frame_s=%.4f\ncells%d_packet_speedup=%.4f\ncells%d_packet_differ=%zu\ncells%d_render_frame_s=%.4f\n", r.cells,
+                    r.primaryPacket + r.shadowPacket, r.cells, (r.primary + r.shadow) / (r.primaryPacket + r.shadowPacket), r.cells, r.packetDiffer, r.cells,
+                    r.rendered);
     if (rows.size() >= 2) {
         std::printf("scaling=%.4f\n", (rows.back().primary + rows.back().shadow) / (rows.front().primary + rows.front().shadow));
         std::printf("packet_scaling=%.4f\n",
                     (rows.back().primaryPacket + rows.back().shadowPacket) / (rows.front().primaryPacket + rows.front().shadowPacket));
+        std::printf("render_scaling=%.4f\n", rows.back().rendered / rows.front().rendered);
     }
     if (kept[0] && kept[1] && pairs > 0) {
-        // The scaling again, each pair's frames taken one right after the other, packets and single rays.
+        // The scaling again, each pair's frames taken one right after the other: packets, single rays, rendered frames.
         auto median = [](std::vector<double> x) {
             std::sort(x.begin(), x.end());
             return x.size() % 2 ? x[x.size() / 2] : 0.5 * (x[x.size() / 2 - 1] + x[x.size() / 2]);
         };
-        for (const bool packets : {true, false}) {
+        enum Kind { Packets, Single, Rendered };
+        for (const Kind kind : {Packets, Single, Rendered}) {
+            auto frame = [kind](FrameRun& run) { return kind == Packets ? run.packetFrame() : kind == Single ? run.singleFrame() : run.renderFrame(); };
             std::vector<double> t0, t1, ratio;
             for (int k = 0; k < pairs; ++k) {
-                t0.push_back(packets ? kept[0]->packetFrame() : kept[0]->singleFrame());
-                t1.push_back(packets ? kept[1]->packetFrame() : kept[1]->singleFrame());
+                t0.push_back(frame(*kept[0]));
+                t1.push_back(frame(*kept[1]));
                 ratio.push_back(t1.back() / t0.back());
             }
             const auto [lo, hi] = std::minmax_element(ratio.begin(), ratio.end());
+            const char* what = kind == Packets ? "packet" : kind == Single ? "single-ray" : "rendered (renderFilm)";
+            const char* name = kind == Packets ? "packet_scaling" : kind == Single ? "scaling" : "render_scaling";
             std::printf("paired %s frames, %d pairs: %d^2 %.3f s, %d^2 %.3f s (medians); time(%d^2) / time(%d^2) %.3f (median of the pairs' "
                         "ratios, %.3f-%.3f)\n",
-                        packets ? "packet" : "single-ray", pairs, kept[0]->cells, median(t0), kept[1]->cells, median(t1), kept[1]->cells, kept[0]->cells,
-                        median(ratio), *lo, *hi);
-            std::printf("%s_paired=%.4f\n", packets ? "packet_scaling" : "scaling", median(ratio));
+                        what, pairs, kept[0]->cells, median(t0), kept[1]->cells, median(t1), kept[1]->cells, kept[0]->cells, median(ratio), *lo, *hi);
+            std::printf("%s_paired=%.4f\n", name, median(ratio));
         }
     }
     return 0;
