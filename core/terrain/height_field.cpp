@@ -23,7 +23,7 @@ double surfaceHeight(const HeightField& h, double x, double z)
     return s >= r ? h00 + s * (h10 - h00) + r * (h11 - h10) : h00 + r * (h01 - h00) + s * (h11 - h01);
 }
 
-HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t nz, float dx, float dz)
+HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t nz, float dx, float dz, uint32_t block)
 {
     if (nx < 2 || nz < 2)
         throw Error(std::string("height field: ") + std::to_string(nx) + " x " + std::to_string(nz) + " samples; it needs at least 2 x 2");
@@ -31,6 +31,8 @@ HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t n
         throw Error(std::string("height field: ") + std::to_string(heights.size()) + " heights for " + std::to_string(nx) + " x " + std::to_string(nz) + " samples");
     if (!std::isfinite(dx) || !(dx > 0.0f) || !std::isfinite(dz) || !(dz > 0.0f))
         throw Error(std::string("height field: sample spacing ") + std::to_string(dx) + " x " + std::to_string(dz) + " must be finite and > 0");
+    if (block < 1 || block > kMaxHeightBlock)
+        throw Error("height field: block of " + std::to_string(block) + " cells; it must be 1 to " + std::to_string(kMaxHeightBlock));
     for (size_t k = 0; k < heights.size(); ++k)
         if (!std::isfinite(heights[k]))
             throw Error(std::string("height field: sample (") + std::to_string(k % nx) + ", " + std::to_string(k / nx) + ") is not a finite height");
@@ -40,9 +42,10 @@ HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t n
     L.nz = nz;
     L.dx = dx;
     L.dz = dz;
+    L.block = block;
     h.heights = std::move(heights);
     // Level 0: one range per block of cells, over the block's samples (edges shared with neighbours).
-    uint32_t w = (nx - 1 + kHeightBlock - 1) / kHeightBlock, d = (nz - 1 + kHeightBlock - 1) / kHeightBlock;
+    uint32_t w = (nx - 1 + block - 1) / block, d = (nz - 1 + block - 1) / block;
     size_t total = 0;
     for (uint32_t lw = w, ld = d;; lw = (lw + 1) / 2, ld = (ld + 1) / 2) {
         if (L.levels == uint32_t(kMaxHeightLevels)) throw Error("height field: too many samples");
@@ -58,9 +61,9 @@ HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t n
     tbb::parallel_for(uint32_t(0), d, [&](uint32_t bj) {
         for (uint32_t bi = 0; bi < w; ++bi) {
             float lo = INFINITY, hi = -INFINITY;
-            const uint32_t i1 = std::min(nx - 1, (bi + 1) * kHeightBlock), j1 = std::min(nz - 1, (bj + 1) * kHeightBlock);
-            for (uint32_t j = bj * kHeightBlock; j <= j1; ++j)
-                for (uint32_t i = bi * kHeightBlock; i <= i1; ++i) {
+            const uint32_t i1 = std::min(nx - 1, (bi + 1) * block), j1 = std::min(nz - 1, (bj + 1) * block);
+            for (uint32_t j = bj * block; j <= j1; ++j)
+                for (uint32_t i = bi * block; i <= i1; ++i) {
                     lo = std::min(lo, s[size_t(j) * nx + i]);
                     hi = std::max(hi, s[size_t(j) * nx + i]);
                 }

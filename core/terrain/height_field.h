@@ -16,16 +16,20 @@ namespace sylva {
 // The terrain's own frame: +Y up, sample (i, j) at (i * dx, height, j * dz), i along x (columns), j along z
 // (rows, heights[j * nx + i]). Cell (i, j) spans samples i..i+1, j..j+1 and holds two triangles split
 // along its (i, j)-(i+1, j+1) diagonal: triangle 2c = (p00, p11, p10), 2c + 1 = (p00, p01, p11) with
-// c = j * (nx - 1) + i. The pyramid's level 0 has one min/max per block of kHeightBlock x kHeightBlock
-// cells (the block's samples, edges included); each level above merges 2 x 2 blocks, up to one block.
-inline constexpr uint32_t kHeightBlock = 8;
-inline constexpr int kMaxHeightLevels = 20;   // 8 x 2^19 cells a side: far beyond any DEM in memory
+// c = j * (nx - 1) + i. The pyramid's level 0 has one min/max per block of `block` x `block` cells (the
+// block's samples, edges included); each level above merges 2 x 2 blocks, up to one block.
+// kHeightBlock, the default block: intersectBlock's per-cell test is cheaper than a pyramid level, so few
+// levels over large blocks trace fastest (docs/PERFORMANCE.md, Terrain: blocks of 2 to 64 measured).
+inline constexpr uint32_t kHeightBlock = 32;
+inline constexpr uint32_t kMaxHeightBlock = 1024;
+inline constexpr int kMaxHeightLevels = 20;   // 32 x 2^19 cells a side at the default block: beyond any DEM in memory
 
 // The shape of a height field and its pyramid (no pointers: the arrays travel with the render scene's
 // other arrays, RenderView::terrainHeights and terrainRanges).
 struct HeightFieldLayout {
     uint32_t nx, nz;             // samples per row / column (>= 2 each)
     float dx, dz;                // sample spacing, metres (> 0)
+    uint32_t block;              // cells a side of a level-0 block (1 .. kMaxHeightBlock)
     uint32_t levels;             // pyramid levels (>= 1; the last has one block)
     uint32_t levelOffset[kMaxHeightLevels];
     uint32_t levelWidth[kMaxHeightLevels];   // blocks per row at each level (columns: levelDepth)
@@ -60,9 +64,10 @@ struct HeightField {
 // point, as the traversal sees it); NaN outside the samples' footprint [0, (nx-1) dx] x [0, (nz-1) dz].
 double surfaceHeight(const HeightField& h, double x, double z);
 
-// Builds the pyramid over `heights` (nx * nz finite samples, row j = z). Throws Error when nx or nz < 2,
-// the sizes disagree, a sample is not finite, or a spacing is not finite and > 0.
-HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t nz, float dx, float dz);
+// Builds the pyramid over `heights` (nx * nz finite samples, row j = z) with level-0 blocks of `block` cells a
+// side. Throws Error when nx or nz < 2, the sizes disagree, a sample is not finite, a spacing is not finite and
+// > 0, or block is outside 1 .. kMaxHeightBlock.
+HeightField buildHeightField(std::vector<float> heights, uint32_t nx, uint32_t nz, float dx, float dz, uint32_t block = kHeightBlock);
 
 namespace height_detail {
 
@@ -94,9 +99,10 @@ SYLVA_HD SYLVA_INLINE bool intersectCell(const HeightFieldView& h, uint32_t i, u
 SYLVA_HD SYLVA_INLINE bool intersectBlock(const HeightFieldView& h, uint32_t bi, uint32_t bj, const glm::vec3& org, const glm::vec3& dir,
                                           float t0, float t1, float tmin, float& tmax, uint32_t& prim, float& u, float& v)
 {
-    const int ci0 = int(bi * kHeightBlock), cj0 = int(bj * kHeightBlock);
-    const int ci1 = int(minf(float((bi + 1) * kHeightBlock), float(h.layout.nx - 1))) - 1;
-    const int cj1 = int(minf(float((bj + 1) * kHeightBlock), float(h.layout.nz - 1))) - 1;
+    const uint32_t B = h.layout.block;
+    const int ci0 = int(bi * B), cj0 = int(bj * B);
+    const int ci1 = int(minf(float((bi + 1) * B), float(h.layout.nx - 1))) - 1;
+    const int cj1 = int(minf(float((bj + 1) * B), float(h.layout.nz - 1))) - 1;
     const glm::vec3 p = org + t0 * dir;   // where the ray enters the block's box
     int ci = int(floorf(p.x / h.layout.dx)) + h.baseI, cj = int(floorf(p.z / h.layout.dz)) + h.baseJ;
     ci = ci < ci0 ? ci0 : (ci > ci1 ? ci1 : ci);
@@ -156,7 +162,7 @@ SYLVA_HD SYLVA_INLINE bool intersectHeightField(const HeightFieldView& h, const 
     while (top > 0) {
         const Entry e = stack[--top];
         SYLVA_COUNT(g_terrainBlockVisits);
-        const float span = float(kHeightBlock << e.level);
+        const float span = float(h.layout.block << e.level);
         const glm::vec2 r = h.ranges[h.layout.levelOffset[e.level] + e.bj * h.layout.levelWidth[e.level] + e.bi];
         const float bx = float(h.baseI), bz = float(h.baseJ);
         const glm::vec3 lo((float(e.bi) * span - bx) * h.layout.dx, r.x, (float(e.bj) * span - bz) * h.layout.dz);

@@ -3,6 +3,7 @@
 // from below, axis-aligned, vertical and from outside the footprint.
 #include <QTest>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -52,7 +53,7 @@ BruteHit brute(const Triangles& tris, const Ray& r)
     return b;
 }
 
-HeightField ridgeTerrain(uint32_t nx, uint32_t nz, float dx, float dz, uint32_t seed)
+HeightField ridgeTerrain(uint32_t nx, uint32_t nz, float dx, float dz, uint32_t seed, uint32_t block = kHeightBlock)
 {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> noise(-0.4f, 0.4f);
@@ -63,7 +64,7 @@ HeightField ridgeTerrain(uint32_t nx, uint32_t nz, float dx, float dz, uint32_t 
             const float ridge = 12.0f * std::exp(-std::fabs(x - 0.4f * z - 20.0f) * 0.5f);   // a sharp crest
             hts[size_t(j) * nx + i] = 3.0f * std::sin(x * 0.21f) * std::cos(z * 0.17f) + ridge + noise(rng);
         }
-    return buildHeightField(std::move(hts), nx, nz, dx, dz);
+    return buildHeightField(std::move(hts), nx, nz, dx, dz, block);
 }
 
 } // namespace
@@ -72,20 +73,48 @@ class TestHeightField : public QObject {
     Q_OBJECT
 
 private Q_SLOTS:
+    void pyramidBoundsEverySample_data()
+    {
+        QTest::addColumn<uint32_t>("block");
+        QTest::addColumn<uint32_t>("levels");
+        QTest::newRow("block 8") << 8u << 4u;    // 60 x 44 cells: blocks 8 x 6, 4 x 3, 2 x 2, 1 x 1
+        QTest::newRow("block 32") << 32u << 2u;   // 2 x 2, 1 x 1
+        QTest::newRow("block 1") << 1u << 7u;     // 60 x 44, 30 x 22, 15 x 11, 8 x 6, 4 x 3, 2 x 2, 1 x 1
+    }
     void pyramidBoundsEverySample()
     {
-        const HeightField h = ridgeTerrain(61, 45, 1.5f, 0.75f, 1);
-        QCOMPARE(h.layout.levels, 4u);   // 60 x 44 cells: blocks 8 x 6, 4 x 3, 2 x 2, 1 x 1
+        QFETCH(uint32_t, block);
+        QFETCH(uint32_t, levels);
+        const HeightField h = ridgeTerrain(61, 45, 1.5f, 0.75f, 1, block);
+        QCOMPARE(h.layout.block, block);
+        QCOMPARE(h.layout.levels, levels);
         const glm::vec2 top = h.ranges[h.layout.levelOffset[h.layout.levels - 1]];
         float lo = INFINITY, hi = -INFINITY;
         for (float v : h.heights) lo = std::min(lo, v), hi = std::max(hi, v);
         QCOMPARE(top.x, lo);
         QCOMPARE(top.y, hi);
+        // Every level-0 block's range holds exactly its samples' (edges shared with the neighbours).
+        const HeightFieldLayout& L = h.layout;
+        for (uint32_t bj = 0; bj < L.levelDepth[0]; ++bj)
+            for (uint32_t bi = 0; bi < L.levelWidth[0]; ++bi) {
+                float blo = INFINITY, bhi = -INFINITY;
+                for (uint32_t j = bj * block; j <= std::min(L.nz - 1, (bj + 1) * block); ++j)
+                    for (uint32_t i = bi * block; i <= std::min(L.nx - 1, (bi + 1) * block); ++i) blo = std::min(blo, h.at(i, j)), bhi = std::max(bhi, h.at(i, j));
+                QCOMPARE(h.ranges[L.levelOffset[0] + bj * L.levelWidth[0] + bi], glm::vec2(blo, bhi));
+            }
     }
 
+    // The default block and a small one (a deep pyramid over the same terrain), 100k rays each.
+    void hitsEqualBruteForce_data()
+    {
+        QTest::addColumn<uint32_t>("block");
+        QTest::newRow("default block") << kHeightBlock;
+        QTest::newRow("block 4") << 4u;
+    }
     void hitsEqualBruteForce()
     {
-        const HeightField h = ridgeTerrain(61, 45, 1.5f, 0.75f, 2);
+        QFETCH(uint32_t, block);
+        const HeightField h = ridgeTerrain(61, 45, 1.5f, 0.75f, 2, block);
         const HeightFieldView v = h.view();
         const Triangles tris = explicitTriangles(h);
         const float sx = 60 * 1.5f, sz = 44 * 0.75f;
@@ -195,6 +224,8 @@ private Q_SLOTS:
         QVERIFY_THROWS_EXCEPTION(Error, buildHeightField(std::vector<float>(5, 0.0f), 2, 2, 1.0f, 1.0f));
         QVERIFY_THROWS_EXCEPTION(Error, buildHeightField(std::vector<float>(4, 0.0f), 2, 2, 0.0f, 1.0f));
         QVERIFY_THROWS_EXCEPTION(Error, buildHeightField(std::vector<float>(4, 0.0f), 2, 2, 1.0f, -2.0f));
+        QVERIFY_THROWS_EXCEPTION(Error, buildHeightField(std::vector<float>(4, 0.0f), 2, 2, 1.0f, 1.0f, 0));
+        QVERIFY_THROWS_EXCEPTION(Error, buildHeightField(std::vector<float>(4, 0.0f), 2, 2, 1.0f, 1.0f, kMaxHeightBlock + 1));
         std::vector<float> nan(4, 0.0f);
         nan[2] = std::nanf("");
         QVERIFY_THROWS_EXCEPTION(Error, buildHeightField(nan, 2, 2, 1.0f, 1.0f));
