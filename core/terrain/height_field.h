@@ -171,11 +171,13 @@ SYLVA_HD SYLVA_INLINE bool intersectHeightField(const HeightFieldView& h, const 
         if (!(tNear <= tmax)) continue;
         if (e.level == 0) {
             // Where the ray leaves the block's columns, or a rising ray rises above the block's highest sample
-            // (padded for rounding as intersectBlock's cells are: no triangle of the block lies higher); an axis
-            // the ray does not move along sets no limit (the box test above found the ray inside that slab).
+            // (no triangle of the block lies higher), padded by at least what intersectBlock pads a cell's test
+            // with there (its four terms are at most max(|lo.y|, |hi.y|) each); an axis the ray does not move
+            // along sets no limit (the box test above found the ray inside that slab).
             const float txFar = ray.dir.x != 0.0f ? maxf((lo.x - ray.org.x) * inv.x, (hi.x - ray.org.x) * inv.x) : 3.0e38f;
             const float tzFar = ray.dir.z != 0.0f ? maxf((lo.z - ray.org.z) * inv.z, (hi.z - ray.org.z) * inv.z) : 3.0e38f;
-            const float tAbove = ray.dir.y > 0.0f ? (hi.y + 1e-5f * fabsf(hi.y) + 1e-6f - ray.org.y) * inv.y : 3.0e38f;
+            const float pad = 4e-5f * maxf(fabsf(lo.y), fabsf(hi.y)) + 1e-6f;
+            const float tAbove = ray.dir.y > 0.0f ? (hi.y + pad - ray.org.y) * inv.y : 3.0e38f;
             const float tFar = minf(minf(txFar, tzFar), minf(tAbove, tmax));
             if (height_detail::intersectBlock(h, e.bi, e.bj, ray.org, ray.dir, tNear, tFar, ray.tmin, tmax, prim, u, v)) {
                 got = true;

@@ -29,7 +29,8 @@ HeightField loadDem(const std::string& path, double spacing, double heightScale)
         throw Error(path + ": a DEM needs at least 2 x 2 samples, this image has " + std::to_string(w) + " x " + std::to_string(h));
     // Heights (kept) + one row of the read + the pyramid (a min and a max per block, 4/3 of its finest level's):
     // checked first.
-    const double need = double(w) * double(h) * 4.0 * (1.0 + 2.0 * 4.0 / 3.0 / double(kHeightBlock * kHeightBlock)) + double(w) * spec.channels * 4.0;
+    const double pyramid = 2.0 * 4.0 / 3.0 / double(kHeightBlock * kHeightBlock);
+    const double need = double(w) * double(h) * 4.0 * (1.0 + pyramid) + double(w) * spec.channels * 4.0;
     const double avail = availableMemoryBytes();
     if (avail > 0.0 && need > avail)
         throw Error(path + ": a " + std::to_string(w) + " x " + std::to_string(h) + " DEM needs " + std::to_string(int(need / 1048576.0)) +
