@@ -32,7 +32,7 @@ SYLVA_DEVICE SYLVA_INLINE void storeF(float* p, float v) { *p = v; }
 SYLVA_DEVICE SYLVA_INLINE void storeF(__half* p, float v) { *p = __float2half_rn(v); }
 
 // One step for every node of every solve (blockIdx.y): collide at the node, push post_m to the
-// neighbour r + c_m when that neighbour is interior (LB_MODEL.md "Update").
+// neighbour r + c_m when that neighbour is interior (docs/LB_MODEL.md "Update").
 template <typename S>
 __global__ void stepKernel(const S* __restrict__ src, S* __restrict__ dst, const float* __restrict__ rho,
                            const unsigned char* __restrict__ brown, int X, int Y, int Z, size_t solveStride, int zeroF0)

@@ -1,4 +1,4 @@
-// The LB lighting solve on the GPU (LB_MODEL.md): the same per-node collision as the CPU, z-fastest layout.
+// The LB lighting solve on the GPU (docs/LB_MODEL.md): the same per-node collision as the CPU, z-fastest layout.
 #pragma once
 
 #include "core/base/progress.h"

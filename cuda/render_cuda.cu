@@ -1,4 +1,5 @@
-// GPU frame: the same shadePixel as the CPU loop, one thread per pixel, 8x8-pixel blocks (seed 000 section 4.3).
+// GPU frame: the same shadePixel as the CPU loop, one thread per pixel, 8x8-pixel blocks (Geist & Steele, "A
+// Lighting Model for Fast Rendering of Forest Ecosystems", section 4.3).
 #include "cuda/render_cuda.h"
 
 #include <vector>

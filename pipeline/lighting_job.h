@@ -56,7 +56,7 @@ LightingGrid lightingFor(const DensityGrid& density, const lb::LbParams& params,
 LightingGrid lightingForWeights(const DensityGrid& density, const lb::LbParams& params, const lb::BoundaryWeights& w,
                                 GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr);
 
-// Relighting by linearity (issue 18 item 2): the lighting of a species for unit boundaries e_m, one grid
+// Relighting by linearity: the lighting of a species for unit boundaries e_m, one grid
 // per moving lattice direction (18: every sun, above or below the horizon), each cached like a lighting
 // grid (key: the grid, the optics, steps and storage, the boundary e_m; not the sun). lightingFor uses a
 // complete cached basis of the same grid and optics when the exact solve is not cached.

@@ -1,20 +1,20 @@
 #!/usr/bin/env python3
 """Writes resources/teapot/teapot.obj (+ teapot.mtl): the PMMA teapot of resources/teapot.sylva.json.
 
-A coarser copy of ../shared/data/models/teapot.obj (the Newell teapot as three.js r187 TeapotGeometry
+A coarser copy of tests/data/models/teapot.obj (the Newell teapot as three.js r187 TeapotGeometry
 tessellates it: 32 Bezier patches of 17 x 17 vertices, 16 segments). Every second row and column of
 each patch's vertex grid is kept (8 segments: the kept vertices lie on the same patches), vertices
 closer than 1e-5 welded, degenerate triangles dropped. The open edges stay open (the spout's tip,
 the ends of handle and spout inside the body, the rim under the lid): the solid voxelizer's winding
 numbers must fill it anyway. Standard library only:
 
-    python3 resources/make_teapot.py [../shared/data/models/teapot.obj]
+    python3 resources/make_teapot.py [tests/data/models/teapot.obj]
 """
 import os
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-SRC = sys.argv[1] if len(sys.argv) > 1 else os.path.join(HERE, "..", "..", "shared", "data", "models", "teapot.obj")
+SRC = sys.argv[1] if len(sys.argv) > 1 else os.path.join(HERE, "..", "tests", "data", "models", "teapot.obj")
 SIDE = 17            # vertices per patch side in the source (16 segments)
 KEEP = 2             # every second row and column: 8 segments
 

@@ -54,7 +54,7 @@ public:
     // Cancels the running lighting job (New: the old scene's grids are not needed).
     void cancel();
 
-    // Relighting from bases (issue 18 item 2). Each species' basis (one LB solve per lattice direction,
+    // Relighting from bases. Each species' basis (one LB solve per lattice direction,
     // lightingBasisFor) held in memory lets a sun change relight the viewport's kept frame with no LB
     // solve and no job (updateViewport). buildRelightingBasis solves what the grid cache lacks (18 solves
     // a species) and loads the rest; a basis already in the cache (`sylva light --basis`, an earlier

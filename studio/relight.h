@@ -1,4 +1,4 @@
-// Relighting the viewport from cached bases (issue 18 item 2): a species' LB lighting for any sun is the
+// Relighting the viewport from cached bases: a species' LB lighting for any sun is the
 // weighted sum of its basis solves (pipeline/lighting_job.h: lightingBasisFor, relight), so a sun change
 // writes the composed grids into the frame the viewport already holds: no LB solve, no frame build.
 #pragma once

@@ -231,7 +231,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
         if (relit) ++m_relitFrames;
     }
     const glm::vec3 sun = sunRadiance(scene.sun);
-    // Progressive refinement (issue 16 item 5): the schedule's frames (while the camera moves every request
+    // Progressive refinement: the schedule's frames (while the camera moves every request
     // restarts them) light with the sun's one shadow ray alone; then, at full size, frames of new sample
     // positions and sky-light subsets are accumulated up to the samples `sylva render` traces.
     const Refinement refine = refinementFor(m_frame->rs.view(),   // the sky's lights are the frame's (built, not placed)

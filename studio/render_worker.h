@@ -31,7 +31,7 @@ struct RenderPass {
     int spp;
 };
 
-// The viewport's refinement once the schedule is done (issue 16 item 5): `frames` full-size frames of
+// The viewport's refinement once the schedule is done: `frames` full-size frames of
 // `perFrame` samples each (one cycle of the K sky-light subsets), accumulated (accumulateFilm) into the
 // frame of `samples` samples per pixel, the scene's spp (at least K), which is `sylva render`'s picture.
 // None (frames 0) for a constant sky whose spp the schedule's last pass already reaches.
@@ -43,8 +43,9 @@ Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp);
 // Tone-mapped sRGB picture of a film in a render mode (composeMode + toneMapped), as a QImage.
 QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float exposureKey);
 
-// Side-by-side compare (seed 000 Figure 2) of one film: columns [0, width/2) from filmImage(film,
-// left), the rest from filmImage(film, right); each half is exactly that mode's own picture.
+// Side-by-side compare (Geist & Steele, "A Lighting Model for Fast Rendering of Forest Ecosystems", Figure 2)
+// of one film: columns [0, width/2) from filmImage(film, left), the rest from filmImage(film, right); each half
+// is exactly that mode's own picture.
 QImage compareImage(const Film& film, RenderMode left, RenderMode right, const glm::vec3& sky, float exposureKey);
 
 // The GPU viewport's frame: the species part built and uploaded on the worker thread, then handed to

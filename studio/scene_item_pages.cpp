@@ -143,7 +143,7 @@ QWidget* SceneItemPages::buildDensityPage()
 {
     auto* page = new QWidget;
     auto* form = new QFormLayout(page);
-    m_densityOn = new QCheckBox(tr("Thin plants by altitude (seed 002, eq. 2-3)"));
+    m_densityOn = new QCheckBox(tr("Thin plants by altitude (Dietrich, Marmitt & Slusallek, eq. 2-3)"));
     m_densityOn->setObjectName("density.enabled");
     connect(m_densityOn, &QCheckBox::toggled, this, [this](bool on) {
         m_apply(m_densityOn, on ? tr("Density rule on") : tr("Density rule off"), [&](Scene& s) { s.terrain.density.enabled = on; });

@@ -1,4 +1,4 @@
-// The sky panel (issue 16 item 9): the sky model (constant, Preetham, HDR map) with its turbidity, map
+// The sky panel: the sky model (constant, Preetham, HDR map) with its turbidity, map
 // file, rotation and intensity, the virtual lights and their interleaving, the sky in the LB boundary, and the sun by dial (elevation,
 // azimuth) or by date, time, time zone and place with a time slider. Every change is an undoable edit
 // of the document (edits of one control less than a second apart merge into one step).

@@ -296,7 +296,7 @@ bool Viewport::paintGpu()
     for (const RenderPass& p : m_worker->passes())
         if (p.divisor == 1) spps.push_back(p.spp);
     if (spps.empty()) spps.push_back(1);
-    // Progressive refinement (issue 16 item 5) on the device, as the worker does it on the CPU: the schedule's
+    // Progressive refinement on the device, as the worker does it on the CPU: the schedule's
     // passes light with the sun's shadow ray alone, then one full-size frame of every sample and sky-light
     // subset (refinementFor's count: the picture the worker accumulates, `sylva render --spp` at that count).
     RenderScene& rs = m_gpuFrame->frame.rs;

@@ -1,4 +1,4 @@
-// Volumes in the studio (issue 17 item 7): Edit > Add Cloud (the pyroclastic generator's form, the same
+// Volumes in the studio: Edit > Add Cloud (the pyroclastic generator's form, the same
 // core/volume/pyroclastic code as `sylva volume cloud`) and Edit > Simulate Smoke (core/volume/smoke's
 // simulation as a job with progress and cancel, `sylva simulate`'s domain and source); each adds one
 // volume (its grid written beside the scene file, or in the studio's data folder) as one undo step.
@@ -22,7 +22,7 @@ class Job;
 class JobManager;
 class SceneDocument;
 
-// The pyroclastic parameters (seed 003): radius, amplitude, noise frequency and octaves, resolution,
+// The pyroclastic parameters (core/volume/pyroclastic.h): radius, amplitude, noise frequency and octaves, resolution,
 // density, seed, centre; and the volume's name.
 class CloudDialog : public QDialog {
     Q_OBJECT

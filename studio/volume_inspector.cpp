@@ -124,7 +124,7 @@ VolumeInspector::VolumeInspector(QWidget* parent) : QWidget(parent)
     m_volumeLighting->setObjectName("volumeLighting");
     m_volumeLighting->addItem(tr("single scattering of the sun"));
     m_volumeLighting->addItem(tr("LB lighting"));
-    m_volumeLighting->setToolTip(tr("Single scattering: the sun's light marched through the density (seed 003); "
+    m_volumeLighting->setToolTip(tr("Single scattering: the sun's light marched through the density toward each sample; "
                                     "LB lighting: each sample lit by the LB grid's luminance"));
     m_extinction = new QSlider(Qt::Horizontal);
     m_extinction->setObjectName("volumeExtinction");

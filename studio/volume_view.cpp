@@ -26,7 +26,7 @@ void main() { ndc = position; gl_Position = vec4(position, 0.0, 1.0); }
 // Box space: the grid spans [0, extent] (extent = dims / longest dim); texture coordinates p / extent.
 // View ray: N samples between the box faces; at each, extinction sigma * density, in-scattered light
 // (single scattering, isotropic, albedo 1) from the sun's transmittance (a march of M samples toward
-// it, seed 003) or from the LB grid's luminance.
+// it, as in the graphics-blog post "In-Scattering Demo") or from the LB grid's luminance.
 const char* kFragmentShader = R"(
 uniform sampler3D density;
 uniform sampler3D lighting;

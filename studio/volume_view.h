@@ -1,6 +1,7 @@
 // The inspector's 3D view: a species' density grid as a 3D texture, ray marched in a fragment shader
-// with single scattering of the sun (seed 003: march the view ray through the volume, at each sample
-// march toward the light for its transmittance), or lit by the LB lighting grid instead.
+// with single scattering of the sun (as in the graphics-blog post "In-Scattering Demo": march the view ray
+// through the volume, at each sample march toward the light for its transmittance), or lit by the LB lighting
+// grid instead.
 #pragma once
 
 #include <memory>

@@ -25,7 +25,7 @@ public:
     virtual ~Backend() = default;
     // "cpu" or "cuda (NVIDIA H100 ...)".
     virtual std::string name() const = 0;
-    // The LB lighting solve (LB_MODEL.md). Throws Error on bad input, BackendError on device trouble.
+    // The LB lighting solve (docs/LB_MODEL.md). Throws Error on bad input, BackendError on device trouble.
     virtual LightingGrid solveLighting(const DensityGrid& density, const lb::LbParams& params, Progress* progress,
                                        lb::SolveStats* stats) = 0;
     // The film of a prepared scene (every pixel, v.spp samples). Throws BackendError on device trouble.

@@ -108,7 +108,7 @@ glm::vec3 sample(const LightingGrid& l, const glm::dvec3& p)
     return out;
 }
 
-// The LB of LB_MODEL.md on a small grid without wood, single-threaded and scalar through the same node
+// The LB of docs/LB_MODEL.md on a small grid without wood, single-threaded and scalar through the same node
 // collision as the solvers (collideNode): for the hundreds of few-hundred-node windows of a forest, where a
 // full solver's setup (page-aligned copies, thread pool per step) costs far more than the steps.
 // faces (when given): per node and channel the irradiance on the six axis-aligned faces (kFaceNormals order),

@@ -1,7 +1,7 @@
-// The forest-level LB grid (seed 000 section 3, issue 18 item 1): a coarse lattice over the whole scene whose
-// node density comes from the plants in its cells, solved with the scene's boundary (sun, and sky when
-// asked), giving each instance a per-channel factor that scales its species' (per-species, unchanged)
-// lighting grid.
+// The forest-level LB grid (Geist & Steele, "A Lighting Model for Fast Rendering of Forest Ecosystems", section
+// 3): a coarse lattice over the whole scene whose node density comes from the plants in its cells, solved with
+// the scene's boundary (sun, and sky when asked), giving each instance a per-channel factor that scales its
+// species' (per-species, unchanged) lighting grid.
 //
 // Density: each instance spreads its species' biomass B (sum of the species grid's densities x its
 // cell volume, x scale^3) evenly over its crown box (the species grid's occupied bounds, scaled and

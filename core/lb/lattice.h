@@ -1,4 +1,4 @@
-// The D3Q19 lattice of the LB lighting model: directions, weights, antipodes (LB_MODEL.md "Lattice").
+// The D3Q19 lattice of the LB lighting model: directions, weights, antipodes (docs/LB_MODEL.md "Lattice").
 #pragma once
 
 #include "core/base/defines.h"

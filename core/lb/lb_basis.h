@@ -19,7 +19,7 @@ struct Sky;
 namespace sylva::lb {
 
 // A boundary condition as weights per channel and lattice direction: boundary node value f_m of channel
-// c = w[c][m] (m = 0..18; w[c][0] = 0). The sun of LB_MODEL.md is sunWeights; a sky adds skyWeights.
+// c = w[c][m] (m = 0..18; w[c][0] = 0). The sun of docs/LB_MODEL.md is sunWeights; a sky adds skyWeights.
 struct BoundaryWeights {
     std::array<std::array<float, kDirections>, 3> w{};
     BoundaryWeights& operator+=(const BoundaryWeights& o);
@@ -27,9 +27,10 @@ struct BoundaryWeights {
     glm::vec3 totals() const;
 };
 
-// The seed's sun: w[c][m] = intensity_c x max(0, n_m . d), d = -normalize(sun).
+// The papers' sun (docs/LB_MODEL.md "Boundary condition"): w[c][m] = intensity_c x max(0, n_m . d), d =
+// -normalize(sun).
 BoundaryWeights sunWeights(const glm::vec3& sun, const glm::vec3& intensity);
-// The sky (without its sun, issue 16 item 7): each direction m gets the sky's radiance integrated over its
+// The sky (without its sun): each direction m gets the sky's radiance integrated over its
 // share of the sphere, the directions w whose light travels nearest to n_m (w nearest -n_m), divided
 // per channel by `unit` (the renderer scales the grid by the sun's radiance, so a sky boundary beside
 // a sun of intensity 1 is given in units of the sun's radiance; a channel with unit 0 gets 0). Shares
@@ -65,7 +66,7 @@ LbParams basisParams(const LbParams& params, int m);
 LightingGrid composeLighting(const std::vector<int>& dirs, const std::vector<const LightingGrid*>& basis,
                              const BoundaryWeights& w);
 
-// The LB field with the first collision separated (issue 18 item 4): the light that reached each node
+// The LB field with the first collision separated: the light that reached each node
 // without scattering, as the same LB solve with sigma_s = 0, sigma_a = sigma_t and f_0 zeroed (the
 // streamed boundary attenuated by (1 - rho sigma_t) per step along each lattice direction: a
 // discrete Beer-Lambert along the sun). Scattered light = the full solve minus this.

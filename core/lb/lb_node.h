@@ -67,9 +67,9 @@ struct Lanes {
     static SYLVA_HD SYLVA_INLINE T nonNegative(T x) { return x > T{} ? x : T{}; }
 };
 
-// In place: f[m] <- f[m] + rho * (Omega f)[m] for all 19 directions (LB_MODEL.md "Update"), the
+// In place: f[m] <- f[m] + rho * (Omega f)[m] for all 19 directions (docs/LB_MODEL.md "Update"), the
 // scattering part through symmetricScatter. With zeroF0 the rest direction is returned as 0 (plants:
-// absorbed light leaves the visible band). The exact result is never negative (LB_MODEL.md
+// absorbed light leaves the visible band). The exact result is never negative (docs/LB_MODEL.md
 // "Stability"), but the reduced products cancel terms, so where it is 0 rounding can leave a few ulps
 // below; those are clamped to 0, which is within the same rounding of the exact value.
 template <typename T, typename Om>

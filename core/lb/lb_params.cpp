@@ -1,4 +1,6 @@
-// Presets from the seeds and parameter validation with messages that name the bound.
+// Presets from the papers (docs/LB_MODEL.md "Parameter presets") and parameter validation with messages that
+// name the bound. Geist & Steele 2008 = Geist & Steele, "A Lighting Model for Fast Rendering of Forest
+// Ecosystems"; Geist & Westall = Geist & Westall, "Lattice-Boltzmann Lighting Models".
 #include "core/lb/lb_params.h"
 
 #include <algorithm>
@@ -14,13 +16,13 @@ namespace sylva::lb {
 const std::vector<Preset>& presets()
 {
     static const std::vector<Preset> list = {
-        {"leaf", "green leaves, Knapp-Carter optics (seed 000 Table 1)",
+        {"leaf", "green leaves, Knapp-Carter optics (Geist & Steele 2008, Table 1)",
          {{{0.109f, 0.891f, -0.120f}, {0.091f, 0.909f, 0.091f}, {0.118f, 0.882f, -0.333f}}}, true},
-        {"dogrose", "dogrose bush (seed 004 Table 1)",
+        {"dogrose", "dogrose bush (Geist & Westall, Table 1)",
          {{{0.109f, 0.891f, -0.231f}, {0.091f, 0.909f, 0.103f}, {0.118f, 0.882f, -0.750f}}}, true},
-        {"cloud", "cloud, albedo 0.99, forward scattering (seed 004 3.2.1)",
+        {"cloud", "cloud, albedo 0.99, forward scattering (Geist & Westall, section 3.2.1)",
          {{{0.008f, 0.792f, 0.9f}, {0.008f, 0.792f, 0.9f}, {0.008f, 0.792f, 0.9f}}}, false},
-        {"pmma", "PMMA plastic (seed 004 Table 2)",
+        {"pmma", "PMMA plastic (Geist & Westall, Table 2)",
          {{{0.01f, 0.99f, 0.80f}, {0.01f, 0.99f, -0.88f}, {0.01f, 0.99f, -0.88f}}}, false},
     };
     return list;
@@ -79,7 +81,7 @@ void validate(const LbParams& params)
             fail("sigma_a = " + num(ch.sigmaA) + " must be finite and >= 0");
         if (!std::isfinite(ch.sigmaS) || ch.sigmaS < 0.0f)
             fail("sigma_s = " + num(ch.sigmaS) + " must be finite and >= 0");
-        // Stability (LB_MODEL.md): every coefficient of I + rho*Omega is >= 0 iff sigma_t * max(rho) <= 1.
+        // Stability (docs/LB_MODEL.md): every coefficient of I + rho*Omega is >= 0 iff sigma_t * max(rho) <= 1.
         // Checked on the float sum the kernels use (compactOmega): any excess over 1 makes the coefficient
         // 1 - rho * sigma_t negative and f with it. Decimal inputs that sum to 1 (0.118 + 0.882) round to
         // exactly 1 there.

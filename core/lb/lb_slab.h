@@ -45,7 +45,7 @@ public:
     virtual void stepPlanes(int x0, int x1) = 0;
     virtual void finishStep() = 0;
     // Local plane x of the current state: planeBytes() bytes (Y x 19 x Z values in storage form,
-    // LB_MODEL.md's order), what a halo message carries.
+    // docs/LB_MODEL.md's order), what a halo message carries.
     virtual void* plane(int x) = 0;
     virtual size_t planeBytes() const = 0;
     virtual int planes() const = 0;

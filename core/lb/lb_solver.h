@@ -1,4 +1,4 @@
-// The LB lighting solve on the CPU: density grid in, RGB lighting grid out (LB_MODEL.md is the contract).
+// The LB lighting solve on the CPU: density grid in, RGB lighting grid out (docs/LB_MODEL.md is the contract).
 #pragma once
 
 #include <vector>
@@ -26,12 +26,13 @@ struct SolveStats {
 LightingGrid solveLighting(const DensityGrid& density, const LbParams& params, Progress* progress = nullptr,
                            SolveStats* stats = nullptr);
 
-// Advances an explicit state of channel 0 (19 values per node in the storage order of LB_MODEL.md:
+// Advances an explicit state of channel 0 (19 values per node in the storage order of docs/LB_MODEL.md:
 // ((i*Y + j)*19 + m)*Z + k) by `steps` steps with the same code as solveLighting. Boundary nodes keep
 // their values. For tests and tools.
 void advance(const DensityGrid& density, const LbParams& params, std::vector<float>& f, int steps);
 
-// Boundary value f_m = max(0, n_m . d) for unit intensity, d = -normalize(sun) (LB_MODEL.md "Boundary condition").
+// Boundary value f_m = max(0, n_m . d) for unit intensity, d = -normalize(sun) (docs/LB_MODEL.md "Boundary
+// condition").
 std::vector<float> boundaryDistribution(const glm::vec3& sun);
 // The sun as a beam rather than the model's cosine lobe: its travel direction -normalize(sun) as a
 // non-negative sum of the three lattice directions (unit vectors) of the tightest cone holding it (fewer

@@ -1,5 +1,5 @@
 // The leaf surface optics an LB channel stands for, and how the renderer turns a scattered LB photon
-// density into the light a surface sends to the camera (issue 21's ground truth: docs/ACCURACY.md).
+// density into the light a surface sends to the camera (the ground truth against Blender's Cycles: docs/ACCURACY.md).
 #pragma once
 
 #include <glm/glm.hpp>

@@ -1,4 +1,4 @@
-// The collision matrix Omega of the LB lighting model (LB_MODEL.md) and its compact even/odd form for kernels.
+// The collision matrix Omega of the LB lighting model (docs/LB_MODEL.md) and its compact even/odd form for kernels.
 #pragma once
 
 #include <array>
@@ -23,7 +23,7 @@ std::array<double, 18 * 18> normalizedPhase(double g);
 
 DenseOmega buildOmega(const ChannelParams& p);
 
-// Compact form used by the node update (LB_MODEL.md "Cost and structure"): for antipodal pairs
+// Compact form used by the node update (docs/LB_MODEL.md "Cost and structure"): for antipodal pairs
 // s_q = f_q+ + f_q-, d_q = f_q+ - f_q-, the scattering part gives out_p+ = (E s)_p + (O d)_p and
 // out_p- = (E s)_p - (O d)_p. 9x9 even and odd blocks, plus the absorption terms. 664 bytes.
 struct CompactOmega {
@@ -35,7 +35,7 @@ struct CompactOmega {
 
 CompactOmega compactOmega(const ChannelParams& p);
 
-// The even and odd blocks reduced by the octahedral symmetry of the lattice (LB_MODEL.md "Cost and
+// The even and odd blocks reduced by the octahedral symmetry of the lattice (docs/LB_MODEL.md "Cost and
 // structure"): both commute with every rotation and reflection of the cube, so in coordinates adapted
 // to it they fall apart into tiny blocks (Schur's lemma), 14 coefficients in all.
 // Even part, from the pair sums s_q: the axial sums s_x, s_y, s_z; the sums of the two diagonal pairs

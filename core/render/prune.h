@@ -1,4 +1,5 @@
-// Stochastic pruning of leaves for distant plants (seed 003, Cook et al. 2007): area-preserving levels of detail.
+// Stochastic pruning of leaves for distant plants (Cook et al. 2007, as the graphics-blog post
+// "Stochastic Pruning for Real-Time LOD" applies it): area-preserving levels of detail.
 #pragma once
 
 #include <cstddef>
@@ -53,7 +54,7 @@ struct PrunedLevel {
 PrunedLevel buildPrunedLevel(const TriangleMesh& mesh, const LeafElements& elements, const std::vector<uint32_t>& order,
                              int level);
 
-// The level an instance at `distance` metres from the camera uses (seed 003): z = max(1, distance /
+// The level an instance at `distance` metres from the camera uses (as in that post): z = max(1, distance /
 // start), kept fraction u = z^-log2(h) with h = 2 (half the leaves at twice the start distance), so
 // u = 1/z; the level is the nearest kept fraction 2^-k in ratio, k = round(log2 z), at most levels - 1.
 // start <= 0 turns pruning off (level 0).

@@ -773,7 +773,8 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
     rs.tilePlants.clear();
     rs.base.land = LandscapeLayout{};
     rs.m_stats.landscape = LandscapeStats{};
-    // The landscape (seed 002): Wang tiles of the species' full meshes on the terrain's cells.
+    // The landscape (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly Complex
+    // Plant Populations"): Wang tiles of the species' full meshes on the terrain's cells.
     if (scene.terrain.enabled() && scene.terrain.cells > 0) {
         const TerrainDesc& t = scene.terrain;
         if (!t.field) throw Error("render: the terrain's heights were not loaded (" + t.dem + ")");
@@ -887,8 +888,8 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
         b.terrainSnow = t.snow;
         b.terrainRockCos = terrainRockCos(t);
         b.terrainSnowY = terrainSnowY(t);
-        // The height field's and the landscape's frames are rebased under the camera, in double (seed 002 at
-        // UTM coordinates: millions of metres from the world origin, centimetres near the camera).
+        // The height field's and the landscape's frames are rebased under the camera, in double (Dietrich et
+        // al. 2006 at UTM coordinates: millions of metres from the world origin, centimetres near the camera).
         const HeightFieldLayout& L = rs.base.terrain;
         const glm::dvec3 camLocal = origin - t.origin;   // the camera in the DEM's frame
         const auto nearest = [](double x, double step, uint32_t n) { return int32_t(std::clamp(std::floor(x / step), 0.0, double(n))); };

@@ -51,7 +51,8 @@ struct alignas(64) TriBlock {
 static_assert(sizeof(TriBlock) == 256);
 
 // The levels a ray descends at most: the top level and up to kMaxLevels - 1 nested instance groups
-// above a mesh (seed 002: terrain cells -> tiles -> plants -> meshes).
+// above a mesh (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly Complex Plant
+// Populations": terrain cells -> tiles -> plants -> meshes).
 inline constexpr int kMaxLevels = kMaxNested + 1;
 
 // An instance: a geometry placed in its parent's frame by a 3x4 row-major affine map parent -> the

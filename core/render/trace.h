@@ -44,11 +44,12 @@ SYLVA_HD SYLVA_INLINE glm::vec2 blockUv(const RenderView& v, const TriBlock& b, 
 // tAlpha of a ray that tests every cut-out (adaptive transparency off).
 inline constexpr float kAlphaEverywhere = 3.0e38f;
 
-// Adaptive transparency (seed 000 section 2.1, Dietrich et al.): beyond v.alphaDistance from the camera
-// leaf cards count as opaque. In the camera-relative frame a ray point's distance from the camera is at
-// most |org| + t |dir|, so cut-outs are honoured for t < tAlpha = (D - |org|) / |dir| only: exactly the
-// points within D on camera rays (org = 0); on shadow rays those surely within D (from a point beyond D,
-// none). t is the same in every instance's frame, so one threshold per ray serves both levels.
+// Adaptive transparency (Geist & Steele, "A Lighting Model for Fast Rendering of Forest Ecosystems", section
+// 2.1, Dietrich et al.): beyond v.alphaDistance from the camera leaf cards count as opaque. In the
+// camera-relative frame a ray point's distance from the camera is at most |org| + t |dir|, so cut-outs are
+// honoured for t < tAlpha = (D - |org|) / |dir| only: exactly the points within D on camera rays (org = 0); on
+// shadow rays those surely within D (from a point beyond D, none). t is the same in every instance's frame, so
+// one threshold per ray serves both levels.
 SYLVA_HD SYLVA_INLINE float alphaTestLimit(const RenderView& v, const Ray& ray)
 {
     if (!(v.alphaDistance > 0.0f)) return kAlphaEverywhere;
@@ -281,8 +282,9 @@ namespace sylva {
 
 namespace trace_detail {
 
-// The ground plane and the terrain, asked first (seed 002 section 4.1): their hit shortens the ray (tmax)
-// before the plants are traversed. Starts the hit record. Returns true when an any-hit query is answered.
+// The ground plane and the terrain, asked first (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level
+// Instancing of Highly Complex Plant Populations", section 4.1): their hit shortens the ray (tmax) before the
+// plants are traversed. Starts the hit record. Returns true when an any-hit query is answered.
 template <bool AnyHit>
 SYLVA_HD inline bool traceGround(const RenderView& v, const Ray& ray, Hit& hit, float& tmax)
 {
@@ -339,7 +341,7 @@ SYLVA_HD inline bool traceInstances(const RenderView& v, const Ray& ray, Hit& hi
 {
     float tmax;
     if (trace_detail::traceGround<AnyHit>(v, ray, hit, tmax)) return true;
-    // The landscape's cells and tiles (seed 002 sections 4.1, 4.2), below the ground's hit.
+    // The landscape's cells and tiles (Dietrich et al. 2006, sections 4.1, 4.2), below the ground's hit.
     if (v.landscapeEnabled) {
         trace_detail::Query lq{v, ray.tmin, alphaTestLimit(v, ray), hit, {}};
         if (trace_detail::traceLandscape<AnyHit, Kd>(lq, ray.org, ray.dir, tmax) && AnyHit) return true;

@@ -1,7 +1,8 @@
-// The landscape's traversal (seed 002 sections 4.1-4.3): the top-level 2D kd-tree over cells, top-down and
-// nearest first, skipping nodes the ray passes above or below; in a cell its tile's 2D tree with the tile's
-// height raised by the cell's ground range; plants lifted onto the height field and thinned by the density
-// rule as they are reached. Included by trace.h after trace_detail's mesh traversal (host and device).
+// The landscape's traversal (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly
+// Complex Plant Populations", sections 4.1-4.3): the top-level 2D kd-tree over cells, top-down and nearest
+// first, skipping nodes the ray passes above or below; in a cell its tile's 2D tree with the tile's height
+// raised by the cell's ground range; plants lifted onto the height field and thinned by the density rule as
+// they are reached. Included by trace.h after trace_detail's mesh traversal (host and device).
 #pragma once
 
 #include "core/terrain/landscape.h"

@@ -1,6 +1,7 @@
 // Participating media in the renderer (host and device): density grids with LB lighting, marched along
-// camera rays (seed 004 3.2.1: "a standard, path integrating volume tracer that samples the medium
-// density and the LB lighting solution along each ray"), beside seed 003's single scattering, with
+// camera rays (Geist & Westall, "Lattice-Boltzmann Lighting Models", section 3.2.1: "a standard, path
+// integrating volume tracer that samples the medium density and the LB lighting solution along each ray"),
+// beside single scattering (as in the graphics-blog posts "Faster Fog" and "In-Scattering Demo"), with
 // empty-space skipping over a max-density brick grid, blackbody emission and shadow transmittance.
 #pragma once
 
@@ -15,8 +16,8 @@
 namespace sylva {
 
 // How a volume's in-scattered light is computed (docs/RENDERING.md "Volumes").
-//   Lb:       sigma_s x the LB photon density (isotropic), seed 004: no shadow rays, all of it indirect;
-//   Single:   seed 003: sun single scattering with the Henyey-Greenstein phase and a shadow march
+//   Lb:       sigma_s x the LB photon density (isotropic), Geist & Westall: no shadow rays, all of it indirect;
+//   Single:   as in those posts: sun single scattering with the Henyey-Greenstein phase and a shadow march
 //             toward the sun at every step (direct, `local`), no multiple scattering;
 //   Combined: Single's sun term plus the LB solution less its uncollided part (multiple scattering,
 //             indirect).

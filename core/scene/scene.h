@@ -46,7 +46,8 @@ struct SpeciesDesc {
     int grid = 64;                       // LB grid nodes along the longest edge
     bool solid = false;                  // voxelized as a solid (interior filled, core/voxel/solid_voxelize.h): plastics
     bool lit = true;                     // false: no LB grid, conventional lighting (ambient = the diffuse colour x
-                                         // the sun's radiance: the LB's open-space value; seed 004 Figure 5)
+                                         // the sun's radiance: the LB's open-space value; Geist & Westall,
+                                         // "Lattice-Boltzmann Lighting Models", Figure 5)
 };
 
 inline constexpr uint32_t kNoGroup = 0xffffffffu;
@@ -91,8 +92,9 @@ struct TerrainDesc {
     glm::vec3 snow{0.80f, 0.82f, 0.86f}; // albedo above snowLine
     float rockSlope = 35.0f;             // degrees
     float snowLine = 0.0f;               // world y, metres; 0 = no snow
-    // Plants (seed 002): the terrain cut into `cells` x `cells` cells along its longer side (0 = no plant
-    // tiles), each carrying a Wang tile of `tiles`' population chosen by `tiling`, thinned by `density`.
+    // Plants (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly Complex Plant
+    // Populations"): the terrain cut into `cells` x `cells` cells along its longer side (0 = no plant tiles),
+    // each carrying a Wang tile of `tiles`' population chosen by `tiling`, thinned by `density`.
     int cells = 0;
     TileSetDesc tiles;
     TilingDesc tiling;
@@ -147,18 +149,18 @@ struct CameraDesc {
     float fovY = 45.0f;
 };
 
-// How the species' LB grids and the renderer's shadow-ray sun share the direct light (issue 18 item 4):
-// Seed = the seed's sum (the grid as solved, uncollided sunlight included, added to the drawn sun: direct
+// How the species' LB grids and the renderer's shadow-ray sun share the direct light:
+// Seed = Geist & Steele's sum (the grid as solved, uncollided sunlight included, added to the drawn sun: direct
 // light counted twice inside crowns); Once = the grid less its uncollided part (lb::scatteredPart), so
 // the grid adds only scattered light to the drawn sun.
 enum class DirectLight { Seed, Once };
 
-// The forest-level LB grid (issue 18 item 1, core/lb/forest_grid.h): Off = every instance of a species lit
+// The forest-level LB grid (core/lb/forest_grid.h): Off = every instance of a species lit
 // alike (as before); On = each top-level instance's species lighting scaled by the grid's factors; Auto = as
 // On where exposure differs (factors spread by 2% or more), else skipped (said in render --stats).
 enum class ForestGridMode { Off, Auto, On };
 
-// What the species' LB boundary holds (issue 16 item 7): Sun = the seed's sun alone (LB_MODEL.md "Boundary
+// What the species' LB boundary holds: Sun = the papers' sun alone (docs/LB_MODEL.md "Boundary
 // condition"; old files); SunSky = the sun plus the sky's radiance over each lattice direction's share of
 // the upper hemisphere (lb::skyWeights), so leaves also receive skylight scattered through the crown.
 enum class LbBoundary { Sun, SunSky };
@@ -186,8 +188,9 @@ struct RenderSettings {
     float indirectScale = 1.0f;          // weight of the LB indirect light (1 = as solved, normalized to open sky)
     float exposureKey = 0.18f;           // Reinhard key value a
     float alphaDistance = 0.0f;          // metres; beyond it from the camera leaf cut-outs are not tested
-                                         // (cards count as opaque; seed 000 section 2.1); 0 = off
-    float pruneDistance = 0.0f;          // metres; stochastic pruning of leaves starts there (seed 003): an
+                                         // (cards count as opaque; Geist & Steele, "A Lighting Model for Fast
+                                         // Rendering of Forest Ecosystems", section 2.1); 0 = off
+    float pruneDistance = 0.0f;          // metres; stochastic pruning of leaves starts there (Cook et al. 2007): an
                                          // instance at distance d keeps about start / d of them; 0 = off
 };
 

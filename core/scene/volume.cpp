@@ -6,7 +6,8 @@ namespace sylva {
 bool volumePreset(const std::string& name, lb::LbParams* out)
 {
     if (name == "smoke") {
-        // Grey soot-laden smoke: albedo 0.5, mildly forward scattering (seed 003's smoke renders with a
+        // Grey soot-laden smoke: albedo 0.5, mildly forward scattering (the smoke renders of the graphics-blog post
+        // "Adventures in Fluid Simulation" use a
         // dark, absorbing medium); f_0 kept as for clouds (no plant absorption model).
         lb::LbParams p;
         for (auto& c : p.channels) c = lb::ChannelParams{0.25f, 0.25f, 0.3f};

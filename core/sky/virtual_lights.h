@@ -1,8 +1,9 @@
-// Virtual directional lights from an environment map (seed 002 section 5.1, after Agarwal et al. 2003 and
-// Kollig & Keller 2003, simplified): the sphere cut into N regions of roughly equal power by recursive
-// median splits of the cumulative luminance power in latitude-longitude, each region one directional
-// light at its power-weighted centre carrying the region's power. And interleaved sampling (Keller &
-// Heidrich 2001): which of those lights pixel (x, y) uses for its sample s.
+// Virtual directional lights from an environment map (Dietrich, Marmitt & Slusallek, "Terrain Guided
+// Multi-Level Instancing of Highly Complex Plant Populations", section 5.1, after Agarwal et al. 2003 and
+// Kollig & Keller 2003, simplified): the sphere cut into N regions of roughly equal power by recursive median
+// splits of the cumulative luminance power in latitude-longitude, each region one directional light at its
+// power-weighted centre carrying the region's power. And interleaved sampling (Keller & Heidrich 2001): which
+// of those lights pixel (x, y) uses for its sample s.
 #pragma once
 
 #include <vector>

@@ -1,5 +1,6 @@
-// A regular height field as a terrain surface (seed 002's ground mesh without its vertex arrays): heights
-// plus a min/max pyramid of blocks, ray-intersected through the triangles the grid implies (host and device).
+// A regular height field as a terrain surface (Dietrich et al.'s ("Terrain Guided Multi-Level Instancing of
+// Highly Complex Plant Populations") ground mesh without its vertex arrays): heights plus a min/max pyramid of
+// blocks, ray-intersected through the triangles the grid implies (host and device).
 #pragma once
 
 #include <cstdint>

@@ -120,12 +120,14 @@ TilePlant makePlant(const Root& r, const TilePlantDesc& p, const LandscapeSpecie
     return t;
 }
 
-// The tile's 2D tree (seed 002 section 4.2: a two-dimensional SAH tree): plants split into two runs of their
-// roots' order along x or z where the surface-area heuristic is lowest. A node's box is its plants' rectangle and
+// The tile's 2D tree (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly Complex
+// Plant Populations", section 4.2: a two-dimensional SAH tree): plants split into two runs of their roots'
+// order along x or z where the surface-area heuristic is lowest. A node's box is its plants' rectangle and
 // vertical extent, which the traversal raises by the ground's band under it: the cost model takes that band as
-// kSahBand of the tile's side, and a node's cost as its box's half surface (top and sides: rays over a landscape
-// are shallow). Leaves of 1 .. kMaxLeaf plants; below depth kSahDepth splits are medians, so the traversal's
-// 64-entry stack always suffices. `plants` is reordered into leaf order. Deterministic: sorts break ties by index.
+// kSahBand of the tile's side, and a node's cost as its box's half surface (top and sides: rays over a
+// landscape are shallow). Leaves of 1 .. kMaxLeaf plants; below depth kSahDepth splits are medians, so the
+// traversal's 64-entry stack always suffices. `plants` is reordered into leaf order. Deterministic: sorts break
+// ties by index.
 void buildTileTree(std::vector<TilePlant>& plants, uint32_t plantBase, double tileSize, std::vector<TileNode>& nodes)
 {
     // The cost constants, measured (bench_landscape, 82 km St Helens, 64^2 and 512^2 cells): a plant's box test

@@ -1,8 +1,9 @@
-// Plant-covered landscapes (seed 002 sections 4.1-4.3, 5.2): the terrain cut into N x N cells, each mapped
-// to a Wang tile (a square population of plant instances), a 2D kd-tree over the cells and a 2D tree per
-// tile whose boxes reach the tile's top; plants are lifted onto the height field and thinned by the density
-// rule while tracing, nothing is stored per cell beyond its tile and a bound of its ground (range and plane). Plain records here (host
-// and device); the traversal is core/render/trace_landscape.h, the build is landscape.cpp.
+// Plant-covered landscapes (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly
+// Complex Plant Populations", sections 4.1-4.3, 5.2): the terrain cut into N x N cells, each mapped to a Wang
+// tile (a square population of plant instances), a 2D kd-tree over the cells and a 2D tree per tile whose boxes
+// reach the tile's top; plants are lifted onto the height field and thinned by the density rule while tracing,
+// nothing is stored per cell beyond its tile and a bound of its ground (range and plane). Plain records here
+// (host and device); the traversal is core/render/trace_landscape.h, the build is landscape.cpp.
 #pragma once
 
 #include <cstdint>

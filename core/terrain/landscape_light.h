@@ -1,12 +1,13 @@
-// The forest-level LB grid over a landscape (issue 18 item 1, seed 000 section 3): a coarse lattice over the
-// terrain's footprint whose nodes under the ground are opaque black and whose columns carry the foliage of
-// the plants that grow there (each cell's tile plants, lifted and thinned exactly as the traversal does, x
-// their species' biomass at their scale), solved with the scene's sun as a beam (lb::solveGroundedLattice:
-// absorption only, see forest_grid.cpp). The light arriving at each column's canopy over the unobstructed
-// light scales the LB lighting of every landscape plant there (core/terrain/landscape.h landLightFactor,
-// read by the shader): plants in a valley or on a wall the terrain shades, or inside a stand that takes the
-// sun's level share, get less than those on open ground. One lattice per frame, nothing per plant: billions
-// of plants cost what their cells cost. docs/RENDERING.md says what it leaves out.
+// The forest-level LB grid over a landscape (Geist & Steele, "A Lighting Model for Fast Rendering of Forest
+// Ecosystems", section 3): a coarse lattice over the terrain's footprint whose nodes under the ground are
+// opaque black and whose columns carry the foliage of the plants that grow there (each cell's tile plants,
+// lifted and thinned exactly as the traversal does, x their species' biomass at their scale), solved with the
+// scene's sun as a beam (lb::solveGroundedLattice: absorption only, see forest_grid.cpp). The light arriving at
+// each column's canopy over the unobstructed light scales the LB lighting of every landscape plant there
+// (core/terrain/landscape.h landLightFactor, read by the shader): plants in a valley or on a wall the terrain
+// shades, or inside a stand that takes the sun's level share, get less than those on open ground. One lattice
+// per frame, nothing per plant: billions of plants cost what their cells cost. docs/RENDERING.md says what it
+// leaves out.
 #pragma once
 
 #include <vector>

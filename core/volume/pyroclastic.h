@@ -1,4 +1,5 @@
-// Pyroclastic cloud volumes (seed 003, "CreatePyroclasticVolume"): a sphere's distance field displaced
+// Pyroclastic cloud volumes (the graphics-blog post "Adventures in Fluid Simulation",
+// its "CreatePyroclasticVolume"): a sphere's distance field displaced
 // outward by |fBm Perlin noise|. Public API for the CLI (`sylva volume cloud`) and for scenes that build
 // a cloud in place of reading a grid.
 #pragma once

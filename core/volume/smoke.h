@@ -1,4 +1,4 @@
-// Smoke simulation (seed 003 "Adventures in Fluid Simulation"; Fedkiw, Stam & Jensen 2001 "Visual
+// Smoke simulation (the graphics-blog post "Adventures in Fluid Simulation"; Fedkiw, Stam & Jensen 2001 "Visual
 // Simulation of Smoke"): stable fluids on a MAC grid with buoyancy from temperature, vorticity
 // confinement, sources and obstacles. Public API for `sylva simulate` and for a studio job.
 //

@@ -1,6 +1,6 @@
-// Solid voxelization (seed 004 3.2.3, the PMMA teapot): the interior of a mesh filled, robust to open
-// edges and gaps through the generalized winding number (winding_number.h). Public API for
-// `sylva voxelize --solid`, scenes and the renderer.
+// Solid voxelization (Geist & Westall, "Lattice-Boltzmann Lighting Models", section 3.2.3, the PMMA teapot):
+// the interior of a mesh filled, robust to open edges and gaps through the generalized winding number
+// (winding_number.h). Public API for `sylva voxelize --solid`, scenes and the renderer.
 #pragma once
 
 #include "core/grid/grid.h"

@@ -1,4 +1,4 @@
-// Mesh to density grid (LB_MODEL.md "Voxelization"): exact triangle / sub-cell marking, parallel, deterministic.
+// Mesh to density grid (docs/LB_MODEL.md "Voxelization"): exact triangle / sub-cell marking, parallel, deterministic.
 #pragma once
 
 #include <glm/glm.hpp>

@@ -20,7 +20,7 @@
 namespace sylva::cli {
 namespace {
 
-// sylva light's defaults on the measured front (issue 18 item 3): fp16, 1 x the longest edge, unless
+// sylva light's defaults on the measured front: fp16, 1 x the longest edge, unless
 // --seed-steps (the seed's fp32, 2 x the longest edge), --steps/--tol or --fp32 say otherwise. Parameters
 // fp16 cannot hold (a large intensity) fall back to fp32 with a note.
 void applyLightDefaults(const Args& args, lb::LbParams& p)
@@ -136,7 +136,7 @@ int runLight(const Args& args)
         bar.finish(log.stages.back());
     }
     if (part != "all") {
-        // The first collision separated (issue 18 item 4): the same LB with scattering off is the uncollided light.
+        // The first collision separated: the same LB with scattering off is the uncollided light.
         ProgressPrinter ubar("uncollided", args.has("--quiet"));
         JobLog ulog;
         const LightingGrid uncollided = lightingFor(density, lb::uncollidedParams(params), cache.get(), &ubar.progress(), &ulog, compute.get());

@@ -1,4 +1,4 @@
-// Digital elevation models in, as height fields: 16-bit PNG (as ../shared/data/terrain), 8-bit images,
+// Digital elevation models in, as height fields: 16-bit PNG (as resources/terrain/sthelens_10m.png), 8-bit images,
 // float TIFF or EXR, read with OpenImageIO.
 #pragma once
 

@@ -1,5 +1,8 @@
 // The scene file's field table: each key once, with its type, bounds, default (from the records of
 // core/scene/scene.h), a one-line doc (docs/SCENE.md's rule column) and its words in `sylva info`.
+// The docs cite papers by short name: Geist & Steele = "A Lighting Model for Fast Rendering of Forest
+// Ecosystems"; Geist & Westall = "Lattice-Boltzmann Lighting Models"; Dietrich et al. = Dietrich,
+// Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly Complex Plant Populations".
 #include "pipeline/scene/scene_fields.h"
 
 #include <algorithm>
@@ -100,7 +103,7 @@ const Table<SpeciesDesc>& lightingTable()
         b.boolean("lb", [](auto& d) -> auto& { return d.lit; })
             .doc("bool",
                  "`false`: no LB grid is solved; the species is lit conventionally, its ambient term the diffuse colour x the "
-                 "sun's radiance (the LB's value in open space; seed 004 Figure 5), default `true`")
+                 "sun's radiance (the LB's value in open space; Geist & Westall, Figure 5), default `true`")
             .writtenIf([](const SpeciesDesc& d) { return !d.lit; });
         b.custom(
              "steps",
@@ -329,7 +332,7 @@ const Table<DensityDesc>& densityTable()
 {
     static const Table<DensityDesc> table = [] {
         TableBuilder<DensityDesc> b(Layout::Inline);
-        b.boolean("enabled", &DensityDesc::enabled).doc("bool", "thin the plants by altitude (seed 002 eq. 2, 3) and the ground's colour");
+        b.boolean("enabled", &DensityDesc::enabled).doc("bool", "thin the plants by altitude (Dietrich et al., eq. 2, 3) and the ground's colour");
         b.number("lower", &DensityDesc::lower).doc("number", "world y of the lower tree line, metres");
         b.number("upper", &DensityDesc::upper).doc("number", "world y of the upper tree line, metres (>= lower)");
         b.number("at_lower", &DensityDesc::atLower, Bounds{.lo = 0.0, .hi = 1.0}).doc("number", "d_min: density threshold at and below the lower line, [0, 1]");
@@ -389,7 +392,7 @@ const Table<TerrainDesc>& terrainTable()
             .doc("number", "world y above which the ground is snow, metres; 0 = no snow");
         b.integer("cells", &TerrainDesc::cells, 0, 65536)
             .doc("integer",
-                 "plant cells along the terrain's longer side (seed 002: 64 .. 512), each carrying a Wang tile of `tiles`; 0 = no plant "
+                 "plant cells along the terrain's longer side (Dietrich et al.: 64 .. 512), each carrying a Wang tile of `tiles`; 0 = no plant "
                  "tiles; `sylva render --cells` overrides it")
             .writtenIf([](const TerrainDesc& t) { return t.cells > 0; })
             .summarized([](const TerrainDesc& t) { return t.cells > 0 ? std::to_string(t.cells) + " cells a side" : std::string(); });
@@ -398,7 +401,7 @@ const Table<TerrainDesc>& terrainTable()
         terrainObject(b, "tiling", [](TerrainDesc& t) -> TilingDesc& { return t.tiling; }, tilingTable(),
                       [](const TerrainDesc& t) { return t.cells > 0; }, "the Wang tile set and the tiling of the cells");
         terrainObject(b, "density", [](TerrainDesc& t) -> DensityDesc& { return t.density; }, densityTable(),
-                      [](const TerrainDesc& t) { return t.density.enabled; }, "adaptive plant density while tracing (seed 002 section 4.3)");
+                      [](const TerrainDesc& t) { return t.density.enabled; }, "adaptive plant density while tracing (Dietrich et al., section 4.3)");
         b.table.after = [](JsonReader& r, const QJsonObject& o, const KeyPath& p, TerrainDesc& t) {
             if (t.cells > 0 && !o.contains(QLatin1String("tiles"))) r.fail(p.field("tiles"), "missing (required with cells > 0: the tiles' plants)");
         };
@@ -648,7 +651,7 @@ const Table<LightingDesc>& sceneLightingTable()
             .summarized([](const LightingDesc& l) { return std::string("LB boundary ") + lbBoundaryName(l.boundary); });
         b.enumeration("forest_grid", &LightingDesc::forestGrid, parseForestGridMode, forestGridModeName, "forest grid", "off, auto, on")
             .doc("string",
-                 "the forest-level LB grid (seed 000 section 3): `off` (default: every instance of a species lit alike), `on` "
+                 "the forest-level LB grid (Geist & Steele, section 3): `off` (default: every instance of a species lit alike), `on` "
                  "(each instance's species lighting scaled by the grid's factors: stand interiors darker, the open side of an "
                  "edge tree lit), `auto` (as `on` where the factors spread by 2% or more, else skipped; `render --stats` says which). "
                  "With a landscape, its tile plants too: one lattice over the terrain whose ground is opaque, valley and shaded-slope "

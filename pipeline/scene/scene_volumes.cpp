@@ -1,4 +1,5 @@
 // The scene file's volumes: optics preset with per-channel overrides, grid files, tracer, placements.
+// Geist & Westall in the docs = Geist & Westall, "Lattice-Boltzmann Lighting Models".
 #include "pipeline/scene/scene_volumes.h"
 
 #include <cmath>
@@ -108,7 +109,7 @@ const Table<VolumeDesc>& volumeTable()
                  d.lighting.storage = keep.storage;
              },
              [](JsonWriter& w, const VolumeDesc& d, const KeyPath&, int) { w.string(d.preset); })
-            .doc("string", "optics: `cloud` (seed 004: sigma_a 0.008, sigma_s 0.792, g 0.9), `smoke` (0.25, 0.25, 0.3), `pmma`")
+            .doc("string", "optics: `cloud` (Geist & Westall: sigma_a 0.008, sigma_s 0.792, g 0.9), `smoke` (0.25, 0.25, 0.3), `pmma`")
             .readWhenAbsent = true;
         channels(b, "sigma_a", &lb::ChannelParams::sigmaA)
             .doc("number or `[r, g, b]`", "absorption per node spacing at density 1; one number sets all channels")
@@ -121,7 +122,7 @@ const Table<VolumeDesc>& volumeTable()
              "tracer", &VolumeDesc::tracer, [](const std::string& s, VolumeTracer* t) { return parseVolumeTracer(s, t); },
              [](VolumeTracer t) { return volumeTracerName(t); }, "volume tracer", "lb, single, combined")
             .doc("string",
-                 "`lb` (seed 004: the LB solution along the ray), `single` (seed 003: sun single scattering, a shadow march per "
+                 "`lb` (Geist & Westall: the LB solution along the ray), `single` (sun single scattering, a shadow march per "
                  "step), `combined` (single + the LB's multiple scattering); ACCURACY.md \"Volumes\"");
         b.number("step", &VolumeDesc::step, Bounds{.lo = 0.05, .hi = 16.0, .unit = " nodes"})
             .doc("number", "largest camera-ray step in nodes, 0.05 .. 16 (adaptive: at most optical depth 0.25 a step, down to step / 8)");

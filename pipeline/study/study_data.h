@@ -125,7 +125,7 @@ struct RenderData {
     std::vector<PresetRow> presets;
 };
 
-// ---- Scene scale: the forest-level grid and the relighting basis (issue 18 item 5) ----
+// ---- Scene scale: the forest-level grid and the relighting basis ----
 
 // One forest-grid setting on the stand, against the per-instance reference.
 struct ForestGridRow {

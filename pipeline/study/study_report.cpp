@@ -400,8 +400,9 @@ std::string renderSections(const RenderData& d, Plotter& pl)
     std::string sppList;
     for (size_t k = 0; k < d.lodSpps.size(); ++k) sppList += (k ? (k + 1 == d.lodSpps.size() ? " and " : ", ") : "") + std::to_string(d.lodSpps[k]);
     s << d.lodScene << ", " << d.lodWidth << "x" << d.lodHeight << ". **Adaptive transparency** "
-         "(`render.alpha_distance`, seed 000 section 2.1): beyond the distance, leaf cut-outs are not tested and cards count as "
-         "opaque. **Stochastic pruning** (`render.prune_distance`, seed 003): an instance at distance d traces a level of detail "
+         "(`render.alpha_distance`, Geist & Steele, \"A Lighting Model for Fast Rendering of Forest Ecosystems\", section 2.1): "
+         "beyond the distance, leaf cut-outs are not tested and cards count as "
+         "opaque. **Stochastic pruning** (`render.prune_distance`, Cook et al. 2007): an instance at distance d traces a level of detail "
          "keeping about start / d of its leaf cards, enlarged to keep the leaf area (docs/RENDERING.md). Each setting at "
       << sppList << " spp; image error as above against the forest with both off at " << d.lodReferenceSpp << " spp ("
       << secs(d.lodReferenceSeconds) << " s), and the knob's own change (\"vs off\"): against both off at the same spp. Build: the "
@@ -666,7 +667,7 @@ void writeReport(const Options& options, const ReportInput& in, Result& result)
 
     std::ostringstream md;
     md << "# Accuracy\n\n";
-    md << "How far the LB lighting (`sylva light`, `../shared/design/LB_MODEL.md`) is from the light transport it approximates, "
+    md << "How far the LB lighting (`sylva light`, [LB_MODEL.md](LB_MODEL.md)) is from the light transport it approximates, "
           "and what each speed knob costs in accuracy and buys in time. The yardstick is a Monte Carlo reference solver "
           "(`core/reference/mc_reference.h`, `sylva reference`): it solves the volumetric radiative transfer on the same density "
           "grid with the same optics, is slow, and is exact in the limit of many paths, with a standard error per node.\n\n";

@@ -1,4 +1,4 @@
-// Scene-scale study (issue 18 item 5): the forest-level grid's resolution against the picture a per-instance
+// Scene-scale study: the forest-level grid's resolution against the picture a per-instance
 // solve gives on a stand of trees, and the relighting basis against direct solves.
 //
 // The reference lights every instance of the stand by its own LB grid, cut out of one LB solve over the whole

@@ -564,7 +564,8 @@ bool measureTruth(const Options& o)
           "(64 diffuse and transmission bounces, 256 transparent) |\n\n";
     {
         const LeafOptics lo = leafOptics(defaultSpeciesLighting(*lb::findPreset("leaf")));
-        md << "The leaf preset (seed 000 Table 1) stands for, per channel R, G, B: single-scattering albedo sigma_s / sigma_t = "
+        md << "The leaf preset (Geist & Steele, \"A Lighting Model for Fast Rendering of Forest Ecosystems\", Table 1) stands for, "
+              "per channel R, G, B: single-scattering albedo sigma_s / sigma_t = "
            << f("%.3f", lo.albedo.x) << ", " << f("%.3f", lo.albedo.y) << ", " << f("%.3f", lo.albedo.z) << "; reflectance "
            << f("%.3f", lo.reflectance.x) << ", " << f("%.3f", lo.reflectance.y) << ", " << f("%.3f", lo.reflectance.z)
            << "; transmittance " << f("%.3f", lo.transmittance.x) << ", " << f("%.3f", lo.transmittance.y) << ", "

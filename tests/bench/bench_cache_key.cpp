@@ -1,7 +1,7 @@
 // Cache key of a 256^3 density grid (density + wood fraction, 128 MiB): the key the cache uses now
 // (densityHash: XXH3-128 over the arrays, pipeline/lighting_job) beside the one it used before
 // (SHA-256 through QCryptographicHash over the same bytes), in one run, medians of several runs.
-// Target (issue 22): <= 50 ms. Ends with name=value lines.
+// Target: <= 50 ms. Ends with name=value lines.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

@@ -1,4 +1,4 @@
-// The forest-level LB grid on the default forest (issue 18 item 1): build + solve time at a few resolutions,
+// The forest-level LB grid on the default forest: build + solve time at a few resolutions,
 // with the factor range it gives. Species densities come from loadSpeciesGrids (through a grid cache in
 // $TMPDIR so reruns skip the per-species solves); only the timed part is the forest grid. Then its share over
 // the bundled landscape (resources/landscape.sylva.json: the St Helens DEM, 125^2 cells of Wang tiles): the

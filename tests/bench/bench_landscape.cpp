@@ -1,11 +1,12 @@
-// Landscape benchmark, seed 002's Table 1: the bundled landscape's species as Wang tiles on the St Helens DEM
-// stretched to 82 km, 64^2 .. 512^2 cells, 640 x 480, one primary and one shadow ray per pixel (alpha-tested
-// leaves), a panorama over the terrain. Per cell count: build time, memory, potentially visible instances and
-// triangles (with and without the density rule's thinning), primary, shadow and frame time; the scaling
-// time(512^2) / time(64^2); the same rays traced ray by ray (traceScene) and an 8x8 tile at a time (traceScenePacket,
-// as the CPU renderer traces a landscape), and with --embree beside Embree 3's single rays and streams; the frame as
-// the renderer renders it (renderFilm: those packets, the surface stage and shading with the species' LB lighting,
-// the seed's frame time); the scaling again from the first and last counts' frames timed in turn (--pairs). Ends
+// Landscape benchmark, Dietrich et al.'s ("Terrain Guided Multi-Level Instancing of Highly Complex Plant
+// Populations") Table 1: the bundled landscape's species as Wang tiles on the St Helens DEM stretched to 82 km,
+// 64^2 .. 512^2 cells, 640 x 480, one primary and one shadow ray per pixel (alpha-tested leaves), a panorama
+// over the terrain. Per cell count: build time, memory, potentially visible instances and triangles (with and
+// without the density rule's thinning), primary, shadow and frame time; the scaling time(512^2) / time(64^2);
+// the same rays traced ray by ray (traceScene) and an 8x8 tile at a time (traceScenePacket, as the CPU renderer
+// traces a landscape), and with --embree beside Embree 3's single rays and streams; the frame as the renderer
+// renders it (renderFilm: those packets, the surface stage and shading with the species' LB lighting, the
+// seed's frame time); the scaling again from the first and last counts' frames timed in turn (--pairs). Ends
 // with name=value lines.
 #include <algorithm>
 #include <cmath>

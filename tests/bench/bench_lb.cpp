@@ -139,7 +139,7 @@ int main(int argc, char** argv)
     };
 
     if (relightOnly) {
-        // Relighting by linearity (issue 18 item 2): the basis of sylva light's default configuration, then
+        // Relighting by linearity: the basis of sylva light's default configuration, then
         // random suns composed from it against a direct solve of each, side by side.
         LbParams p = base;
         useFrontDefaults(p);
@@ -185,7 +185,7 @@ int main(int argc, char** argv)
     LbParams p16 = base;
     p16.storage = Storage::Fp16;
     // sylva light's default (useFrontDefaults) against the fp32 streaming floor of the seed's configuration,
-    // both measured in this run (issue 18 item 3: target <= 0.33 x the floor at <= 1% from the seed's result).
+    // both measured in this run (target: <= 0.33 x the floor at <= 1% from the seed's result).
     {
         LbParams cli = base;
         useFrontDefaults(cli);

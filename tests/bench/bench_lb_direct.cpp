@@ -1,4 +1,4 @@
-// Direct light counted once (issue 18 item 4): the LB grid with its uncollided part (the seed's sum) and with
+// Direct light counted once: the LB grid with its uncollided part (the seed's sum) and with
 // only its scattered part, each added to the direct light drawn separately, against the Monte Carlo
 // reference, which separates the uncollided light (maxBounces 0) from the rest. docs/ACCURACY.md records it.
 //

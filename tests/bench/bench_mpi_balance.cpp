@@ -2,7 +2,8 @@
 // one on one thread (the same renderFilmRect the ranks call), then the speedup at N ranks is simulated for
 // the dynamic queue of 32x32 tiles (each rank takes the next tile when it is free; a tile traced by a rank
 // other than 0 pays the per-tile message cost) and for the seed's static split (N equal parts of the
-// image, seed 000 section 4.3: rows and, for comparison, columns).
+// image, Geist & Steele, "A Lighting Model for Fast Rendering of Forest Ecosystems", section 4.3: rows and, for
+// comparison, columns).
 //   bench_mpi_balance [SCENE.sylva.json] [--spp N] [--message-us U]   (default: the default forest)
 #include <algorithm>
 #include <cstdio>

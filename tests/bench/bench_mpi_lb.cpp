@@ -4,7 +4,7 @@
 // medium (every row collides: the dearest plane); then, alone, the halo exchange of the same planes
 // (both ranks send one plane and receive one, as a step does, no update beside it). From the measured
 // cost of a plane and of a halo exchange it simulates one step of an X x Y x Z grid (default the
-// issue's 1024 x 512 x 512) on 2 to 16 ranks:
+// target size, 1024 x 512 x 512) on 2 to 16 ranks:
 //   T(N) = (P + 2) t_plane + max(0, t_halo(N) - P t_plane)   (overlapped: the halos travel while the
 //          P = ceil((X - 2) / N) owned planes are stepped; the two halo planes are stepped after)
 //   t_halo(N) = t_halo at N = 2 (one neighbour), 2 t_halo beyond (two neighbours, the same link)

@@ -1,6 +1,7 @@
-// Volume source benchmarks (issue 17): one smoke simulation step at 128^3 against the memory-streaming floor of
-// the bytes it moves, and the LB solve of seed 004's cloud (256 x 128^2, cloud preset) against the fp32
-// streaming floor, both floors measured in the same run (as bench_lb does). Ends with name=value lines.
+// Volume source benchmarks: one smoke simulation step at 128^3 against the memory-streaming floor of
+// the bytes it moves, and the LB solve of Geist & Westall's ("Lattice-Boltzmann Lighting Models") cloud (256 x
+// 128^2, cloud preset) against the fp32 streaming floor, both floors measured in the same run (as bench_lb
+// does). Ends with name=value lines.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -39,7 +40,7 @@ double copySeconds(size_t bytes)
     return best;
 }
 
-// Seed 004's cloud grid: two pyroclastic clouds side by side on 256 x 128 x 128 nodes.
+// Geist & Westall's cloud grid: two pyroclastic clouds side by side on 256 x 128 x 128 nodes.
 DensityGrid cloud256()
 {
     DensityGrid g;

@@ -30,7 +30,7 @@ namespace sylva::lbx {
 using lb::kC;
 using lb::kDirections;
 
-// The g values of the sweep (issue 6, item 4): both |g| = 1 limits and values just under them.
+// The g values of the sweep: both |g| = 1 limits and values just under them.
 inline const std::vector<float>& sweepG()
 {
     static const std::vector<float> g = {-1.0f, -0.999999f, -0.5f, 0.0f, 0.5f, 0.999999f, 1.0f};
@@ -151,7 +151,7 @@ inline std::vector<float> postCollision(const DensityGrid& d, const lb::LbParams
     return post;
 }
 
-// Photon bookkeeping of one step from state f (LB_MODEL.md "Update"): content = sum of f over the
+// Photon bookkeeping of one step from state f (docs/LB_MODEL.md "Update"): content = sum of f over the
 // interior; inflow = post values that boundary nodes send into the interior; outflow = post values
 // that interior nodes send onto the boundary (dropped); absorbed = what interior collisions remove
 // (f_0 dropped by plants). With these, content(t+1) = content(t) + inflow - outflow - absorbed.

@@ -1,4 +1,4 @@
-// The forest-level LB grid (issue 18 item 1): factors per instance against what must hold without any
+// The forest-level LB grid: factors per instance against what must hold without any
 // fitted numbers: an isolated plant gets exactly the unobstructed 1, a plant inside a closed ring gets less
 // than the ring, the factor is continuous as a plant moves, well-separated plants are uniform (skip).
 #include <QTest>

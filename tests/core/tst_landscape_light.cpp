@@ -1,4 +1,4 @@
-// The forest-level LB grid over a landscape (issue 18 item 1, core/terrain/landscape_light.h): open flat ground
+// The forest-level LB grid over a landscape (core/terrain/landscape_light.h): open flat ground
 // keeps the unobstructed light (closed form: the empty lattice's steady state is the boundary's), a valley is
 // darker than its ridges and a slope facing away from a low sun darker than one facing it, a stand darker
 // than open ground beside it, the plants counted are those the traversal's own growth test keeps (brute

@@ -1,5 +1,5 @@
-// Relighting by linearity (issue 18 item 2), boundary weights (sun, sky: issue 16 item 7) and the
-// uncollided part of the LB field (issue 18 item 4), against direct solves and closed forms.
+// Relighting by linearity, boundary weights (sun, sky) and the
+// uncollided part of the LB field, against direct solves and closed forms.
 #include <QTest>
 
 #include <cmath>
@@ -214,7 +214,7 @@ private Q_SLOTS:
         QCOMPARE(z.totals().y, 0.0f);
     }
 
-    // A boundary per channel (the sun plus a coloured sky, issue 16 item 7) through weightedSolves: one
+    // A boundary per channel (the sun plus a coloured sky) through weightedSolves: one
     // solve when the channels share a distribution, one per lit channel otherwise; the solves' channels put
     // together equal the superposition of the 18 unit-boundary solves (the basis) with the same weights.
     void weightedSolvesAreTheSuperposition()

@@ -1,4 +1,4 @@
-// LB solver at the edges of its parameters (issue 6, item 4): g in [-1, 1] with both limits, sigma_a
+// LB solver at the edges of its parameters: g in [-1, 1] with both limits, sigma_a
 // from 0 to 1, sigma_s up to the stability bound, empty / full / random density, axis, diagonal and
 // grazing suns, fp32 and fp16: finite, non-negative, photons conserved when nothing absorbs and never
 // created otherwise, fp16 neither overflowing nor flushing to zero, |g| -> 1 smooth, bad values refused.
@@ -158,7 +158,7 @@ private Q_SLOTS:
         }
     }
 
-    // Photon balance step by step (LB_MODEL.md "Update"): content(t+1) = content(t) + inflow - outflow -
+    // Photon balance step by step (docs/LB_MODEL.md "Update"): content(t+1) = content(t) + inflow - outflow -
     // absorbed, where inflow is what boundary nodes send in and outflow what interior nodes send onto
     // the boundary. Nothing absorbs when sigma_a = 0 (absorbed = 0 at every step, the run's inflow =
     // outflow + content) or when f_0 is kept; plants with sigma_a > 0 absorb >= 0 and never more than

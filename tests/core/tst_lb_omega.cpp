@@ -1,4 +1,6 @@
-// Omega: mass conservation, the seed's isotropic matrix and null vector, pass-through, the |g| -> 1 limit.
+// Omega: mass conservation, the isotropic matrix of Geist & Steele, "A Lighting Model for Fast Rendering of
+// Forest Ecosystems", eqs. (5)-(7), the null vector of the appendix of Geist & Westall, "Lattice-Boltzmann
+// Lighting Models", pass-through, the |g| -> 1 limit.
 #include <QTest>
 
 #include <cmath>
@@ -14,7 +16,8 @@ namespace {
 
 double at(const DenseOmega& om, int i, int j) { return om[size_t(i * kDirections + j)]; }
 
-// The seed's discrete HG phase, written out independently: p_ij with the (1 - g^2) factor, normalized per column.
+// Geist & Steele's discrete HG phase, written out independently: p_ij with the (1 - g^2) factor, normalized per
+// column.
 double seedPhase(double g, int i, int j)
 {
     auto unit = [](int m) {

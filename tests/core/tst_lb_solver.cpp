@@ -1,5 +1,6 @@
-// LB solver against the seed's naive kernel, conservation, diffusion, symmetry, tolerance mode, fp16, validation;
-// the shared control flow (lb_device.h) against a recording device.
+// LB solver against the naive kernel of Geist & Westall, "Lattice-Boltzmann Lighting Models", conservation,
+// diffusion, symmetry, tolerance mode, fp16, validation; the shared control flow (lb_device.h) against a
+// recording device.
 #include <QTest>
 
 #include <numeric>
@@ -40,7 +41,7 @@ DensityGrid randomDensity(glm::ivec3 dims, uint32_t seed, double emptyShare, dou
     return g;
 }
 
-// The seed's naive kernel (004 section 3.1) in double precision: dense Omega, every node pushes
+// The naive kernel of Geist & Westall (section 3.1) in double precision: dense Omega, every node pushes
 // f_m + rho * (Omega f)_m to r + c_m when that node is interior; plants zero f_0 after each step.
 std::vector<double> referenceSolve(const DensityGrid& d, const LbParams& p, int channel, int steps)
 {
@@ -309,8 +310,9 @@ private Q_SLOTS:
 
     void pulseSpreadsWithSeedDiffusionCoefficient()
     {
-        // Seed equation (4) with lambda = tau = 1: D = ((2/sigma_t) - 1) / (4 (1 + sigma_a)); in 3D the second
-        // moment of the density grows as d<r^2>/dt = 6 D. Measured between steps 20 and 40 in a uniform medium; within 1%.
+        // Geist & Westall's equation (4) with lambda = tau = 1: D = ((2/sigma_t) - 1) / (4 (1 + sigma_a)); in
+        // 3D the second moment of the density grows as d<r^2>/dt = 6 D. Measured between steps 20 and 40 in a
+        // uniform medium; within 1%.
         const int n = 91, c = 45;
         DensityGrid d;
         d.geometry.dims = {n, n, n};

@@ -1,4 +1,4 @@
-// `sylva light` at the edges of the stable region (issue 6, item 4): values outside it are refused
+// `sylva light` at the edges of the stable region: values outside it are refused
 // (exit 1, or 2 for text that is no number) with a message naming the parameter and its bound;
 // values exactly on the bounds run and give a finite, non-negative grid. A frame larger than the memory
 // renders in bands, the same picture as the whole frame.

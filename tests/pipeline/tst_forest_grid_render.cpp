@@ -1,4 +1,4 @@
-// The forest-level LB grid in the picture (issue 18 item 1): a square stand of shrubs under a low sun, seen
+// The forest-level LB grid in the picture: a square stand of shrubs under a low sun, seen
 // from the sun's side (the sunward faces: the front row open to the sun, the rows behind it in its shade; from
 // above, the crowns' tops are lit alike in a stand and the face factors keep them so), with
 // lighting.forest_grid on, auto and off. The species has no LB grid of its own (its indirect light is

@@ -1,4 +1,4 @@
-// Geometry and rendering at the extremes (issue 6, item 4): degenerate, tiny (1e-6 m) and huge (1e5 m)
+// Geometry and rendering at the extremes: degenerate, tiny (1e-6 m) and huge (1e5 m)
 // meshes through voxelize + light + render; scenes 1e5-1e7 m from the origin drawing the same picture
 // without acne or speckled shadows; a camera almost touching a leaf; 1x1 images, spp 1 to 4096.
 #include <QDir>
@@ -256,7 +256,7 @@ private Q_SLOTS:
             QCOMPARE(count(f3.what, 2), 0);
             QVERIFY(count(f3.what, 1) > 0 && count(f3.what, 0) > 0);
         }
-        // Their density marks what they touch (LB_MODEL.md "Voxelization").
+        // Their density marks what they touch (docs/LB_MODEL.md "Voxelization").
         VoxelizeSettings vs;
         vs.longestAxisNodes = 16;
         const DensityGrid d = voxelize(onlyDegenerate, vs);

@@ -1,5 +1,5 @@
-// Relighting from a cached basis (issue 18 item 2), sylva light's front defaults (item 3) and its light parts
-// (item 4): the pipeline and the command line against direct solves.
+// Relighting from a cached basis, sylva light's front defaults (fp16, 1 x the longest
+// edge) and its light parts (all, scattered, uncollided): the pipeline and the command line against direct solves.
 #include <QDir>
 #include <QFile>
 #include <QJsonDocument>

@@ -1,4 +1,4 @@
-// Render passes (issue 22, item 2): `sylva render --passes` and exportRender write one multi-layer EXR
+// Render passes: `sylva render --passes` and exportRender write one multi-layer EXR
 // whose layers carry Cycles' names; Combined is the documented composition of the others; the depth
 // and normal of a known plane (a tilted quad and the ground) against the ray-plane intersection
 // computed here from the pinhole camera.

@@ -1,4 +1,4 @@
-// "Only what the scene requires" (issue 6, item 5), read from the JobLog of renderScene: grids are
+// "Only what the scene requires", read from the JobLog of renderScene: grids are
 // computed per species, not per instance; a rerun recomputes only what the change invalidates (a camera,
 // instance or render-settings change no grid, a sun move no voxelization, an unchanged scene nothing);
 // local mode solves nothing.

@@ -1,4 +1,4 @@
-// A terrain in the renderer (issue 15's first slice): a flat terrain renders the ground plane's picture,
+// A terrain in the renderer: a flat terrain renders the ground plane's picture,
 // the same scene 5e6 m from the origin renders the same picture, the scene file's terrain keys (read,
 // written, relative paths) and a DEM's bad input.
 #include <QTemporaryDir>

@@ -1,4 +1,4 @@
-// Volumes in the renderer (issue 17): Beer-Lambert through a homogeneous absorbing box against
+// Volumes in the renderer: Beer-Lambert through a homogeneous absorbing box against
 // exp(-sigma_t L) per camera ray; single scattering of a homogeneous slab against a quadrature computed
 // here; the tracer's modes against a Monte Carlo picture (core/reference's transport, on camera rays);
 // a cloud's shadow on the ground against the box's transmittance; blackbody emission against Planck

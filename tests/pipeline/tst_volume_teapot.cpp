@@ -1,8 +1,8 @@
-// The PMMA teapot (issue 17 item 6, seed 004 3.2.3): the bundled resources/teapot.sylva.json read as
-// `sylva render` reads it. Its solid voxelization against an independent volume (the teapot's parts
-// closed by caps over their open edges, their union integrated exactly along vertical lines by ray
-// parity), the LB glow against the sun (the lit side brighter than the far side, light through the
-// plastic on the far side), the conventional twin's ambient equal to the diffuse colour, and
+// The PMMA teapot (Geist & Westall, "Lattice-Boltzmann Lighting Models", section 3.2.3): the bundled
+// resources/teapot.sylva.json read as `sylva render` reads it. Its solid voxelization against an independent
+// volume (the teapot's parts closed by caps over their open edges, their union integrated exactly along
+// vertical lines by ray parity), the LB glow against the sun (the lit side brighter than the far side, light
+// through the plastic on the far side), the conventional twin's ambient equal to the diffuse colour, and
 // `sylva light --mesh --solid` against the library's solid voxelizer.
 #include <QTemporaryDir>
 #include <QTest>
@@ -167,7 +167,7 @@ private Q_SLOTS:
         QVERIFY(s.species[0].solid && s.species[0].lit);
         QCOMPARE(s.species[0].preset, std::string("pmma"));
         const lb::ChannelParams& r = s.species[0].lighting.channels[0];
-        QCOMPARE(r.g, 0.80f);   // seed 004 Table 2
+        QCOMPARE(r.g, 0.80f);   // Geist & Westall, Table 2
         QCOMPARE(s.species[0].lighting.channels[1].g, -0.88f);
         QCOMPARE(r.sigmaA, 0.01f);
         QCOMPARE(r.sigmaS, 0.99f);
