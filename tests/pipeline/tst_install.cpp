@@ -1,4 +1,4 @@
-// cmake --install (issue 22, item 3): the build tree installed into a temporary prefix (install only, no
+// cmake --install: the build tree installed into a temporary prefix (install only, no
 // rebuild). The installed sylva runs from there (--version, a render that needs its bundled colour
 // table); the man page and the bash completion name every command and option the binary's own --help
 // lists; the .desktop file, icon and MIME type fit together (Qt's MIME database, reading the prefix,
