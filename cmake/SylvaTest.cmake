@@ -11,7 +11,7 @@ function(sylva_add_test)
     target_link_libraries(${T_NAME} PRIVATE sylva_pipeline Qt6::Test ${T_LIBS})
   endif()
   target_compile_definitions(${T_NAME} PRIVATE
-    SYLVA_SHARED_DATA="${SYLVA_SHARED_DATA}"
+    SYLVA_RESOURCES="${CMAKE_SOURCE_DIR}/resources"
     SYLVA_TEST_DATA="${CMAKE_SOURCE_DIR}/tests/data"
     SYLVA_TEST_OUTPUT="${CMAKE_BINARY_DIR}/test-output")
   add_test(NAME ${T_NAME} COMMAND ${T_NAME})
@@ -27,5 +27,5 @@ function(sylva_add_bench)
   cmake_parse_arguments(B "" "NAME" "SOURCES;LIBS" ${ARGN})
   add_executable(${B_NAME} ${B_SOURCES})
   target_link_libraries(${B_NAME} PRIVATE sylva_pipeline ${B_LIBS})
-  target_compile_definitions(${B_NAME} PRIVATE SYLVA_SHARED_DATA="${SYLVA_SHARED_DATA}")
+  target_compile_definitions(${B_NAME} PRIVATE SYLVA_RESOURCES="${CMAKE_SOURCE_DIR}/resources")
 endfunction()

@@ -44,7 +44,7 @@ Command studyCommand()
             "measure speed against accuracy; regenerate ACCURACY.md with tables and plots (report: from stored numbers; scene: the forest-level grid against per-instance solves and the relighting basis against direct solves; truth: against Blender's Cycles, skipped without `blender` or with --quick; sky: virtual lights x subsets x spp under three skies, the LB with the sky in its boundary against Monte Carlo)",
             {{"--out", "DIR", "folder of ACCURACY.md; plots and numbers go to DIR/accuracy (default docs)"},
              {"--quick", "", "small grids, fewer paths and samples: a few minutes"},
-             {"--tree", "MESH", "the real tree (default ../shared/data/trees/quaternius/OBJ/Tree_1.obj)"},
+             {"--tree", "MESH", "the real tree (default resources/trees/quaternius/OBJ/Tree_1.obj)"},
              kCache, kNoCache, kThreads, kQuiet},
             1, 1, &runStudy};
 }

@@ -17,7 +17,7 @@ struct Options {
     std::vector<Part> parts;            // measured now; the others' stored results are reused (empty: report only)
     std::string outDir = "docs";        // ACCURACY.md here, plots and stored results in outDir/accuracy
     bool quick = false;                 // small grids, fewer paths and samples: a few minutes on 2 cores
-    std::string treeMesh;               // the real tree (empty: ../shared/data/trees/quaternius/OBJ/Tree_1.obj)
+    std::string treeMesh;               // the real tree (empty: resources/trees/quaternius/OBJ/Tree_1.obj)
     GridCache* cache = nullptr;         // Monte Carlo references and the renders' lighting grids (null: none)
     std::function<void(const std::string&)> log;   // one line per measurement
 };

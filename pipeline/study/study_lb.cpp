@@ -56,7 +56,7 @@ void finishRun(RunInfo& run)
 std::string treeMeshPath(const Options& options)
 {
     if (!options.treeMesh.empty()) return options.treeMesh;
-    return std::string(SYLVA_SOURCE_DIR) + "/../shared/data/trees/quaternius/OBJ/Tree_1.obj";
+    return std::string(SYLVA_SOURCE_DIR) + "/resources/trees/quaternius/OBJ/Tree_1.obj";
 }
 
 float sampleWorld(const LightingGrid& g, const glm::dvec3& world, int c)

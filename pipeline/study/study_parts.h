@@ -47,7 +47,7 @@ struct ReportInput {
 // Writes outDir/ACCURACY.md and, with gnuplot, outDir/accuracy/*.png (result.plots, result.plotNote).
 void writeReport(const Options& options, const ReportInput& input, Result& result);
 
-// The real tree of the studies: options.treeMesh or ../shared/data/trees/quaternius/OBJ/Tree_1.obj.
+// The real tree of the studies: options.treeMesh or resources/trees/quaternius/OBJ/Tree_1.obj.
 std::string treeMeshPath(const Options& options);
 
 // Value of a grid's channel c at a world position: trilinear between nodes, clamped to the grid.

@@ -1,4 +1,4 @@
-// Sky study (issue 16): virtual lights N, interleaved subsets K and samples per pixel on the default forest
+// Sky study: virtual lights N, interleaved subsets K and samples per pixel on the default forest
 // under a Preetham sky and two HDR maps, against 1024 lights x 64 spp, with the sun-only frame's time beside
 // them; and the LB with the sky in its boundary against Monte Carlo with the same boundary. Writes
 // outDir/accuracy/sky.md, which the report includes.
@@ -82,7 +82,7 @@ void markFront(std::vector<Row>& rows)
 bool measureSky(const Options& o)
 {
     const double t0 = secondsNow();
-    const std::string hdri = std::string(SYLVA_SOURCE_DIR) + "/../shared/data/hdri/";
+    const std::string hdri = std::string(SYLVA_SOURCE_DIR) + "/resources/hdri/";
     std::vector<SkyCase> skies;
     {
         SkyCase p{"preetham", "Preetham, turbidity 3, the forest's sun", SkyDesc{}};

@@ -840,8 +840,8 @@ void TestVoxelize::badInput()
 
 void TestVoxelize::realTree()
 {
-    const std::string path = std::string(SYLVA_SHARED_DATA) + "/trees/quaternius/OBJ/Tree_1.obj";
-    if (!std::filesystem::exists(path)) QSKIP("Tree_1.obj not present under the shared data folder");
+    const std::string path = std::string(SYLVA_RESOURCES) + "/trees/quaternius/OBJ/Tree_1.obj";
+    QVERIFY2(std::filesystem::exists(path), path.c_str());
     TriangleMesh mesh;
     QVERIFY(readObj(path, mesh));
     QVERIFY(mesh.triangleCount() > 300);

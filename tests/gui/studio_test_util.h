@@ -30,9 +30,9 @@
 
 namespace sylva::test {
 
-inline QString sharedTree() { return QStringLiteral(SYLVA_SHARED_DATA "/trees/quaternius/OBJ/Tree_1.obj"); }
+inline QString sharedTree() { return QStringLiteral(SYLVA_RESOURCES "/trees/quaternius/OBJ/Tree_1.obj"); }
 
-// Three Tree_1 instances of the shared data in a row, turned 0, 40 and 80 degrees, seen from the front.
+// Three Tree_1 instances of resources/trees in a row, turned 0, 40 and 80 degrees, seen from the front.
 inline Scene treeScene()
 {
     Scene s;

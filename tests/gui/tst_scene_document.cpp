@@ -25,7 +25,7 @@ using namespace sylva;
 
 namespace {
 
-QString sharedTree() { return QStringLiteral(SYLVA_SHARED_DATA "/trees/quaternius/OBJ/Tree_1.obj"); }
+QString sharedTree() { return QStringLiteral(SYLVA_RESOURCES "/trees/quaternius/OBJ/Tree_1.obj"); }
 
 Scene treeScene(int instances)
 {

@@ -1,4 +1,4 @@
-// The studio's sky panel and relighting from cached bases (issues 16 item 9, 18 item 2) under Xvfb:
+// The studio's sky panel and relighting from cached bases under Xvfb:
 // panel edits are undoable scene edits whose built sky equals the one the scene reader builds; the time
 // slider moves the sun as NOAA's algorithm (core/sky/sun_position) and the solar-noon closed form place it;
 // with every species' basis in memory a sun change starts no lighting job and writes nothing to the grid
@@ -115,7 +115,7 @@ private Q_SLOTS:
         QCOMPARE(panel.kind()->currentData().toInt(), int(sky::SkyKind::Constant));
 
         // A map: the file, then its rotation and intensity; the lights and their interleave.
-        const QString map = QStringLiteral(SYLVA_SHARED_DATA "/hdri/forest.exr");
+        const QString map = QStringLiteral(SYLVA_RESOURCES "/hdri/forest.exr");
         panel.setMapChooser([map] { return map; });
         panel.kind()->setCurrentIndex(panel.kind()->findData(int(sky::SkyKind::Map)));   // asks for the file
         QCOMPARE(doc.scene().skyModel.kind, sky::SkyKind::Map);

@@ -259,8 +259,8 @@ private Q_SLOTS:
 
     void realTreeLightingLooksRight()
     {
-        const QString tree = QString(SYLVA_SHARED_DATA) + "/trees/quaternius/OBJ_textured/Tree_1.obj";
-        if (!QFile::exists(tree)) QSKIP("../shared/data is absent");
+        const QString tree = QString(SYLVA_RESOURCES) + "/trees/quaternius/OBJ_textured/Tree_1.obj";
+        QVERIFY2(QFile::exists(tree), qPrintable(tree));
         const QString dir = outDir() + "/real";
         QDir().mkpath(dir);
         // Sun from +x and above: the +x side of the crown must be brighter than the -x side.

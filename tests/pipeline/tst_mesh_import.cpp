@@ -20,7 +20,7 @@ using namespace sylva;
 
 namespace {
 
-QString treesDir() { return QStringLiteral(SYLVA_SHARED_DATA "/trees/quaternius"); }
+QString treesDir() { return QStringLiteral(SYLVA_RESOURCES "/trees/quaternius"); }
 
 QString outputDir()
 {
@@ -164,7 +164,7 @@ private Q_SLOTS:
     void realObjTrees_data()
     {
         QTest::addColumn<QString>("file");
-        if (!QDir(treesDir() + "/OBJ").exists()) QSKIP("shared data trees/quaternius/OBJ is absent");
+        QVERIFY2(QDir(treesDir() + "/OBJ").exists(), qPrintable(treesDir()));
         const QStringList objs = QDir(treesDir() + "/OBJ").entryList({"*.obj"}, QDir::Files, QDir::Name);
         QVERIFY(objs.size() >= 4);
         for (const QString& obj : objs) QTest::newRow(qPrintable(obj)) << treesDir() + "/OBJ/" + obj;
@@ -203,7 +203,7 @@ private Q_SLOTS:
     void objLeafWoodSplitKeepsIdenticalMaterials()
     {
         const QString file = treesDir() + "/OBJ/Tree_1.obj";
-        if (!QFile::exists(file)) QSKIP("shared data trees/quaternius/OBJ is absent");
+        QVERIFY2(QFile::exists(file), qPrintable(file));
         ImportReport report;
         const TriangleMesh mesh = importMesh(file.toStdString(), {}, &report);
         QCOMPARE(mesh.materials.size(), size_t(2));
@@ -223,7 +223,7 @@ private Q_SLOTS:
     void objTexturedResolvesTextures_data()
     {
         QTest::addColumn<QString>("file");
-        if (!QDir(treesDir() + "/OBJ_textured").exists()) QSKIP("shared data trees/quaternius/OBJ_textured is absent");
+        QVERIFY2(QDir(treesDir() + "/OBJ_textured").exists(), qPrintable(treesDir()));
         for (const char* tree : {"Tree_1", "Birch_1", "Pine_1", "DeadTree_1"})
             QTest::newRow(tree) << treesDir() + "/OBJ_textured/" + tree + ".obj";
     }
@@ -259,7 +259,7 @@ private Q_SLOTS:
     // without textures it is wood; a missing texture is a warning and an empty path.
     void leafDetectionFromTextures()
     {
-        if (!QDir(treesDir() + "/OBJ_textured").exists()) QSKIP("shared data trees/quaternius/OBJ_textured is absent");
+        QVERIFY2(QDir(treesDir() + "/OBJ_textured").exists(), qPrintable(treesDir()));
         const size_t leafTriangles = countObj(treesDir() + "/OBJ/Tree_1.obj").trianglesPerMaterial["Tree_Leaves"];
         QVERIFY(leafTriangles > 0);
 
@@ -289,7 +289,7 @@ private Q_SLOTS:
     void fbxTrees_data()
     {
         QTest::addColumn<QString>("file");
-        if (!QDir(treesDir() + "/FBX").exists()) QSKIP("shared data trees/quaternius/FBX is absent");
+        QVERIFY2(QDir(treesDir() + "/FBX").exists(), qPrintable(treesDir()));
         const QStringList files = QDir(treesDir() + "/FBX").entryList({"*.fbx"}, QDir::Files, QDir::Name);
         QVERIFY(!files.isEmpty());
         for (const QString& f : files) QTest::newRow(qPrintable(f)) << treesDir() + "/FBX/" + f;

@@ -25,7 +25,7 @@ namespace {
 
 const char* kName = "scene.json";
 
-QString sharedTree() { return QStringLiteral(SYLVA_SHARED_DATA "/trees/quaternius/OBJ/Tree_1.obj"); }
+QString sharedTree() { return QStringLiteral(SYLVA_RESOURCES "/trees/quaternius/OBJ/Tree_1.obj"); }
 
 void writeText(const QString& path, const QByteArray& text)
 {

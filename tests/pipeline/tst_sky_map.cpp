@@ -1,4 +1,4 @@
-// Environment maps from files (pipeline/io/env_map_io) and `sylva sky`: the real HDRIs of ../shared/data/hdri
+// Environment maps from files (pipeline/io/env_map_io) and `sylva sky`: the real HDRIs of resources/hdri
 // (cleaned, their sun found, lights summing to the map), bad maps refused with clear errors, hostile values
 // cleaned, and the written Preetham map read back against the model at the pixel centres.
 #include <QDir>
@@ -80,8 +80,8 @@ class TestSkyMap : public QObject {
 private Q_SLOTS:
     void realMaps()
     {
-        const QString dir = QString(SYLVA_SHARED_DATA) + "/hdri";
-        if (!QDir(dir).exists()) QSKIP("../shared/data/hdri is absent");
+        const QString dir = QString(SYLVA_RESOURCES) + "/hdri";
+        QVERIFY2(QDir(dir).exists(), qPrintable(dir));
         int suns = 0;
         for (const char* name : {"forest", "sky", "park", "sunset", "dawn"}) {
             const std::string path = (dir + "/" + name + ".exr").toStdString();

@@ -1,6 +1,6 @@
-// Tests of the sources of density (issue 17): the pyroclastic cloud generator against its published
+// Tests of the sources of density: the pyroclastic cloud generator against its published
 // formula, the solid voxelizer against closed-form volumes and brute-force winding numbers (a sphere,
-// a sphere with a hole, the open Utah teapot of ../shared/data), and the commands `sylva volume cloud`,
+// a sphere with a hole, the open Utah teapot of tests/data/models), and the commands `sylva volume cloud`,
 // `sylva simulate` and `sylva voxelize --solid` (files read back, bad input refused with exit 1).
 #include <QTemporaryDir>
 #include <QTest>
@@ -88,7 +88,7 @@ float trilinear(const DensityGrid& g, const glm::dvec3& world)
     return float(v);
 }
 
-QString teapotPath() { return QStringLiteral(SYLVA_SHARED_DATA "/models/teapot.obj"); }
+QString teapotPath() { return QStringLiteral(SYLVA_TEST_DATA "/models/teapot.obj"); }
 
 } // namespace
 
@@ -241,7 +241,7 @@ private Q_SLOTS:
     // a Monte Carlo estimate of the inside volume by the exact winding number within 3 sigma + 2%.
     void teapotIsFilled()
     {
-        if (!QFile::exists(teapotPath())) QSKIP("../shared/data/models/teapot.obj is absent");
+        QVERIFY2(QFile::exists(teapotPath()), qPrintable(teapotPath()));
         const TriangleMesh mesh = importMesh(teapotPath().toStdString());
         VoxelizeSettings s;
         s.longestAxisNodes = 48;
@@ -347,7 +347,7 @@ private Q_SLOTS:
         }
     }
 
-    // Bad volume input in a scene (issue 17 item 9): negative, NaN and over-range densities, a grid of
+    // Bad volume input in a scene: negative, NaN and over-range densities, a grid of
     // size 0, optics out of range (sigma < 0, g outside [-1, 1], sigma_t over the LB's bound of 1 for a
     // tracer that solves the LB) each exit 1 with the volume or file named and write no picture; single
     // scattering needs no LB and takes that medium. --volume-tracer replaces every volume's tracer: its
