@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Sylva on a fresh Debian 12 machine: install what is missing, build, then run the main job or the tests.
-#   ./build.sh run    install + build + render the default forest to out/default_forest.png
+#   ./build.sh run    install + build the sylva program only + render the default forest to out/default_forest.png
 #   ./build.sh test   install + build + run every test (ctest)
-#   ./build.sh build  install + build only
+#   ./build.sh build  install + build everything (programs, studio, tests, benchmarks)
 set -euo pipefail
 
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -39,6 +39,7 @@ install_missing() {
   fi
 }
 
+# build [TARGET...]: configure, then build the targets (everything when none is named).
 build() {
   # nvcc lives outside PATH in a default CUDA install; the build enables CUDA when it finds it.
   if ! command -v nvcc >/dev/null 2>&1 && [[ -x /usr/local/cuda/bin/nvcc ]]; then
@@ -46,8 +47,10 @@ build() {
   fi
   echo "==> configuring ($BUILD_DIR)"
   (cd "$ROOT" && cmake --preset release >/dev/null)
-  echo "==> building with $JOBS jobs"
-  cmake --build "$BUILD_DIR" -j "$JOBS"
+  local targets=()
+  if (($#)); then targets=(--target "$@"); fi
+  echo "==> building ${*:-everything} with $JOBS jobs"
+  cmake --build "$BUILD_DIR" -j "$JOBS" "${targets[@]}"
 }
 
 run_main_job() {
@@ -60,7 +63,7 @@ run_main_job() {
 }
 
 case "$MODE" in
-  run) install_missing; build; run_main_job ;;
+  run) install_missing; build sylva; run_main_job ;;
   test) install_missing; build; cd "$BUILD_DIR" && ctest --output-on-failure -j "$JOBS" ;;
   build) install_missing; build ;;
   *) echo "usage: $0 [run|test|build]" >&2; exit 2 ;;
