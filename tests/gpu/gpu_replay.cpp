@@ -2,8 +2,8 @@
 // OpenImageIO, Assimp...: the lent device machines). tst_gpu writes each bundled scene's prepared frame and its
 // CPU film to a folder (SYLVA_GPU_REPLAY_DIR=DIR, bundledScenesMatchCpu; core/render/scene_bytes.h); this
 // program links only the core and the CUDA backend, traces each frame on the device and compares it with the
-// CPU film in every mode with tst_gpu's tolerance (values of the tone-mapped pictures off by more than 0.1:
-// at most 1 in 200). tests/gpu/device_replay.sh prepares the folder and the command.
+// CPU film in every mode in linear radiance with tst_gpu's tolerance (kGpuAgainstCpu, tests/common/linear_compare.h).
+// tests/gpu/device_replay.sh prepares the folder and the command.
 //   gpu_replay DIR [--cpu]     --cpu: trace on the CPU instead (checks the replay itself: the same bits)
 // Prints a line per frame and mode, then name=value lines; exits 1 when a frame is off or unreadable, 2 on usage.
 #include <algorithm>
@@ -18,26 +18,12 @@
 #include "core/base/error.h"
 #include "core/render/render_cpu.h"
 #include "core/render/scene_bytes.h"
-#include "core/render/tonemap.h"
 #include "core/scene/scene.h"
 #include "cuda/device_query.h"
 #include "cuda/render_cuda.h"
+#include "tests/common/linear_compare.h"
 
 using namespace sylva;
-
-namespace {
-
-std::vector<float> toneMappedMode(const Film& f, RenderMode m, const glm::vec3& sky)
-{
-    std::vector<glm::vec3> lin = composeMode(f, m, sky);
-    std::vector<float> out(lin.size() * 3);
-    ToneMapParams p;
-    p.key = 0.18f;
-    toneMapToSrgb(&lin[0].x, lin.size(), out.data(), p);
-    return out;
-}
-
-} // namespace
 
 int main(int argc, char** argv)
 {
@@ -79,14 +65,12 @@ int main(int argc, char** argv)
             const std::string name = path.stem().string();
             bool ok = !onCpu || sameBits;
             for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb}) {
-                const std::vector<float> a = toneMappedMode(cpu, m, sky), b = toneMappedMode(other, m, sky);
-                int bad = 0;
-                for (size_t i = 0; i < a.size(); ++i) bad += std::fabs(a[i] - b[i]) > 0.1f;
-                const int n = int(a.size());
-                ok = ok && bad <= n / 200;
-                std::printf("%s %s: %d of %d values differ by more than 0.1 (%.3f s, %s)\n", name.c_str(), renderModeName(m), bad, n, seconds,
+                const test::LinearComparison c = test::compareLinear(composeMode(other, m, sky), composeMode(cpu, m, sky), test::kGpuAgainstCpu);
+                ok = ok && c.pass;
+                std::printf("%s %s: %s (%.3f s, %s)\n", name.c_str(), renderModeName(m), c.summary.c_str(), seconds,
                             sameBits ? "the same bits" : "bits differ");
-                std::printf("%s_%s_values_off=%d\n", name.c_str(), renderModeName(m), bad);
+                std::printf("%s_%s_values_off=%zu\n%s_%s_mean_error=%.3g\n", name.c_str(), renderModeName(m), c.off, name.c_str(),
+                            renderModeName(m), c.meanError);
             }
             if (!ok) ++failed;
             std::printf("%s_ok=%d\n", name.c_str(), ok ? 1 : 0);
