@@ -344,7 +344,16 @@ private Q_SLOTS:
             den += double(luminance(a[i])) * double(luminance(a[i]));
         }
         const double err = std::sqrt(num / den);
-        QVERIFY2(err > 0.0 && err < 0.5, qPrintable(QString("relative error %1").arg(err)));
+        double meanA = 0.0, meanB = 0.0;
+        for (size_t i = 0; i < a.size(); ++i) meanA += luminance(a[i]), meanB += luminance(b[i]);
+        const double meanShift = std::fabs(meanB - meanA) / meanA;
+        qInfo("pruned and cut at short distances: relative L2 of luminance %.4f, mean luminance moved by %.4f", err, meanShift);
+        // Measured 0.246 and 0.089 (the same on every run: the pruning is seeded). At 5 and 10 m every tree of the
+        // small forest is pruned and cut, the strongest setting: pixels move, the picture as a whole little more
+        // than the leaf area's fluctuation. The bounds hold the measured figures with a fifth to spare, so a
+        // change that prunes twice as hard or loses leaf area fails.
+        QVERIFY2(err > 0.0 && err < 0.30, qPrintable(QString("relative error %1").arg(err)));
+        QVERIFY2(meanShift < 0.11, qPrintable(QString("mean luminance moved by %1").arg(meanShift)));
     }
 };
 
