@@ -1,4 +1,4 @@
-// The studio's sun drag on the default forest relit from cached bases (issue 18 item 2): the window, its
+// The studio's sun drag on the default forest relit from cached bases: the window, its
 // sky panel's azimuth dial and the CPU viewport at 640x360. Builds (or loads from the grid cache) each
 // species' relighting basis first, then turns the dial: in `sequential` steps (each waits for the
 // viewport's first image of the new sun: the latency-bound rate) and as a `drag` (the dial moved at 30

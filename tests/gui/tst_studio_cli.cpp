@@ -103,7 +103,10 @@ private Q_SLOTS:
             fresh->inspectorDock()->show();
             fresh->addDockWidget(Qt::LeftDockWidgetArea, dock(fresh.get(), "logDock"));
             fresh->resize(900, 640);
-            QTest::qWait(100);
+            // The window manager applies the new size and dock layout asynchronously: wait for them before
+            // closing (what close saves is what the next window must show).
+            QTRY_COMPARE_WITH_TIMEOUT(fresh->size(), QSize(900, 640), 60000);
+            QTRY_VERIFY_WITH_TIMEOUT(fresh->inspectorDock()->isVisible(), 60000);
             QVERIFY(fresh->close());
         }
         QVERIFY(!QSettings().value("window/state").toByteArray().isEmpty());

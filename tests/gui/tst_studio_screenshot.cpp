@@ -1,5 +1,5 @@
-// A screenshot of the main window with a lit tree under Xvfb, against a golden image with a loose
-// tolerance (fonts and widget styles may move a few pixels between machines; the tree must not).
+// A screenshot of the main window with a lit tree under Xvfb, against a golden image (the same pixels run to
+// run; the tolerance allows a few pixels of another machine's font rasterizer, not a moved widget or tree).
 // The picture is written to the build tree (test-output/gui_main_window.png) for inspection; a missing
 // baseline is written and fails; SYLVA_TEST_UPDATE=1 rewrites it.
 #include <QDir>
@@ -55,7 +55,7 @@ private Q_SLOTS:
         // What changes from run to run (times, paths) stays out of the picture.
         win.clearLog();
         win.statusBar()->clearMessage();
-        QTest::qWait(100);
+        QCoreApplication::processEvents();   // grab() paints the widgets itself; this only flushes posted updates
         const QImage shot = win.grab().toImage().convertToFormat(QImage::Format_RGB888);
 
         const QString out = QString(SYLVA_TEST_OUTPUT) + "/gui_main_window.png";
@@ -70,14 +70,15 @@ private Q_SLOTS:
         OIIO::ImageBuf a(out.toStdString()), b(golden.toStdString());
         QCOMPARE(a.spec().width, b.spec().width);
         QCOMPARE(a.spec().height, b.spec().height);
-        // A pixel fails above 0.25 in any channel (64 of 255). The picture fails when more than 3% of
-        // its pixels fail (text re-flowed by another font) or its mean error exceeds 0.02 (a wrong or
-        // missing render changes the whole viewport, about half the window).
-        const auto cmp = OIIO::ImageBufAlgo::compare(a, b, 0.25f, 0.1f);
+        // The window is drawn by the same Qt, fonts and renderer on every run: measured, the same pixels on three
+        // runs (0 differing). A pixel fails above two 8-bit steps in a channel; the picture fails when more than
+        // 0.2% of its pixels fail (about 1,300: a label re-flowed or a widget moved) or its mean error exceeds
+        // half a step. A new window layout needs SYLVA_TEST_UPDATE=1 and a look at the picture.
+        const auto cmp = OIIO::ImageBufAlgo::compare(a, b, 2.5f / 255.0f, 2.5f / 255.0f);
         const double npx = double(a.spec().width) * double(a.spec().height);
-        qInfo("screenshot vs golden: %lld failing pixels (%.2f%%), mean error %.4f", (long long)cmp.nfail,
-              100.0 * double(cmp.nfail) / npx, cmp.meanerror);
-        if (double(cmp.nfail) > 0.03 * npx || cmp.meanerror > 0.02) {
+        qInfo("screenshot vs golden: %lld pixels off by more than two steps (%.3f%%), mean error %.5f, max channel error %.0f steps",
+              (long long)cmp.nfail, 100.0 * double(cmp.nfail) / npx, cmp.meanerror, cmp.maxerror * 255.0);
+        if (double(cmp.nfail) > 0.002 * npx || cmp.meanerror > 0.5 / 255.0) {
             OIIO::ImageBuf diff = OIIO::ImageBufAlgo::absdiff(a, b);
             diff = OIIO::ImageBufAlgo::mul(diff, 16.0f);
             diff.write(out.toStdString() + ".diff16.png");

@@ -160,9 +160,17 @@ private Q_SLOTS:
         s.render.mode = RenderMode::Lb;
         worker.request(s, assets, QSize(128, 72));
         QTRY_COMPARE_WITH_TIMEOUT(images.count(), 1, 20000);
-        QTest::qWait(50);
-        QCOMPARE(images.count(), 1);
+        QVERIFY(images.at(0).at(2).toBool());
         QVERIFY(images.at(0).at(0).value<QImage>() != full);
+        // ... and no pass after it: the worker answers requests in order, so the same request again is
+        // answered by the next image, itself recomposed (full size, last, that request's serial). A trace
+        // started after the first image would come first, or leave the film mid-schedule so that the
+        // second answer is a quarter-size pass.
+        worker.request(s, assets, QSize(128, 72));
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 2, 20000);
+        QCOMPARE(images.at(1).at(4).toULongLong(), worker.latestRequest());
+        QVERIFY(images.at(1).at(2).toBool());
+        QCOMPARE(images.at(1).at(0).value<QImage>(), images.at(0).at(0).value<QImage>());
 
         // Camera moves in a burst: only the last one needs to finish.
         images.clear();
@@ -183,7 +191,7 @@ private Q_SLOTS:
         QTRY_VERIFY_WITH_TIMEOUT(!images.isEmpty() && images.last().at(2).toBool(), 20000);
     }
 
-    // Progressive refinement (issue 16 item 5) under a Preetham sky with 16 virtual lights in 4 subsets:
+    // Progressive refinement under a Preetham sky with 16 virtual lights in 4 subsets:
     // while the camera moves (every request restarts the schedule) the schedule's frames light with the
     // sun alone; once it stops, frames of 4 samples (one cycle of the subsets) are accumulated until the
     // scene's 8 spp, and that last picture equals the frame `sylva render` traces (buildRenderScene at the
@@ -239,7 +247,7 @@ private Q_SLOTS:
         QVERIFY2(maxStep(moving, settled) > 8, qPrintable(QString("moving frame only %1 steps off the settled one").arg(maxStep(moving, settled))));
     }
 
-    // Side-by-side compare (seed 000 Figure 2): both halves come from one trace. Turning compare on
+    // Side-by-side compare (Geist & Steele, "A Lighting Model for Fast Rendering of Forest Ecosystems", Figure 2): both halves come from one trace. Turning compare on
     // (or changing its mode) recomposes the last film without tracing: the left half equals the
     // mode-A picture and the right half the mode-B picture of that same film, pixel for pixel. A
     // fresh trace with compare on matches the two pictures of a headless buildRenderScene frame.
@@ -279,8 +287,13 @@ private Q_SLOTS:
         images.clear();
         worker.request(s, assets, size, RenderMode::Lb);
         QTRY_COMPARE_WITH_TIMEOUT(images.count(), 1, 20000);
-        QTest::qWait(50);
-        QCOMPARE(images.count(), 1);
+        // No pass after it (as for a mode change above): the same request again is answered by the next
+        // image, recomposed, the same picture.
+        worker.request(s, assets, size, RenderMode::Lb);
+        QTRY_COMPARE_WITH_TIMEOUT(images.count(), 2, 20000);
+        QCOMPARE(images.at(1).at(4).toULongLong(), worker.latestRequest());
+        QVERIFY(images.at(1).at(2).toBool());
+        QCOMPARE(images.at(1).at(0).value<QImage>(), images.at(0).at(0).value<QImage>());
         const QImage cmp = images.at(0).at(0).value<QImage>();
         const QString mismatch = halvesMatch(cmp, full, lbImage, 0);
         QVERIFY2(mismatch.isEmpty(), qPrintable(mismatch));

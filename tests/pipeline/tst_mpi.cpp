@@ -251,7 +251,7 @@ private Q_SLOTS:
 
     // A rank killed (SIGKILL) or stopped (SIGSTOP: it hangs) while the frame is traced (512 spp: tens of
     // seconds of tracing even on idle cores, so the signal lands mid-frame; the job ends first): mpirun exits
-    // non-zero within 30 s, rank 0 says what happened, and neither the picture nor a temporary file is left.
+    // non-zero by itself (120 s bound only a hang), rank 0 says what happened, and neither the picture nor a temporary file is left.
     // A rank stopped as soon as it exists ("hung at start": before MPI_Init, or in it) ends the job
     // through the start bound (2 x --mpi-timeout + 5 s).
     void deadOrHungRankEndsTheJob_data()
@@ -296,13 +296,13 @@ private Q_SLOTS:
         QCOMPARE(::kill(victim, signal), 0);
         QElapsedTimer t;
         t.start();
-        const bool ended = p.waitForFinished(30000);
+        const bool ended = p.waitForFinished(120000);   // bounds a hang only: the job must end by itself
         if (!ended) {
             ::kill(victim, SIGKILL);
             p.kill();
             p.waitForFinished(5000);
         }
-        QVERIFY2(ended, "the job did not end within 30 s");
+        QVERIFY2(ended, "the job did not end after a rank was signalled");
         err += p.readAllStandardError();
         qInfo("the job ended %.1f s after the signal", double(t.elapsed()) / 1000.0);
         QVERIFY(p.exitStatus() != QProcess::NormalExit || p.exitCode() != 0);

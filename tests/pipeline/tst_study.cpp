@@ -1,6 +1,8 @@
-// `sylva study lb --quick` end to end (CI smoke test, label slow): the report, its kept sections, the plots or
-// the note that they were skipped, and `sylva study report` from the stored numbers; `sylva study scene --quick`;
-// `sylva study sky --quick`.
+// `sylva study lb --quick` end to end (label slow: minutes): the numbers it measures (lb.json: every error
+// finite, at least its reference's noise and below the LB's documented error; fp16 = fp32; a finer grid
+// closer to the finest reference for the trees; the step counts each mode implies), the report, its kept
+// sections, the plots or the note that they were skipped, and `sylva study report` from the stored numbers;
+// `sylva study scene --quick`; `sylva study sky --quick`.
 #include <QDir>
 #include <QFile>
 #include <QJsonArray>
@@ -11,6 +13,7 @@
 #include <QTemporaryDir>
 #include <QTest>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <tuple>
@@ -52,6 +55,94 @@ QString readAll(const QString& path)
 class TestStudy : public QObject {
     Q_OBJECT
 
+    // What `sylva study lb --quick` measured (accuracy/lb.json), against what its own setup implies:
+    // - each reference's noise (relative standard error over the interior) is positive and small, and an
+    //   LB error measured against it is at least that noise (the noise adds in quadrature: e^2 = lb^2 +
+    //   noise^2; 0.9 of it leaves room for the sampling of that sum over the nodes);
+    // - every error is finite and below 0.12: the full study's largest same-grid error is 0.074 and its
+    //   largest error against the finest grid 0.111 (docs/ACCURACY.md); the quick references' noise
+    //   (a quarter of the paths: twice the full study's, ~0.02-0.03) adds to that in quadrature;
+    // - fp16 storage changes an error by less than 1e-3 (the full study: at most 2.6e-4);
+    // - for the two trees, the 64-node grid is closer to the finest (64) reference than the 32-node grid
+    //   sampled at its nodes, in every steps mode and storage (the crown's detail is resolved better;
+    //   the full study: 0.110 -> 0.085 and 0.111 -> 0.088);
+    // - the steps run: `default` = 2 x the longest edge, `half` = the longest edge, the tolerances at
+    //   most 4 x the longest edge, 1e-4 at least as many as 1e-3;
+    // - exactly one row per case is the product's default, the one `default_config` names.
+    void checkLbNumbers(const QString& path)
+    {
+        QFile f(path);
+        QVERIFY(f.open(QIODevice::ReadOnly));
+        const QJsonObject root = QJsonDocument::fromJson(f.readAll()).object();
+        const QString defaultConfig = root.value("default_config").toString();
+        QVERIFY2(defaultConfig.startsWith("grid "), qPrintable(defaultConfig));
+        int casesRun = 0;
+        for (const QJsonValue& cv : root.value("cases").toArray()) {
+            const QJsonObject c = cv.toObject();
+            const QString name = c.value("name").toString();
+            // The real tree's mesh is in the repository (resources/trees): no case may be skipped.
+            QVERIFY2(c.value("skipped").toString().isEmpty(), qPrintable(name + ": " + c.value("skipped").toString()));
+            ++casesRun;
+            QCOMPARE(c.value("fine_grid").toInt(), 64);
+            std::map<int, double> noise;
+            for (const QJsonValue& rv : c.value("references").toArray()) {
+                const QJsonObject r = rv.toObject();
+                const double n = r.value("noise").toDouble();
+                QVERIFY2(n > 0.0 && n < 0.05, qPrintable(name + QString(": reference noise %1").arg(n)));
+                noise[r.value("grid").toInt()] = n;
+            }
+            QCOMPARE(noise.size(), size_t(2));
+            // (grid, steps, fp16) -> row
+            std::map<std::tuple<int, QString, bool>, QJsonObject> rows;
+            int defaults = 0;
+            for (const QJsonValue& rv : c.value("rows").toArray()) {
+                const QJsonObject r = rv.toObject();
+                const int grid = r.value("grid").toInt();
+                const QString steps = r.value("steps").toString();
+                const bool fp16 = r.value("fp16").toBool();
+                const QString what = QString("%1 grid %2 %3 %4").arg(name).arg(grid).arg(steps, fp16 ? "fp16" : "fp32");
+                rows[{grid, steps, fp16}] = r;
+                const double same = r.value("err_same").toDouble(), fine = r.value("err_fine").toDouble();
+                QVERIFY2(std::isfinite(same) && std::isfinite(fine), qPrintable(what));
+                QVERIFY2(same >= 0.9 * noise[grid] && same < 0.12, qPrintable(what + QString(": error %1, noise %2").arg(same).arg(noise[grid])));
+                QVERIFY2(fine >= 0.9 * noise[64] && fine < 0.12, qPrintable(what + QString(": error vs 64 %1").arg(fine)));
+                if (grid == 64) QCOMPARE(fine, same);   // the finest grid is its own reference
+                // Steps: the longest edge of the run's grid from its dims ("25x32x25").
+                int longest = 0;
+                for (const QString& d : r.value("dims").toString().split('x')) longest = std::max(longest, d.toInt());
+                QCOMPARE(longest, grid);
+                const int taken = r.value("steps_taken").toInt();
+                if (steps == "default") QCOMPARE(taken, 2 * longest);
+                else if (steps == "half") QCOMPARE(taken, longest);
+                else QVERIFY2(taken > 0 && taken <= 4 * longest, qPrintable(what + QString(": %1 steps").arg(taken)));
+                if (r.value("default").toBool()) {
+                    ++defaults;
+                    QVERIFY2(defaultConfig == QString("grid %1, %2, %3").arg(grid).arg(steps, fp16 ? "fp16" : "fp32"), qPrintable(what));
+                }
+            }
+            QCOMPARE(rows.size(), size_t(2 * 4 * 2));   // grids 32 and 64, four steps modes, two storages
+            QCOMPARE(defaults, 1);
+            for (int grid : {32, 64})
+                for (const QString steps : {"default", "half", "tol 1e-3", "tol 1e-4"}) {
+                    const QJsonObject a = rows[{grid, steps, false}], b = rows[{grid, steps, true}];
+                    const double d = std::fabs(a.value("err_fine").toDouble() - b.value("err_fine").toDouble());
+                    QVERIFY2(d < 1e-3, qPrintable(QString("%1 grid %2 %3: fp16 moves the error by %4").arg(name).arg(grid).arg(steps).arg(d)));
+                    if (grid == 32 && name != "cloud") {
+                        const double coarse = a.value("err_fine").toDouble(), finer = rows[{64, steps, false}].value("err_fine").toDouble();
+                        QVERIFY2(finer < coarse, qPrintable(QString("%1 %2: 64 nodes %3, 32 nodes %4 against the 64 reference")
+                                                                .arg(name, steps).arg(finer).arg(coarse)));
+                    }
+                }
+            for (int grid : {32, 64})
+                for (bool fp16 : {false, true}) {
+                    const int tight = rows[{grid, "tol 1e-4", fp16}].value("steps_taken").toInt();
+                    const int loose = rows[{grid, "tol 1e-3", fp16}].value("steps_taken").toInt();
+                    QVERIFY2(tight >= loose, qPrintable(QString("%1 grid %2: tol 1e-4 %3 steps, tol 1e-3 %4").arg(name).arg(grid).arg(tight).arg(loose)));
+                }
+        }
+        QVERIFY(casesRun >= 3);
+    }
+
 private Q_SLOTS:
     void quickLbStudy()
     {
@@ -77,6 +168,7 @@ private Q_SLOTS:
         QVERIFY(md.contains("## Quality presets"));
         QVERIFY(md.contains("sylva study voxel"));   // the parts not measured say how to measure them
         QVERIFY(QFile::exists(dir.filePath("accuracy/lb.json")));
+        checkLbNumbers(dir.filePath("accuracy/lb.json"));
         if (!QStandardPaths::findExecutable("gnuplot").isEmpty()) {
             const QStringList pngs = QDir(dir.filePath("accuracy")).entryList({"*.png"});
             QVERIFY2(!pngs.isEmpty(), qPrintable(r.out));

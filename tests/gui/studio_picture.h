@@ -1,0 +1,76 @@
+// The studio tests' oracle for pictures: what the renderer itself gives for a scene and camera
+// (buildRenderScene + renderFilm, as `sylva render` and the exports trace it), and how far a picture
+// the window shows or writes is from it.
+#pragma once
+
+#include <algorithm>
+#include <cstdlib>
+#include <vector>
+
+#include <QImage>
+#include <QSize>
+
+#include "core/render/render_cpu.h"
+#include "core/scene/scene.h"
+#include "pipeline/render/render_job.h"
+#include "studio/asset_store.h"
+#include "studio/render_worker.h"
+
+namespace sylva::test {
+
+// The assets the window holds for a scene, as buildRenderScene takes them.
+inline std::vector<SpeciesAssets> assetCopies(const std::vector<AssetsPtr>& held)
+{
+    std::vector<SpeciesAssets> out;
+    for (const AssetsPtr& a : held) out.push_back(*a);
+    return out;
+}
+
+// The settled picture of the CPU viewport for `scene` at `size`, traced headless: the frame `sylva render`
+// builds for the scene's camera at that size, at the samples the viewport ends on (the schedule's last
+// pass, or the refinement's accumulated samples for a sky with virtual lights: refinementFor), through the
+// viewport's tone map (filmImage).
+inline QImage settledPicture(Scene scene, const std::vector<SpeciesAssets>& assets, QSize size)
+{
+    scene.render.width = size.width();
+    scene.render.height = size.height();
+    const int sceneSpp = scene.render.spp, lastPass = RenderWorker::defaultPasses().back().spp;
+    scene.render.spp = lastPass;
+    RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
+    const Refinement r = refinementFor(rs.view(), sceneSpp, lastPass);
+    if (r.frames > 0 && r.samples != lastPass) {
+        scene.render.spp = r.samples;
+        rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
+    }
+    return filmImage(renderFilm(rs.view()), scene.render.mode, composeSky(scene), scene.render.exposureKey);
+}
+
+// The largest difference of two pictures in any channel, in 8-bit steps (256: sizes differ).
+inline int maxStep(const QImage& p, const QImage& q)
+{
+    if (p.size() != q.size()) return 256;
+    const QImage a = p.convertToFormat(QImage::Format_RGB32), b = q.convertToFormat(QImage::Format_RGB32);
+    int m = 0;
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x) {
+            const QRgb u = a.pixel(x, y), v = b.pixel(x, y);
+            m = std::max({m, std::abs(qRed(u) - qRed(v)), std::abs(qGreen(u) - qGreen(v)), std::abs(qBlue(u) - qBlue(v))});
+        }
+    return m;
+}
+
+// Pixels whose largest channel difference exceeds `steps` 8-bit steps.
+inline int pixelsOver(const QImage& p, const QImage& q, int steps)
+{
+    if (p.size() != q.size()) return p.width() * p.height();
+    const QImage a = p.convertToFormat(QImage::Format_RGB32), b = q.convertToFormat(QImage::Format_RGB32);
+    int n = 0;
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x) {
+            const QRgb u = a.pixel(x, y), v = b.pixel(x, y);
+            n += std::max({std::abs(qRed(u) - qRed(v)), std::abs(qGreen(u) - qGreen(v)), std::abs(qBlue(u) - qBlue(v))}) > steps;
+        }
+    return n;
+}
+
+} // namespace sylva::test
