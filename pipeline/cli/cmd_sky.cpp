@@ -97,7 +97,7 @@ Command skyCommand()
             "a Preetham daylight sky as an equirectangular HDR map (2:1, row 0 at the zenith)",
             {{"--turbidity", "T", "atmospheric turbidity, 2 (clear) .. 10 (hazy); default 3"},
              {"--sun", "X,Y,Z", "direction toward the sun (+Y up), elevation >= -10 degrees; default: the scene's sun, "
-                                "else (0.4, 0.8, 0.3). Until scenes have a sky field, SCENE gives only the sun"},
+                                "else (0.4, 0.8, 0.3). SCENE gives only the sun: its sky block (kind, turbidity) is not read"},
              kSunAt,
              {"--width", "W", "map width in pixels, even, 2 .. 16384 (height W/2); default 512"},
              {"--scale", "S", "multiplies the radiance (the model's unit is kcd/m^2); default 1"},
