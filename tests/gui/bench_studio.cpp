@@ -3,7 +3,7 @@
 // --gaps: Tree_1 lit at grid 96 (seconds of LB) while a 10 ms timer runs on the GUI thread; each gap
 //   between two ticks timed on the wall clock and in the GUI thread's own CPU time (work this thread does
 //   shows in both; a wait on the software GL threads composing a repaint, or the VM not run, only in the
-//   first). Target (issue 5): no 50 ms of GUI-thread work between two ticks.
+//   first). Target: no 50 ms of GUI-thread work between two ticks.
 // --forest: the default forest (32-node grids, from the grid cache after the first run) in a 640x360
 //   viewport; after each small orbit the time from the request to the first (quarter-size) picture shown.
 //   Target: 0.5 s.
