@@ -4,8 +4,12 @@
 
 #include <QProcess>
 #include <QProcessEnvironment>
+#include <QRegularExpression>
 #include <QString>
 #include <QStringList>
+
+#include <map>
+#include <set>
 
 namespace sylva::test {
 
@@ -23,6 +27,37 @@ inline Run runProgram(const QString& program, const QStringList& args,
     p.waitForFinished(timeoutMs);
     return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
             QString::fromUtf8(p.readAllStandardError())};
+}
+
+// Every command `sylva --help` lists, with the options its own `--help` lists (lines "  -x ...": "-h, --help"
+// names two; --output also answers to -o): what the docs, the man page and the completion must name.
+inline std::map<QString, std::set<QString>> sylvaHelpTable(const QString& sylva)
+{
+    std::map<QString, std::set<QString>> table;
+    bool inCommands = false;
+    static const QRegularExpression commandLine("^  ([a-z][a-z0-9-]*) ");   // "  render     render a scene ..."
+    for (const QString& line : runProgram(sylva, {"--help"}).out.split('\n')) {
+        if (line.startsWith("commands:")) {
+            inCommands = true;
+            continue;
+        }
+        if (inCommands && line.trimmed().isEmpty()) break;
+        const QRegularExpressionMatch m = commandLine.match(line);
+        if (inCommands && m.hasMatch()) table[m.captured(1)];
+    }
+    static const QRegularExpression optionLine("^  (-\\S+)");
+    for (auto& [name, options] : table) {
+        for (const QString& line : runProgram(sylva, {name, "--help"}).out.split('\n')) {
+            if (!optionLine.match(line).hasMatch()) continue;
+            for (QString word : line.trimmed().split(' ', Qt::SkipEmptyParts)) {
+                if (!word.startsWith('-')) break;
+                word.remove(',');
+                options.insert(word);
+            }
+        }
+        if (options.count("--output")) options.insert("-o");   // its help line: "output file (also -o)"
+    }
+    return table;
 }
 
 #ifdef SYLVA_CLI_PATH

@@ -26,6 +26,7 @@
 #include "studio/camera_nav.h"
 #include "studio/relight.h"
 #include "studio/sky_panel.h"
+#include "studio_picture.h"
 #include "studio_test_util.h"
 
 using namespace sylva;
@@ -53,18 +54,6 @@ int cacheFiles(const QString& dir)
         ++n;
     }
     return n;
-}
-
-int maxStep(const QImage& p, const QImage& q)
-{
-    if (p.size() != q.size()) return 256;
-    int m = 0;
-    for (int y = 0; y < q.height(); ++y)
-        for (int x = 0; x < q.width(); ++x) {
-            const QRgb a = p.pixel(x, y), b = q.pixel(x, y);
-            m = std::max({m, std::abs(qRed(a) - qRed(b)), std::abs(qGreen(a) - qGreen(b)), std::abs(qBlue(a) - qBlue(b))});
-        }
-    return m;
 }
 
 } // namespace

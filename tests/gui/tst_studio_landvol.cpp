@@ -31,20 +31,6 @@ using namespace sylva::test;
 
 namespace {
 
-// Pixels whose RGB differ by more than `tol` levels in some channel.
-int differing(const QImage& a, const QImage& b, int tol = 2)
-{
-    if (a.size() != b.size()) return a.width() * a.height();
-    const QImage x = a.convertToFormat(QImage::Format_RGB32), y = b.convertToFormat(QImage::Format_RGB32);
-    int n = 0;
-    for (int j = 0; j < x.height(); ++j)
-        for (int i = 0; i < x.width(); ++i) {
-            const QRgb p = x.pixel(i, j), q = y.pixel(i, j);
-            if (std::abs(qRed(p) - qRed(q)) > tol || std::abs(qGreen(p) - qGreen(q)) > tol || std::abs(qBlue(p) - qBlue(q)) > tol) ++n;
-        }
-    return n;
-}
-
 // Mean absolute luminance difference over the rectangle (fractions of the picture).
 double meanDiff(const QImage& a, const QImage& b, double x0, double y0, double x1, double y1)
 {
@@ -187,7 +173,7 @@ private Q_SLOTS:
         QTest::mouseMove(v, QPoint(230, 150));
         QTest::mouseRelease(v, Qt::LeftButton, {}, QPoint(230, 150));
         const QImage flown = settled(*w);
-        QVERIFY2(differing(first, flown) > flown.width() * flown.height() / 10, "flying did not change the picture");
+        QVERIFY2(pixelsOver(first, flown, 2) > flown.width() * flown.height() / 10, "flying did not change the picture");
         QCOMPARE(worker->frameBuilds(), builds);   // a camera move re-places, builds nothing
 
         // Density: the lower tree line up by 4 m (fewer plants low down); one undo step; no frame build.
@@ -199,7 +185,7 @@ private Q_SLOTS:
         const QImage thinned = settled(*w);
         QCOMPARE(worker->frameBuilds(), builds);
         QCOMPARE(worker->frameUpdates(), updates + 1);
-        const int changed = differing(flown, thinned);
+        const int changed = pixelsOver(flown, thinned, 2);
         QVERIFY2(changed > 20, qPrintable(QString("the density edit changed %1 pixels").arg(changed)));
 
         // The updated frame against a whole build of the same scene (a change of accel forces one; the
@@ -209,7 +195,7 @@ private Q_SLOTS:
         w->document()->edit(rebuilt, "force a build");
         const QImage whole = settled(*w);
         QCOMPARE(worker->frameBuilds(), builds + 1);
-        QCOMPARE(differing(thinned, whole, 0), 0);
+        QCOMPARE(pixelsOver(thinned, whole, 0), 0);
         w->document()->undoStack()->undo();   // accel back (a build again)
         settled(*w);
         const int builds2 = worker->frameBuilds();
@@ -219,7 +205,7 @@ private Q_SLOTS:
         QCOMPARE(w->document()->scene().terrain.density.lower, 4.0);
         const QImage back = settled(*w);
         QCOMPARE(worker->frameBuilds(), builds2);
-        QCOMPARE(differing(flown, back, 0), 0);
+        QCOMPARE(pixelsOver(flown, back, 0), 0);
 
         // A tile edit (the plants' spacing): the landscape's arrays again, the species' BVH kept.
         select(*w, {OutlinerItem::Kind::Tiles, -1});
@@ -230,7 +216,7 @@ private Q_SLOTS:
         const QImage sparse = settled(*w);
         QCOMPARE(worker->frameBuilds(), builds2);
         QCOMPARE(worker->frameUpdates(), updates2 + 1);
-        QVERIFY(differing(back, sparse) > 20);
+        QVERIFY(pixelsOver(back, sparse, 2) > 20);
     }
 
     // A small scene with a ground and a few shrubs, local mode; a cloud added through Edit > Add Cloud.
@@ -300,7 +286,7 @@ private Q_SLOTS:
         QVERIFY(w->document()->scene().volumes.empty());
         QCOMPARE(m->rowCount(m->indexOf({OutlinerItem::Kind::VolumesGroup, -1})), 0);
         const QImage after = settled(*w, 120000);
-        QCOMPARE(differing(empty, after, 0), 0);
+        QCOMPARE(pixelsOver(empty, after, 0), 0);
     }
 
     void smokeJob()

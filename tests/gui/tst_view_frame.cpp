@@ -16,6 +16,7 @@
 #include "studio/asset_store.h"
 #include "studio/render_worker.h"
 #include "pipeline/render/view_frame.h"
+#include "studio_picture.h"
 #include "studio_test_util.h"
 
 using namespace sylva;
@@ -223,16 +224,6 @@ private Q_SLOTS:
         const RenderScene rs = buildRenderScene(cli, m_assets, sunRadiance(cli.sun));
         QVERIFY(rs.view().skyLightCount == 16);
         const QImage reference = filmImage(renderFilm(rs.view()), cli.render.mode, composeSky(cli), cli.render.exposureKey);
-        auto maxStep = [](const QImage& p, const QImage& q) {
-            if (p.size() != q.size()) return 256;
-            int m = 0;
-            for (int y = 0; y < q.height(); ++y)
-                for (int x = 0; x < q.width(); ++x) {
-                    const QRgb a = p.pixel(x, y), b = q.pixel(x, y);
-                    m = std::max({m, std::abs(qRed(a) - qRed(b)), std::abs(qGreen(a) - qGreen(b)), std::abs(qBlue(a) - qBlue(b))});
-                }
-            return m;
-        };
         const int worst = maxStep(settled, reference);
         QVERIFY2(worst <= 1, qPrintable(QString("the settled viewport is %1 steps off sylva render's frame").arg(worst)));
         // The moving frame is the sun's alone: darker than the settled one (no sky light), and the same

@@ -19,6 +19,7 @@ namespace {
 
 using sylva::test::Run;
 using sylva::test::runProgram;
+using sylva::test::sylvaHelpTable;
 
 QString readText(const QString& path)
 {
@@ -137,39 +138,6 @@ std::set<QString> testsInCMakeFiles()
 
 // `sylva --help`'s commands, each with the options its `sylva COMMAND --help` lists (as typed: "-h, --help"
 // gives both; "--output FILE  output file (also -o)" gives --output and -o).
-std::map<QString, std::set<QString>> helpTable()
-{
-    std::map<QString, std::set<QString>> table;
-    const Run main = runProgram(QStringLiteral(SYLVA_CLI_PATH), {"--help"});
-    bool inCommands = false;
-    static const QRegularExpression commandLine("^  ([a-z][a-z0-9-]*) ");
-    for (const QString& line : main.out.split('\n')) {
-        if (line.startsWith("commands:")) {
-            inCommands = true;
-            continue;
-        }
-        if (inCommands && line.trimmed().isEmpty()) break;
-        const QRegularExpressionMatch m = commandLine.match(line);
-        if (inCommands && m.hasMatch()) table[m.captured(1)];
-    }
-    static const QRegularExpression optionLine("^  (-\\S+)");
-    for (auto& [name, options] : table) {
-        const Run r = runProgram(QStringLiteral(SYLVA_CLI_PATH), {name, "--help"});
-        bool inOptions = false;
-        for (const QString& line : r.out.split('\n')) {
-            if (line.startsWith("options:")) inOptions = true;
-            if (!inOptions || !optionLine.match(line).hasMatch()) continue;
-            for (QString word : line.trimmed().split(' ', Qt::SkipEmptyParts)) {
-                if (!word.startsWith('-')) break;
-                word.remove(',');
-                options.insert(word);
-            }
-        }
-        if (options.count("--output")) options.insert("-o");
-    }
-    return table;
-}
-
 // One option CLI.md gives a command, and where.
 struct Claim {
     QString command, option, section;
@@ -291,7 +259,7 @@ private Q_SLOTS:
     // docs/CLI.md against every command's --help, both ways.
     void cliDocMatchesHelp()
     {
-        const std::map<QString, std::set<QString>> help = helpTable();
+        const std::map<QString, std::set<QString>> help = sylvaHelpTable(QStringLiteral(SYLVA_CLI_PATH));
         QVERIFY2(help.size() >= 10 && help.count("render") && help.at("render").count("--spp"),
                  "sylva --help / sylva render --help did not list what they should (the parse is stale)");
         const QString doc = readText(sourcePath("docs/CLI.md"));

@@ -18,6 +18,7 @@
 #include <QStandardPaths>
 
 #include "pipeline/io/image_io.h"
+#include "tests/common/run_program.h"
 
 namespace {
 
@@ -47,37 +48,6 @@ QString readText(const QString& path)
 }
 
 // The command table as the binary's --help pages show it: command -> option names (as typed).
-std::map<QString, std::set<QString>> commandTable(const QString& sylva)
-{
-    std::map<QString, std::set<QString>> table;
-    const Run help = run(sylva, {"--help"});
-    bool inCommands = false;
-    static const QRegularExpression commandLine("^  ([a-z][a-z0-9-]*) ");   // "  render     render a scene ..."
-    for (const QString& line : help.out.split('\n')) {
-        if (line.startsWith("commands:")) {
-            inCommands = true;
-            continue;
-        }
-        if (inCommands && line.trimmed().isEmpty()) break;
-        const QRegularExpressionMatch m = commandLine.match(line);
-        if (inCommands && m.hasMatch()) table[m.captured(1)];
-    }
-    static const QRegularExpression optionLine("^  (-\\S+)");
-    for (auto& [name, options] : table) {
-        for (const QString& line : run(sylva, {name, "--help"}).out.split('\n')) {
-            const QRegularExpressionMatch m = optionLine.match(line);
-            if (!m.hasMatch()) continue;
-            for (QString word : line.trimmed().split(' ', Qt::SkipEmptyParts)) {   // "-h, --help" names two
-                if (!word.startsWith('-')) break;
-                word.remove(',');
-                options.insert(word);
-            }
-        }
-        if (options.count("--output")) options.insert("-o");   // its help line: "output file (also -o)"
-    }
-    return table;
-}
-
 } // namespace
 
 class TestInstall : public QObject {
@@ -96,7 +66,7 @@ private Q_SLOTS:
         const Run r = run(CMAKE_COMMAND, {"--install", SYLVA_BUILD_DIR, "--prefix", m_prefix.path()});
         QVERIFY2(r.code == 0, qPrintable(r.out + r.err));
         m_sylva = installed("bin/sylva");
-        m_table = commandTable(m_sylva);
+        m_table = sylva::test::sylvaHelpTable(m_sylva);
         QVERIFY2(m_table.size() >= 7, qPrintable(QString::number(m_table.size())));
         QVERIFY(m_table.count("render") && m_table.at("render").count("--passes"));
     }
