@@ -104,8 +104,7 @@ private Q_SLOTS:
         // Frames through the widget while the camera moves (1 spp, 1280x720), for the record: each frame
         // is a camera edit and the wait for the picture it produces (paintGL through the event loop).
         v.worker()->setPasses({{1, 1}});
-        v.resize(1280, 720);
-        QTest::qWait(200);
+        v.resize(1280, 720);   // the five frames before the timed ones wait out the resize's own pictures
         QSignalSpy shown(&v, &Viewport::imageShown);
         const int frames = 60;
         QElapsedTimer t;
