@@ -30,6 +30,7 @@ struct LinearTolerance {
 struct LinearComparison {
     size_t values = 0;
     size_t off = 0;
+    double floor = 0.0;                 // floorOfMean x the reference's mean over all values
     double worst = 0.0;                 // the largest |got - want| / (pixelRelative x |want| + floor): > 1 is off
     glm::dvec3 meanGot{0.0}, meanWant{0.0};
     double meanError = 0.0;             // the largest |mean got - mean want| / mean want over the channels
@@ -55,11 +56,11 @@ inline LinearComparison compareLinear(const std::vector<glm::vec3>& got, const s
     }
     c.meanWant /= double(want.size());
     c.meanGot /= double(want.size());
-    const double floor = tol.floorOfMean * std::fabs(all) / double(c.values);
+    c.floor = tol.floorOfMean * std::fabs(all) / double(c.values);
     for (size_t i = 0; i < want.size(); ++i)
         for (int k = 0; k < 3; ++k) {
             const double w = want[i][k], g = got[i][k];
-            const double r = std::fabs(g - w) / (tol.pixelRelative * std::fabs(w) + floor);
+            const double r = std::fabs(g - w) / (tol.pixelRelative * std::fabs(w) + c.floor);
             c.worst = std::max(c.worst, std::isfinite(r) ? r : 1e30);
             c.off += !(r <= 1.0);
         }

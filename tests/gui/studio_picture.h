@@ -45,32 +45,34 @@ inline QImage settledPicture(Scene scene, const std::vector<SpeciesAssets>& asse
     return filmImage(renderFilm(rs.view()), scene.render.mode, composeSky(scene), scene.render.exposureKey);
 }
 
+// Each pixel's largest channel difference between two pictures of one size, in 8-bit steps.
+inline std::vector<int> pixelSteps(const QImage& p, const QImage& q)
+{
+    const QImage a = p.convertToFormat(QImage::Format_RGB32), b = q.convertToFormat(QImage::Format_RGB32);
+    std::vector<int> steps;
+    steps.reserve(size_t(a.width()) * size_t(a.height()));
+    for (int y = 0; y < a.height(); ++y)
+        for (int x = 0; x < a.width(); ++x) {
+            const QRgb u = a.pixel(x, y), v = b.pixel(x, y);
+            steps.push_back(std::max({std::abs(qRed(u) - qRed(v)), std::abs(qGreen(u) - qGreen(v)), std::abs(qBlue(u) - qBlue(v))}));
+        }
+    return steps;
+}
+
 // The largest difference of two pictures in any channel, in 8-bit steps (256: sizes differ).
 inline int maxStep(const QImage& p, const QImage& q)
 {
     if (p.size() != q.size()) return 256;
-    const QImage a = p.convertToFormat(QImage::Format_RGB32), b = q.convertToFormat(QImage::Format_RGB32);
-    int m = 0;
-    for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x) {
-            const QRgb u = a.pixel(x, y), v = b.pixel(x, y);
-            m = std::max({m, std::abs(qRed(u) - qRed(v)), std::abs(qGreen(u) - qGreen(v)), std::abs(qBlue(u) - qBlue(v))});
-        }
-    return m;
+    const std::vector<int> s = pixelSteps(p, q);
+    return s.empty() ? 0 : *std::max_element(s.begin(), s.end());
 }
 
-// Pixels whose largest channel difference exceeds `steps` 8-bit steps.
+// Pixels whose largest channel difference exceeds `steps` 8-bit steps (every pixel: sizes differ).
 inline int pixelsOver(const QImage& p, const QImage& q, int steps)
 {
     if (p.size() != q.size()) return p.width() * p.height();
-    const QImage a = p.convertToFormat(QImage::Format_RGB32), b = q.convertToFormat(QImage::Format_RGB32);
-    int n = 0;
-    for (int y = 0; y < a.height(); ++y)
-        for (int x = 0; x < a.width(); ++x) {
-            const QRgb u = a.pixel(x, y), v = b.pixel(x, y);
-            n += std::max({std::abs(qRed(u) - qRed(v)), std::abs(qGreen(u) - qGreen(v)), std::abs(qBlue(u) - qBlue(v))}) > steps;
-        }
-    return n;
+    const std::vector<int> s = pixelSteps(p, q);
+    return int(std::count_if(s.begin(), s.end(), [steps](int d) { return d > steps; }));
 }
 
 } // namespace sylva::test
