@@ -35,6 +35,13 @@ __global__ void forEachKernel(size_t n, Body body)
     if (i < n) body(i);
 }
 
+template <class Body>
+__global__ void forEachRowKernel(size_t n, size_t len, Body body)
+{
+    const size_t i = size_t(blockIdx.x) * blockDim.x + threadIdx.x;
+    if (i < n) body(i / len, i % len, i % len + 1);
+}
+
 template <int K, class Body>
 __global__ void sumKernel(size_t n, Body body, double* out)
 {
@@ -44,16 +51,29 @@ __global__ void sumKernel(size_t n, Body body, double* out)
     for (int k = 0; k < K; ++k) blockSum(t[k], &out[k]);
 }
 
-inline unsigned blocksFor(size_t n) { return unsigned((n + kThreads - 1) / kThreads); }
-
 } // namespace exec_detail
+
+// Blocks of `threads` threads that cover n items (kernels outside the executor use it too).
+inline unsigned blocksFor(size_t n, int threads = exec_detail::kThreads)
+{
+    return unsigned((n + size_t(threads) - 1) / size_t(threads));
+}
 
 struct CudaExec {
     template <class Body>
     void forEach(size_t n, const Body& body) const
     {
         if (n == 0) return;
-        exec_detail::forEachKernel<<<exec_detail::blocksFor(n), exec_detail::kThreads>>>(n, body);
+        exec_detail::forEachKernel<<<blocksFor(n), exec_detail::kThreads>>>(n, body);
+        check(cudaGetLastError(), "kernel launch");
+    }
+
+    template <class Body>
+    void forEachRow(size_t rows, size_t len, const Body& body) const
+    {
+        const size_t n = rows * len;
+        if (n == 0) return;
+        exec_detail::forEachRowKernel<<<blocksFor(n), exec_detail::kThreads>>>(n, len, body);
         check(cudaGetLastError(), "kernel launch");
     }
 
@@ -62,7 +82,7 @@ struct CudaExec {
     {
         check(cudaMemsetAsync(out, 0, K * sizeof(double)), "sum reset");
         if (n == 0) return;
-        exec_detail::sumKernel<K><<<exec_detail::blocksFor(n), exec_detail::kThreads>>>(n, body, out);
+        exec_detail::sumKernel<K><<<blocksFor(n), exec_detail::kThreads>>>(n, body, out);
         check(cudaGetLastError(), "sum kernel launch");
     }
 };

@@ -5,6 +5,13 @@
 //   exec.sum<K>(n, body, out)    out[k] = sum over i of t[k], where body(i, t) fills double t[K] (zeroed
 //                                first); out is the executor's memory (host here, device for CudaExec),
 //                                and later bodies may read it. n = 0 writes zeros.
+//   exec.forEachRow(rows, len, body)  body(r, k0, k1) for every row r in [0, rows) of len items: the calls
+//                                cover items [0, len) of each row, [k0, k1) at a time (the host passes
+//                                whole rows, tasks of about kChunk items; the device one item a thread),
+//                                so a body computes what a row shares once per call.
+//   exec.sumRows<K>(rows, len, body, out)  host only: out[k] = sum over the rows of t[k], where
+//                                body(r, 0, len, t) adds row r's terms to double t[K] (zeroed per row);
+//                                the rows' sums are added in row order.
 //   pipelineSlabs(n, stages, fn) host only: dependent passes over a grid's slabs, temporally blocked.
 #pragma once
 
@@ -30,6 +37,25 @@ struct HostExec {
         tbb::parallel_for(tbb::blocked_range<size_t>(0, n, kChunk), [&](const tbb::blocked_range<size_t>& r) {
             for (size_t i = r.begin(); i != r.end(); ++i) body(i);
         });
+    }
+
+    template <class Body>
+    void forEachRow(size_t rows, size_t len, const Body& body) const
+    {
+        const size_t grain = len >= kChunk ? 1 : kChunk / (len > 0 ? len : 1);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, rows, grain), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t i = r.begin(); i != r.end(); ++i) body(i, size_t(0), len);
+        });
+    }
+
+    template <int K, class Body>
+    void sumRows(size_t rows, size_t len, const Body& body, double* out) const
+    {
+        std::vector<double> partial(rows * K, 0.0);
+        forEachRow(rows, len, [&](size_t r, size_t k0, size_t k1) { body(r, k0, k1, &partial[r * K]); });
+        for (int k = 0; k < K; ++k) out[k] = 0.0;
+        for (size_t r = 0; r < rows; ++r)
+            for (int k = 0; k < K; ++k) out[k] += partial[r * K + k];
     }
 
     template <int K, class Body>

@@ -22,11 +22,27 @@
 #include "core/base/memory.h"
 #include "core/base/error.h"
 #include "core/base/half.h"
+#include "core/base/parallel.h"
 #include "core/lb/lb_device.h"
+#include "core/lb/lb_kernels.h"
 #include "core/lb/lb_node.h"
 #include "core/lb/lb_slab.h"
 
 namespace sylva::lb {
+
+// fp16 storage on the CPU: F16C's conversions where present (round to nearest even, as floatToHalf).
+template <>
+struct StoredValue<uint16_t> {
+    static SYLVA_INLINE float load(const uint16_t* p)
+    {
+#ifdef SYLVA_LB_F16C
+        return _cvtsh_ss(*p);
+#else
+        return halfToFloat(*p);
+#endif
+    }
+    static SYLVA_INLINE uint16_t make(float v) { return floatToHalf(v); }
+};
 
 namespace {
 
@@ -135,13 +151,6 @@ inline Vec8 loadVector(const uint16_t* p)
 #endif
 }
 
-template <typename S>
-S toStorage(float v);
-template <>
-float toStorage<float>(float v) { return v; }
-template <>
-uint16_t toStorage<uint16_t>(float v) { return floatToHalf(v); }
-
 // A large array on 2 MB pages where the kernel allows it (madvise): the streaming step touches ~30
 // pages per row, so with 4 KB pages most of them miss the TLB.
 template <typename S>
@@ -244,9 +253,9 @@ public:
     {
         // Boundary condition for unit intensity; the solve is linear in intensity (scaled at the end).
         const std::vector<float> bc = boundaryOf(m_params);
-        const size_t count = size_t(m_X) * size_t(m_Y) * size_t(kDirections) * size_t(m_Z);
-        S bcValue[kDirections];
-        for (int m = 0; m < kDirections; ++m) bcValue[m] = toStorage<S>(bc[size_t(m)]);
+        LbBoundary boundary;
+        std::copy_n(bc.begin(), kDirections, boundary.f);
+        const size_t count = shape().values();
         m_fields.resize(std::min(m_fields.size(), solves.size()));
         for (size_t c = 0; c < solves.size(); ++c) {
             const ChannelParams& cp = solves[c];
@@ -263,25 +272,11 @@ public:
             ChannelField<S>& field = *m_fields[c];
             field.flip = false;
             if (!fresh && interiorFollows) continue;
-            // Fresh memory: both copies in full, in parallel (each x-slab by the thread that will first
-            // touch it). Reused memory: the interior of the current copy; the boundary already holds the
-            // boundary condition in both.
-            tbb::parallel_for(0, m_X, [&](int i) {
-                for (int j = 0; j < m_Y; ++j) {
-                    const bool boundaryRow = i == 0 || j == 0 || i == m_X - 1 || j == m_Y - 1;
-                    if (!fresh && boundaryRow) continue;
-                    const bool wholeRow = m_params.warmStart || boundaryRow;
-                    for (int m = 0; m < kDirections; ++m) {
-                        for (PageArray<S>* copy : {&field.a, &field.b}) {
-                            if (!fresh && copy != &field.a) continue;
-                            S* row = &(*copy)[dindex(i, j, 0, m)];
-                            std::fill(row, row + m_Z, wholeRow ? bcValue[m] : toStorage<S>(0.0f));
-                            row[0] = bcValue[m];
-                            row[m_Z - 1] = bcValue[m];
-                        }
-                    }
-                }
-            });
+            // Fresh memory: both copies in full, in parallel (each slab of rows by the thread that will
+            // first touch it). Reused memory: the interior of the current copy; the rows on the x and y
+            // faces already hold the boundary condition in both.
+            startState(HostExec(), field.a.data(), shape(), boundary, m_params.warmStart, !fresh);
+            if (fresh) startState(HostExec(), field.b.data(), shape(), boundary, m_params.warmStart);
         }
         m_skipF0 = m_params.zeroF0 && bc[0] == 0.0f;
     }
@@ -296,12 +291,9 @@ public:
     // node totals and level compareLevel returns the relative L2 change between the two (else 0).
     double advanceBlock(int levels, int compareLevel) override
     {
-        const size_t rows = size_t(m_X) * size_t(m_Y);
-        if (compareLevel >= 1 && m_totals.empty()) m_totals.assign(m_fields.size() * rows * size_t(m_Z), 0.0f);
-        if (compareLevel >= 1) {
-            m_rowDiff.assign(rows, 0.0);
-            m_rowNorm.assign(rows, 0.0);
-        }
+        const size_t totals = m_fields.size() * shape().nodes();
+        if (compareLevel >= 1 && m_totals[0].size() != totals)
+            for (std::vector<float>& t : m_totals) t.assign(totals, 0.0f);
         for (size_t c = 0; c < m_fields.size(); ++c) {
             ChannelField<S>& field = *m_fields[c];
             for (int w = 0; w < m_X + levels - 1; ++w) {
@@ -319,12 +311,9 @@ public:
             if (levels & 1) field.flip = !field.flip;
         }
         if (compareLevel < 1) return 0.0;
-        double diff = 0.0, norm = 0.0;
-        for (size_t r = 0; r < rows; ++r) {
-            diff += m_rowDiff[r];
-            norm += m_rowNorm[r];
-        }
-        return norm > 0.0 ? std::sqrt(diff / norm) : 0.0;
+        double sums[2];
+        totalsChange(HostExec(), m_totals[1].data(), m_totals[0].data(), totals, sums);
+        return relativeChange(sums);
     }
 
     // One step of source plane x of channel solve c from src into dst (the collision of its rows and their
@@ -374,43 +363,17 @@ public:
     }
 
     // Starts every channel solve from the current state of `coarse`, the same solves on coarsen() of this
-    // grid: interior nodes interpolate the coarse distributions trilinearly at (i/2, j/2, k/2) (bilinear in
-    // x and y per coarse row, then linear in z); boundary nodes keep the boundary condition the
-    // constructor set. Only the current copy's interior is written: the first step overwrites the other
-    // copy's interior and its boundary already holds the boundary condition.
+    // grid (lb_kernels.h's prolongate); boundary nodes keep the boundary condition setSolves set. Only the
+    // current copy's interior is written: the first step overwrites the other copy's interior and its
+    // boundary already holds the boundary condition.
     void prolongateFrom(const LbGrid& coarseGrid) override
     {
         const Solver<S>& coarse = dynamic_cast<const Solver<S>&>(coarseGrid);
-        const int cX = coarse.m_X, cY = coarse.m_Y, cZ = coarse.m_Z;
         for (size_t c = 0; c < m_fields.size(); ++c) {
             const ChannelField<S>& cf = *coarse.m_fields[c];
-            const S* cs = cf.flip ? cf.b.data() : cf.a.data();
             ChannelField<S>& field = *m_fields[c];
             field.flip = false;
-            S* dst = field.a.data();
-            tbb::parallel_for(1, m_X - 1, [&](int i) {
-                std::vector<float> rows(4 * size_t(cZ), 0.0f), xy(size_t(cZ), 0.0f), out(size_t(m_Z), 0.0f);
-                const int I0 = std::min(i / 2, cX - 2);
-                const float fx = float(i) / 2.0f - float(I0);
-                for (int j = 1; j < m_Y - 1; ++j) {
-                    const int J0 = std::min(j / 2, cY - 2);
-                    const float fy = float(j) / 2.0f - float(J0);
-                    const float w[4] = {(1.0f - fx) * (1.0f - fy), (1.0f - fx) * fy, fx * (1.0f - fy), fx * fy};
-                    for (int m = 0; m < kDirections; ++m) {
-                        for (int q = 0; q < 4; ++q)
-                            loadRow(cs + coarse.dindex(I0 + (q >> 1), J0 + (q & 1), 0, m), rows.data() + size_t(q) * size_t(cZ), cZ);
-                        for (size_t K = 0; K < size_t(cZ); ++K)
-                            xy[K] = w[0] * rows[K] + w[1] * rows[size_t(cZ) + K] + w[2] * rows[2 * size_t(cZ) + K] +
-                                    w[3] * rows[3 * size_t(cZ) + K];
-                        for (int k = 1; k < m_Z - 1; ++k) {
-                            const int K0 = std::min(k / 2, cZ - 2);
-                            const float fz = float(k) / 2.0f - float(K0);
-                            out[size_t(k)] = (1.0f - fz) * xy[size_t(K0)] + fz * xy[size_t(K0) + 1];
-                        }
-                        storeRow(out.data() + 1, dst + dindex(i, j, 1, m), m_Z - 2);
-                    }
-                }
-            });
+            prolongate(HostExec(), cf.flip ? cf.b.data() : cf.a.data(), coarse.shape(), field.a.data(), shape());
         }
     }
 
@@ -438,21 +401,13 @@ public:
     void totals(size_t c, std::vector<float>& out) override
     {
         const ChannelField<S>& f = *m_fields[c];
-        const S* cur = f.flip ? f.b.data() : f.a.data();
-        out.assign(size_t(m_X) * m_Y * m_Z, 0.0f);
-        tbb::parallel_for(0, m_X, [&](int i) {
-            std::vector<float> row(static_cast<size_t>(m_Z));
-            for (int j = 0; j < m_Y; ++j) {
-                float* o = &out[(size_t(i) * m_Y + size_t(j)) * size_t(m_Z)];
-                for (int m = 0; m < kDirections; ++m) {
-                    loadRow(cur + dindex(i, j, 0, m), row.data(), m_Z);
-                    for (int k = 0; k < m_Z; ++k) o[k] += row[size_t(k)];
-                }
-            }
-        });
+        out.resize(shape().nodes());
+        nodeTotals(HostExec(), f.flip ? f.b.data() : f.a.data(), out.data(), shape());
     }
 
 private:
+    LbShape shape() const { return {m_X, m_Y, m_Z, 1}; }
+
     size_t dindex(int i, int j, int k, int m) const
     {
         return ((size_t(i) * size_t(m_Y) + size_t(j)) * kDirections + size_t(m)) * size_t(m_Z) + size_t(k);
@@ -494,7 +449,7 @@ private:
             for (int m = firstM; m < kDirections; ++m) {
                 if ((nearFace && targetIsBoundary(m)) || m_streamLen[m] <= 0) continue;
                 S* d = dstRow + m_streamOff[m];
-                if (m == 0 && m_params.zeroF0) std::fill(d, d + m_streamLen[m], toStorage<S>(0.0f));
+                if (m == 0 && m_params.zeroF0) std::fill(d, d + m_streamLen[m], StoredValue<S>::make(0.0f));
                 else std::memcpy(d, srcRow + size_t(m) * size_t(m_Z) + size_t(m_streamK0[m]), size_t(m_streamLen[m]) * sizeof(S));
             }
             return;
@@ -546,16 +501,13 @@ private:
 
     // Loads each 8-node vector of an active row straight from storage, collides it when it holds
     // medium, and writes it to buf (the rows of 19 directions the streaming then reads).
-    // Loads each 8-node vector of an active row straight from storage, collides it when it holds
-    // medium, and writes it to buf (the rows of 19 directions the streaming then reads).
-    // With outMode 1 it stores the node totals sum_m f_m of the source state (tolerance check), with
-    // outMode 2 it also adds their squared change since those and their squares to the row's sums.
+    // With outMode 1 or 2 it stores the node totals sum_m f_m of the source state (nodeTotal, the
+    // tolerance check) in m_totals[0] or [1].
     void collideRowFused(size_t r, size_t c, const S* srcRow, float* buf, int firstM, int outMode)
     {
         const ChannelField<S>& field = *m_fields[c];
         const size_t Zp = size_t(m_Zp), Z = size_t(m_Z);
-        float* tot = outMode != 0 ? &m_totals[(c * size_t(m_X) * m_Y + r) * Z] : nullptr;
-        double diff = 0.0, norm = 0.0;
+        float* tot = outMode != 0 ? &m_totals[size_t(outMode - 1)][(c * size_t(m_X) * m_Y + r) * Z] : nullptr;
         Vec8 f[kDirections];
         if (firstM == 1) f[0] = Vec8{};
         for (size_t k = 0; k < Zp; k += kLanes) {
@@ -569,24 +521,12 @@ private:
                     f[m] = loadVec(tmp);
                 }
             }
-            if (outMode != 0) {
-                Vec8 sum{};
-                for (int m = 0; m < kDirections; ++m) sum = sum + f[m];
-                for (size_t l = 0; l < kLanes && k + l < Z; ++l) {
-                    if (outMode == 2) {
-                        const double d = double(sum[l]) - double(tot[k + l]);
-                        diff += d * d;
-                        norm += double(sum[l]) * double(sum[l]);
-                    }
-                    tot[k + l] = sum[l];
-                }
+            if (tot) {
+                const Vec8 sum = nodeTotal(f);
+                for (size_t l = 0; l < kLanes && k + l < Z; ++l) tot[k + l] = sum[l];
             }
             if (m_rowActive[r] && vectorActive(r, k)) collideVector(f, r, k, field);
             for (int m = firstM; m < kDirections; ++m) storeVec(buf + size_t(m) * Zp + k, f[m]);
-        }
-        if (outMode == 2) {
-            m_rowDiff[r] += diff;
-            m_rowNorm[r] += norm;
         }
     }
 
@@ -607,8 +547,7 @@ private:
     int m_streamK0[kDirections] = {}, m_streamLen[kDirections] = {};
     ptrdiff_t m_streamOff[kDirections] = {};
     std::vector<std::unique_ptr<ChannelField<S>>> m_fields;
-    std::vector<float> m_totals;
-    std::vector<double> m_rowDiff, m_rowNorm;
+    std::vector<float> m_totals[2];   // the node totals of the tolerance check: before and after a step
     tbb::enumerable_thread_specific<Scratch> m_scratch;
 };
 

@@ -1,5 +1,6 @@
-// pipelineSlabs (core/base/parallel.h): the temporally blocked stages against stage-by-stage passes, at
-// every slab count and stage count around the chunking's edges and for several thread counts.
+// core/base/parallel.h: pipelineSlabs' temporally blocked stages against stage-by-stage passes, at every
+// slab count and stage count around the chunking's edges and for several thread counts; HostExec's rows
+// (forEachRow covers every item once, sumRows adds the rows in row order on any thread count).
 #include <QTest>
 
 #include <atomic>
@@ -110,6 +111,45 @@ private Q_SLOTS:
                     for (size_t r = 0; r < runs.size(); ++r)
                         QVERIFY2(runs[r].load() == 1, qPrintable(QString("%1 slabs, %2 stages: stage %3 slab %4 ran %5 times")
                                                                      .arg(n).arg(stages).arg(r / size_t(n)).arg(r % size_t(n)).arg(runs[r].load())));
+                }
+        }
+    }
+
+    // forEachRow hands every item of every row exactly once, whole rows on the host, for rows shorter and
+    // longer than a task's items; sumRows has the bits of the rows' sums added in order, on any thread count.
+    void rowsCoverEveryItemAndSumInOrder()
+    {
+        for (int threads : {1, 2, 7}) {
+            tbb::task_arena arena(threads);
+            for (size_t len : {size_t(1), size_t(3), size_t(1000), HostExec::kChunk + 5})
+                for (size_t rows : {size_t(0), size_t(1), size_t(17), size_t(300)}) {
+                    std::vector<std::atomic<int>> seen(rows * len);
+                    for (auto& v : seen) v = 0;
+                    std::atomic<int> partial{0};
+                    arena.execute([&] {
+                        HostExec().forEachRow(rows, len, [&](size_t r, size_t k0, size_t k1) {
+                            if (k0 != 0 || k1 != len) ++partial;
+                            for (size_t k = k0; k < k1; ++k) ++seen[r * len + k];
+                        });
+                    });
+                    QCOMPARE(partial.load(), 0);
+                    for (const auto& v : seen) QCOMPARE(v.load(), 1);
+                    auto term = [](size_t r, size_t k) { return 1.0 / double(3 + r * 7 + k) - 1e-3 * double(k % 5); };
+                    double ref[2] = {0.0, 0.0};
+                    for (size_t r = 0; r < rows; ++r) {
+                        double row[2] = {0.0, 0.0};
+                        for (size_t k = 0; k < len; ++k) row[0] += term(r, k), row[1] += term(r, k) * term(r, k);
+                        ref[0] += row[0];
+                        ref[1] += row[1];
+                    }
+                    double got[2] = {-1.0, -1.0};
+                    arena.execute([&] {
+                        HostExec().sumRows<2>(rows, len, [&](size_t r, size_t k0, size_t k1, double* t) {
+                            for (size_t k = k0; k < k1; ++k) t[0] += term(r, k), t[1] += term(r, k) * term(r, k);
+                        }, got);
+                    });
+                    QVERIFY2(std::memcmp(ref, got, sizeof ref) == 0,
+                             qPrintable(QString("%1 rows of %2, %3 threads").arg(rows).arg(len).arg(threads)));
                 }
         }
     }
