@@ -19,6 +19,7 @@
 #include "pipeline/io/grid_file.h"
 #include "pipeline/scene/scene_volumes.h"
 #include "studio/job_manager.h"
+#include "studio/param_widgets.h"
 #include "studio/scene_document.h"
 
 namespace sylva {
@@ -30,15 +31,6 @@ QDoubleSpinBox* dspin(const char* name, double lo, double hi, int decimals, doub
     s->setObjectName(QString::fromLatin1(name));
     s->setRange(lo, hi);
     s->setDecimals(decimals);
-    s->setValue(value);
-    return s;
-}
-
-QSpinBox* ispin(const char* name, int lo, int hi, int value)
-{
-    auto* s = new QSpinBox;
-    s->setObjectName(QString::fromLatin1(name));
-    s->setRange(lo, hi);
     s->setValue(value);
     return s;
 }
@@ -96,18 +88,14 @@ CloudDialog::CloudDialog(const volume::PyroclasticParams& p, const QString& name
     auto* form = new QFormLayout(this);
     m_name = new QLineEdit(name);
     m_name->setObjectName("cloud.name");
-    m_radius = dspin("cloud.radius", 0.001, 1e5, 3, p.radius);
-    m_amplitude = dspin("cloud.amplitude", 0.0, 1e5, 3, p.amplitude);
-    m_frequency = dspin("cloud.frequency", 0.0001, 1e4, 4, p.frequency);
-    m_octaves = ispin("cloud.octaves", 1, 12, p.octaves);
-    m_resolution = ispin("cloud.resolution", volume::kCloudMinNodes, volume::kCloudMaxNodes, p.resolution);
-    m_density = dspin("cloud.density", 0.001, 1.0, 3, p.density);
-    m_seed = ispin("cloud.seed", 0, 1 << 30, int(p.seed));
-    for (int a = 0; a < 3; ++a) m_centre[a] = dspin(a == 0 ? "cloud.centre.x" : a == 1 ? "cloud.centre.y" : "cloud.centre.z", -1e7, 1e7, 2, p.centre[a]);
-    m_radius->setToolTip(tr("Radius of the undisplaced sphere, metres"));
-    m_amplitude->setToolTip(tr("Largest outward displacement by |fBm noise|, metres"));
-    m_frequency->setToolTip(tr("Noise cells per metre of the first octave"));
-    m_resolution->setToolTip(tr("Nodes per axis of the cubic grid (the LB solves on it)"));
+    m_radius = paramSpin(volume::kCloudRadius, "cloud.radius", 3, p.radius);
+    m_amplitude = paramSpin(volume::kCloudAmplitude, "cloud.amplitude", 3, p.amplitude);
+    m_frequency = paramSpin(volume::kCloudFrequency, "cloud.frequency", 4, p.frequency);
+    m_octaves = paramIntSpin(volume::kCloudOctaves, "cloud.octaves", p.octaves);
+    m_resolution = paramIntSpin(volume::kCloudResolution, "cloud.resolution", p.resolution);
+    m_density = paramSpin(volume::kCloudDensity, "cloud.density", 3, p.density);
+    m_seed = paramSeedEdit(volume::kCloudSeed, "cloud.seed", p.seed);
+    for (int a = 0; a < 3; ++a) m_centre[a] = paramSpin(volume::kCloudCentre, QStringLiteral("cloud.centre.") + QChar("xyz"[a]), 2, p.centre[a]);
     form->addRow(tr("Name"), m_name);
     form->addRow(tr("Radius (m)"), m_radius);
     form->addRow(tr("Amplitude (m)"), m_amplitude);
@@ -129,7 +117,7 @@ volume::PyroclasticParams CloudDialog::params() const
     p.octaves = m_octaves->value();
     p.resolution = m_resolution->value();
     p.density = float(m_density->value());
-    p.seed = uint64_t(m_seed->value());
+    p.seed = paramSeed(m_seed);
     p.centre = glm::vec3(float(m_centre[0]->value()), float(m_centre[1]->value()), float(m_centre[2]->value()));
     return p;
 }
@@ -142,7 +130,7 @@ void CloudDialog::setParams(const volume::PyroclasticParams& p)
     m_octaves->setValue(p.octaves);
     m_resolution->setValue(p.resolution);
     m_density->setValue(p.density);
-    m_seed->setValue(int(p.seed));
+    setParamSeed(m_seed, p.seed);
     for (int a = 0; a < 3; ++a) m_centre[a]->setValue(p.centre[a]);
 }
 
@@ -158,19 +146,18 @@ SmokeDialog::SmokeDialog(const SmokeSpec& s, QWidget* parent) : QDialog(parent),
     const char* cellNames[3] = {"smoke.cells.x", "smoke.cells.y", "smoke.cells.z"};
     const char* posNames[3] = {"smoke.position.x", "smoke.position.y", "smoke.position.z"};
     for (int a = 0; a < 3; ++a) {
-        m_cells[a] = ispin(cellNames[a], volume::kSmokeMinCells, volume::kSmokeMaxCells, s.cells[a]);
-        m_position[a] = dspin(posNames[a], -1e7, 1e7, 2, s.position[a]);
+        m_cells[a] = paramIntSpin(volume::kSmokeCells, cellNames[a], s.cells[a]);
+        m_position[a] = dspin(posNames[a], -kWidgetLimit, kWidgetLimit, 2, s.position[a]);
     }
-    m_width = dspin("smoke.width", 0.01, 1e4, 3, s.width);
-    m_steps = ispin("smoke.steps", 1, 100000, s.steps);
-    m_seed = ispin("smoke.seed", 0, 1 << 30, int(s.seed));
-    m_kelvin = dspin("smoke.kelvin", 0.0, 40000.0, 0, double(s.sourceKelvin));
+    m_width = paramSpin(volume::kSmokeWidth, "smoke.width", 3, s.width);
+    m_steps = paramIntSpin(volume::kSmokeSteps, "smoke.steps", s.steps);
+    m_seed = paramSeedEdit(volume::kSmokeSeed, "smoke.seed", s.seed);
+    m_kelvin = paramSpin(kSmokeSourceKelvin, "smoke.kelvin", 0, double(s.sourceKelvin));
     m_kelvin->setSpecialValueText(tr("cold (no emission)"));
-    m_kelvin->setToolTip(tr("Hot smoke: the sources' temperature in kelvin, drawn as blackbody emission (1000 K and up glow)"));
     form->addRow(tr("Name"), m_name);
     form->addRow(tr("Cells"), triple(m_cells[0], m_cells[1], m_cells[2]));
     form->addRow(tr("Width (m)"), m_width);
-    form->addRow(tr("Steps (0.02 s each)"), m_steps);
+    form->addRow(tr("Steps (%1 s each)").arg(QString::fromStdString(paramNumber(volume::kSmokeDt.def[0]))), m_steps);
     form->addRow(tr("Seed"), m_seed);
     form->addRow(tr("Source temperature (K)"), m_kelvin);
     form->addRow(tr("Floor centre (m)"), triple(m_position[0], m_position[1], m_position[2]));
@@ -187,7 +174,7 @@ SmokeSpec SmokeDialog::spec() const
     }
     s.width = float(m_width->value());
     s.steps = m_steps->value();
-    s.seed = uint64_t(m_seed->value());
+    s.seed = paramSeed(m_seed);
     s.sourceKelvin = float(m_kelvin->value());
     return s;
 }
@@ -296,10 +283,9 @@ Job* VolumeTools::simulateSmoke(const SmokeSpec& spec)
     settings.cells = spec.cells;
     settings.seed = spec.seed;
     try {
-        if (!(spec.width > 0.0f)) throw Error("smoke: the width must be > 0");
-        if (spec.steps < 1) throw Error("smoke: at least one step");
-        if (!(spec.sourceKelvin >= 0.0f) || spec.sourceKelvin > 40000.0f) throw Error("smoke: the source temperature must be 0 .. 40000 K");
-        volume::setSmokeDomain(settings, spec.width);
+        checkParam(volume::kSmokeSteps, spec.steps, "smoke");
+        checkParam(kSmokeSourceKelvin, spec.sourceKelvin, "smoke", "source temperature");
+        volume::setSmokeDomain(settings, spec.width);   // checks the width
         const bool hot = spec.sourceKelvin > 0.0f;
         if (hot) settings.buoyancyTemperature /= spec.sourceKelvin;   // per kelvin: the same rise as unit temperature
         settings.sources.push_back({volume::defaultSmokeSource(settings, spec.width), 1.0f, hot ? spec.sourceKelvin : 1.0f, glm::vec3(0.0f)});

@@ -36,23 +36,30 @@ public:
 private:
     QLineEdit* m_name;
     QDoubleSpinBox *m_radius, *m_amplitude, *m_frequency, *m_density;
-    QSpinBox *m_octaves, *m_resolution, *m_seed;
+    QSpinBox *m_octaves, *m_resolution;
+    QLineEdit* m_seed;
     QDoubleSpinBox* m_centre[3];
 };
 
+// Hot smoke's source temperature, a parameter of the studio's smoke job alone.
+inline constexpr ParamSpec kSmokeSourceKelvin{.key = "source_kelvin", .metavar = "K", .lo = 0.0, .hi = 40000.0, .def = {0.0},
+                                              .help = "hot smoke: the sources' temperature in kelvin, drawn as blackbody emission "
+                                                      "(1000 K and up glow); 0 = cold"};
+
 // What the smoke job simulates: cells, domain width (metres), steps, and where the domain's floor centre
-// stands in the world.
+// stands in the world. The ranges are core/volume/smoke.h's; the form starts smaller than `sylva simulate`'s
+// defaults (a quarter of the cells, 40 steps) so that a first try takes seconds.
 struct SmokeSpec {
     glm::ivec3 cells{32, 48, 32};
-    float width = 1.0f;
+    float width = float(volume::kSmokeWidth.def[0]);
     int steps = 40;
-    uint64_t seed = 1;
+    uint64_t seed = uint64_t(volume::kSmokeSeed.def[0]);
     glm::dvec3 position{0.0};
     QString name = QStringLiteral("smoke");
     // Hot smoke (> 0): the sources' temperature in kelvin. The job then also writes the temperature
     // grid (kelvin: blackbody emission, RENDERING.md) and the volume references it; the buoyancy per
     // kelvin is the default's per unit over this, so the plume rises as cold smoke of unit temperature.
-    float sourceKelvin = 0.0f;
+    float sourceKelvin = float(kSmokeSourceKelvin.def[0]);
 };
 
 class SmokeDialog : public QDialog {
@@ -65,7 +72,8 @@ public:
 private:
     SmokeSpec m_initial;
     QLineEdit* m_name;
-    QSpinBox *m_cells[3], *m_steps, *m_seed;
+    QSpinBox *m_cells[3], *m_steps;
+    QLineEdit* m_seed;
     QDoubleSpinBox *m_width, *m_kelvin;
     QDoubleSpinBox* m_position[3];
 };

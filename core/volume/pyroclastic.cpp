@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <string>
 
 #include <tbb/blocked_range.h>
@@ -15,13 +14,6 @@
 namespace sylva::volume {
 namespace {
 
-std::string num(double v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.9g", v);
-    return buf;
-}
-
 void require(bool ok, const std::string& what)
 {
     if (!ok) throw Error("volume cloud: " + what);
@@ -31,15 +23,14 @@ void require(bool ok, const std::string& what)
 
 void validatePyroclastic(const PyroclasticParams& p)
 {
-    require(std::isfinite(p.radius) && p.radius > 0.0f, "radius " + num(p.radius) + " must be finite and > 0");
-    require(std::isfinite(p.amplitude) && p.amplitude >= 0.0f, "amplitude " + num(p.amplitude) + " must be finite and >= 0");
-    require(std::isfinite(p.frequency) && p.frequency > 0.0f, "frequency " + num(p.frequency) + " must be finite and > 0");
-    require(p.octaves >= 1 && p.octaves <= 12, "octaves " + std::to_string(p.octaves) + " must be in 1..12");
-    require(p.resolution >= kCloudMinNodes && p.resolution <= kCloudMaxNodes,
-            "resolution " + std::to_string(p.resolution) + " must be in " + std::to_string(kCloudMinNodes) + ".." +
-                std::to_string(kCloudMaxNodes));
-    require(std::isfinite(p.density) && p.density > 0.0f && p.density <= 1.0f,
-            "density " + num(p.density) + " must lie in (0, 1]");
+    const std::string context = "volume cloud";
+    checkParam(kCloudRadius, p.radius, context);
+    checkParam(kCloudAmplitude, p.amplitude, context);
+    checkParam(kCloudFrequency, p.frequency, context);
+    checkParam(kCloudOctaves, p.octaves, context);
+    checkParam(kCloudResolution, p.resolution, context);
+    checkParam(kCloudDensity, p.density, context);
+    checkParam(kCloudSeed, p.seed, context);
     require(std::isfinite(p.centre.x) && std::isfinite(p.centre.y) && std::isfinite(p.centre.z), "centre must be finite");
 }
 

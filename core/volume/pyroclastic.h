@@ -8,25 +8,46 @@
 
 #include <glm/glm.hpp>
 
+#include "core/base/param_spec.h"
 #include "core/grid/grid.h"
 
 namespace sylva::volume {
 
-inline constexpr int kCloudMinNodes = 8;
-inline constexpr int kCloudMaxNodes = 512;
 // Bump when a change alters the grids makePyroclasticCloud returns (for cache keys).
 inline constexpr int kPyroclasticVersion = 1;
 
+// The parameters, each declared once (core/base/param_spec.h): `sylva volume cloud`'s options and
+// --help, the studio's Add Cloud form, validatePyroclastic and docs/CLI.md's table read these.
+inline constexpr ParamSpec kCloudRadius{.key = "radius", .metavar = "R", .lo = 0.0, .loOpen = true, .def = {1.0},
+                                        .help = "radius R of the undisplaced sphere, metres"};
+inline constexpr ParamSpec kCloudAmplitude{.key = "amplitude", .metavar = "A", .lo = 0.0, .def = {0.5},
+                                           .help = "largest outward displacement A by the noise, metres",
+                                           .note = "; the surface radius lies in [R, R + A]"};
+inline constexpr ParamSpec kCloudFrequency{.key = "frequency", .metavar = "F", .lo = 0.0, .loOpen = true, .def = {1.5},
+                                           .help = "noise cells per metre of the first octave"};
+inline constexpr ParamSpec kCloudOctaves{.key = "octaves", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 1, .hi = 12,
+                                         .def = {4}, .help = "fBm octaves (lacunarity 2, gain 0.5)"};
+inline constexpr ParamSpec kCloudResolution{.key = "resolution", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 8, .hi = 512,
+                                            .def = {128}, .help = "nodes per axis of the cubic grid"};
+inline constexpr ParamSpec kCloudDensity{.key = "density", .metavar = "D", .lo = 0.0, .hi = 1.0, .loOpen = true, .def = {1.0},
+                                         .help = "density inside the cloud"};
+inline constexpr ParamSpec kCloudSeed{.key = "seed", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 0, .hi = 0x1p62,
+                                      .def = {1}, .help = "noise seed", .note = "; the same seed gives the same grid"};
+inline constexpr ParamSpec kCloudCentre{.key = "centre", .metavar = "X,Y,Z", .count = 3, .def = {0.0, 0.0, 0.0},
+                                        .help = "world position of the sphere's centre, metres"};
+inline constexpr const ParamSpec* kCloudParams[] = {&kCloudRadius,     &kCloudAmplitude, &kCloudFrequency, &kCloudOctaves,
+                                                    &kCloudResolution, &kCloudDensity,   &kCloudSeed,      &kCloudCentre};
+
 // 36 bytes.
 struct PyroclasticParams {
-    float radius = 1.0f;        // R: radius of the undisplaced sphere, metres (> 0)
-    float amplitude = 0.5f;     // A: largest outward displacement, metres (>= 0); surface radius in [R, R + A]
-    float frequency = 1.5f;     // noise lattice cells per metre of the first octave (> 0)
-    int octaves = 4;            // fBm octaves (1..12), lacunarity 2, gain 0.5
-    int resolution = 128;       // nodes per axis of the cubic grid (8..512)
-    float density = 1.0f;       // density inside the cloud, in (0, 1]
-    uint64_t seed = 1;          // noise permutation
-    glm::vec3 centre{0.0f};     // world position of the sphere's centre, metres
+    float radius = float(kCloudRadius.def[0]);
+    float amplitude = float(kCloudAmplitude.def[0]);
+    float frequency = float(kCloudFrequency.def[0]);
+    int octaves = int(kCloudOctaves.def[0]);
+    int resolution = int(kCloudResolution.def[0]);
+    float density = float(kCloudDensity.def[0]);
+    uint64_t seed = uint64_t(kCloudSeed.def[0]);
+    glm::vec3 centre{float(kCloudCentre.def[0]), float(kCloudCentre.def[1]), float(kCloudCentre.def[2])};
 };
 
 // The cloud's surface radius toward world point p (relative to the centre):

@@ -89,7 +89,7 @@ struct AxisBatch {
                                                const AxisBatch& z, int count, float* out)
 {
     int base[kBatch];
-    for (int q = 0; q < count; ++q) base[q] = (x.i[q] * dims.y + y.i[q]) * dims.z + z.i[q];   // < 2^31: kSmokeMaxCells
+    for (int q = 0; q < count; ++q) base[q] = (x.i[q] * dims.y + y.i[q]) * dims.z + z.i[q];   // < 2^31: kSmokeCells.hi
     const int dy = dims.z, dx = dims.y * dims.z;
     for (int q = 0; q < count; ++q) {
         const float* p = data + base[q];
@@ -195,6 +195,7 @@ bool SmokeShape::contains(const glm::vec3& p) const
 
 void setSmokeDomain(SmokeSettings& s, float width)
 {
+    checkParam(kSmokeWidth, width, "simulate");
     s.cellSize = width / float(std::max(1, s.cells.x));
     s.origin = glm::vec3(-0.5f * width, 0.0f, -0.5f * float(s.cells.z) * s.cellSize);
 }
@@ -219,24 +220,25 @@ void validateSmoke(const SmokeSettings& s)
 {
     auto fail = [](const std::string& what) { throw Error("simulate: " + what); };
     for (int a = 0; a < 3; ++a)
-        if (s.cells[a] < kSmokeMinCells || s.cells[a] > kSmokeMaxCells)
+        if (!paramHolds(kSmokeCells, (long long)s.cells[a]))
             fail("grid size " + std::to_string(s.cells.x) + "x" + std::to_string(s.cells.y) + "x" + std::to_string(s.cells.z) +
-                 ": every axis needs " + std::to_string(kSmokeMinCells) + ".." + std::to_string(kSmokeMaxCells) + " cells");
+                 ": every axis needs " + paramRange(kSmokeCells) + " cells");
     const double need = smokeBytes(s.cells), have = availableMemoryBytes();
     if (have > 0.0 && need > have)
         fail("a " + std::to_string(s.cells.x) + "x" + std::to_string(s.cells.y) + "x" + std::to_string(s.cells.z) + " grid needs " +
              num(need / 1048576.0) + " MiB but only " + num(have / 1048576.0) + " MiB are available");
     if (!(std::isfinite(s.cellSize) && s.cellSize > 0.0f)) fail("cell size " + num(s.cellSize) + " must be finite and > 0");
-    if (!(std::isfinite(s.dt) && s.dt > 0.0f)) fail("time step " + num(s.dt) + " must be finite and > 0");
+    checkParam(kSmokeDt, s.dt, "simulate", "time step");
     if (!finite3(s.origin)) fail("origin must be finite");
     if (!std::isfinite(s.buoyancyDensity) || !std::isfinite(s.buoyancyTemperature)) fail("buoyancy must be finite");
-    if (!(std::isfinite(s.vorticity) && s.vorticity >= 0.0f)) fail("vorticity " + num(s.vorticity) + " must be finite and >= 0");
+    checkParam(kSmokeVorticity, s.vorticity, "simulate");
     if (!(s.densityDecay >= 0.0f && s.densityDecay * s.dt <= 1.0f))
         fail("density decay " + num(s.densityDecay) + " must be >= 0 and at most 1 / dt");
     if (!(s.temperatureDecay >= 0.0f && s.temperatureDecay * s.dt <= 1.0f))
         fail("temperature decay " + num(s.temperatureDecay) + " must be >= 0 and at most 1 / dt");
-    if (!(s.jitter >= 0.0f && s.jitter <= 1.0f)) fail("jitter " + num(s.jitter) + " must lie in [0, 1]");
-    if (!(s.pressureTolerance > 0.0 && s.pressureTolerance < 1.0)) fail("pressure tolerance must lie in (0, 1)");
+    checkParam(kSmokeJitter, s.jitter, "simulate");
+    checkParam(kSmokeTolerance, s.pressureTolerance, "simulate");
+    checkParam(kSmokeSeed, s.seed, "simulate");
     if (s.pressureMaxIterations < 1) fail("pressure iterations must be >= 1");
     if (!(std::isfinite(s.cflLimit) && s.cflLimit > 0.0f)) fail("CFL limit must be finite and > 0");
     auto checkShape = [&](const SmokeShape& sh, const std::string& what) {
@@ -250,8 +252,8 @@ void validateSmoke(const SmokeSettings& s)
         const SmokeSource& src = s.sources[i];
         const std::string what = "source " + std::to_string(i + 1);
         checkShape(src.shape, what);
-        if (!(src.density >= 0.0f && src.density <= 1.0f)) fail(what + ": density " + num(src.density) + " must lie in [0, 1]");
-        if (!(std::isfinite(src.temperature) && src.temperature >= 0.0f)) fail(what + ": temperature must be finite and >= 0");
+        checkParam(kSmokeSourceDensity, src.density, "simulate: " + what, "density");
+        checkParam(kSmokeSourceTemperature, src.temperature, "simulate: " + what, "temperature");
         if (!finite3(src.velocity)) fail(what + ": velocity must be finite");
         const float cfl = glm::length(src.velocity) * s.dt / s.cellSize;
         if (cfl > s.cflLimit)

@@ -20,6 +20,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/base/param_spec.h"
 #include "core/grid/grid.h"
 
 namespace sylva {
@@ -28,8 +29,37 @@ class Progress;
 
 namespace sylva::volume {
 
-inline constexpr int kSmokeMinCells = 3;
-inline constexpr int kSmokeMaxCells = 512;
+// The parameters `sylva simulate` and the studio's smoke form set, each declared once
+// (core/base/param_spec.h): the members' defaults, validateSmoke, the options and --help, the form's
+// widgets and docs/CLI.md's table read these.
+inline constexpr ParamSpec kSmokeCells{.key = "grid", .kind = ParamSpec::Kind::Integer, .metavar = "X,Y,Z", .count = 3, .lo = 3, .hi = 512,
+                                       .def = {64, 96, 64}, .help = "cells per axis"};
+inline constexpr ParamSpec kSmokeWidth{.key = "size", .metavar = "W", .lo = 0.0, .loOpen = true, .def = {1.0},
+                                       .help = "domain width along x, metres; cells are cubes"};
+inline constexpr ParamSpec kSmokeDt{.key = "dt", .metavar = "S", .lo = 0.0, .loOpen = true, .def = {0.02},
+                                    .help = "time step, seconds"};
+inline constexpr ParamSpec kSmokeSteps{.key = "steps", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 1, .hi = 1000000,
+                                       .def = {100}, .help = "steps to run"};
+inline constexpr ParamSpec kSmokeBuoyancy{.key = "buoyancy", .metavar = "A,B", .count = 2, .def = {0.05, 2.0},
+                                          .help = "force per unit density (down) and per unit temperature (up), m/s^2"};
+inline constexpr ParamSpec kSmokeVorticity{.key = "vorticity", .metavar = "E", .lo = 0.0, .def = {0.3},
+                                           .help = "vorticity confinement epsilon, 0 = off"};
+inline constexpr ParamSpec kSmokeJitter{.key = "jitter", .metavar = "J", .lo = 0.0, .hi = 1.0, .def = {0.2},
+                                        .help = "source density noise"};
+inline constexpr ParamSpec kSmokeTolerance{.key = "tol", .metavar = "T", .lo = 0.0, .hi = 1.0, .loOpen = true, .hiOpen = true,
+                                           .def = {1e-6}, .help = "relative residual of the pressure solve"};
+inline constexpr ParamSpec kSmokeSeed{.key = "seed", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 0, .hi = 0x1p62,
+                                      .def = {1}, .help = "seed of the source noise", .note = "; the same seed gives the same bits"};
+inline constexpr ParamSpec kSmokeSourceDensity{.key = "source-density", .metavar = "D", .lo = 0.0, .hi = 1.0, .def = {1.0},
+                                               .help = "density the sources set"};
+inline constexpr ParamSpec kSmokeSourceTemperature{.key = "source-temperature", .metavar = "T", .lo = 0.0, .def = {1.0},
+                                                   .help = "temperature the sources set, above ambient"};
+inline constexpr ParamSpec kSmokeSourceVelocity{.key = "source-velocity", .metavar = "X,Y,Z", .count = 3, .def = {0.0, 0.0, 0.0},
+                                                .help = "velocity inside the sources, m/s"};
+inline constexpr const ParamSpec* kSmokeParams[] = {&kSmokeCells,     &kSmokeWidth,         &kSmokeDt,
+                                                    &kSmokeSteps,     &kSmokeBuoyancy,      &kSmokeVorticity,
+                                                    &kSmokeJitter,    &kSmokeTolerance,     &kSmokeSeed,
+                                                    &kSmokeSourceDensity, &kSmokeSourceTemperature, &kSmokeSourceVelocity};
 
 enum class SmokeInterp { Linear, MonotonicCubic };
 
@@ -47,27 +77,27 @@ struct SmokeShape {
 // and the faces inside take the source velocity.
 struct SmokeSource {
     SmokeShape shape;
-    float density = 1.0f;         // in [0, 1]
-    float temperature = 1.0f;     // above ambient, in the simulation's temperature unit (>= 0)
-    glm::vec3 velocity{0.0f};     // metres per second
+    float density = float(kSmokeSourceDensity.def[0]);
+    float temperature = float(kSmokeSourceTemperature.def[0]);   // in the simulation's temperature unit
+    glm::vec3 velocity{float(kSmokeSourceVelocity.def[0]), float(kSmokeSourceVelocity.def[1]), float(kSmokeSourceVelocity.def[2])};
 };
 
 struct SmokeSettings {
-    glm::ivec3 cells{64, 96, 64};   // nx, ny, nz (each 3..512)
-    float cellSize = 1.0f / 64.0f;  // h, metres
+    glm::ivec3 cells{int(kSmokeCells.def[0]), int(kSmokeCells.def[1]), int(kSmokeCells.def[2])};   // nx, ny, nz
+    float cellSize = float(kSmokeWidth.def[0]) / float(kSmokeCells.def[0]);   // h, metres
     glm::vec3 origin{0.0f};         // world position of the domain's lower corner
-    float dt = 0.02f;               // seconds per step
-    float buoyancyDensity = 0.05f;  // alpha: downward force per unit density (m/s^2)
-    float buoyancyTemperature = 2.0f;  // beta: upward force per unit temperature (m/s^2)
-    float vorticity = 0.3f;         // epsilon of the confinement force (0: off)
+    float dt = float(kSmokeDt.def[0]);   // seconds per step
+    float buoyancyDensity = float(kSmokeBuoyancy.def[0]);       // alpha: downward force per unit density
+    float buoyancyTemperature = float(kSmokeBuoyancy.def[1]);   // beta: upward force per unit temperature
+    float vorticity = float(kSmokeVorticity.def[0]);            // epsilon of the confinement force
     float densityDecay = 0.0f;      // fraction of density lost per second (0: none)
     float temperatureDecay = 0.5f;  // fraction of temperature lost per second
-    float jitter = 0.2f;            // source density noise amplitude in [0, 1]
+    float jitter = float(kSmokeJitter.def[0]);
     SmokeInterp interp = SmokeInterp::Linear;
-    double pressureTolerance = 1e-6;   // relative residual of the pressure solve
+    double pressureTolerance = kSmokeTolerance.def[0];
     int pressureMaxIterations = 200;
     float cflLimit = 5.0f;          // a step that moves anything more than this many cells is refused
-    uint64_t seed = 1;
+    uint64_t seed = uint64_t(kSmokeSeed.def[0]);
     std::vector<SmokeSource> sources;
     std::vector<SmokeShape> obstacles;
 };

@@ -7,12 +7,17 @@
 #include "pipeline/cli/cli_util.h"
 #include "pipeline/cli/commands.h"
 #include "pipeline/cli/common_options.h"
+#include "pipeline/cli/param_options.h"
 #include "pipeline/io/file_extension.h"
 #include "pipeline/io/grid_file.h"
 #include "pipeline/io/output_path.h"
 
 namespace sylva::cli {
 namespace {
+
+// How often a frame is written: a choice of this command alone.
+constexpr ParamSpec kEvery{.key = "every", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 1, .hi = 1000000, .def = {10},
+                           .help = "write a frame every N steps and after the last"};
 
 // "x,y,z,r" a sphere, "box:x,y,z,hx,hy,hz" a box; several separated by ';'.
 std::vector<volume::SmokeShape> parseShapes(const std::string& option, const std::string& text)
@@ -58,34 +63,38 @@ int runSimulate(const Args& args)
 {
     auto threads = threadLimit(args);
     volume::SmokeSettings s;
-    if (args.has("--grid")) {
-        const std::vector<std::string> parts = splitList(args.get("--grid"));
-        if (parts.size() != 3) throw UsageError("option --grid: expected X,Y,Z cells, got '" + args.get("--grid") + "'");
-        for (int a = 0; a < 3; ++a) s.cells[a] = int(parseInteger("--grid", parts[size_t(a)], 0, 1 << 20));
-    }
-    const float width = args.has("--size") ? float(parseNumber("--size", args.get("--size"))) : 1.0f;
-    if (!(width > 0.0f)) throw Error("simulate: --size " + args.get("--size") + " must be > 0");
+    readParam(args, volume::kSmokeCells, s.cells);
+    float width = float(volume::kSmokeWidth.def[0]);
+    readParam(args, volume::kSmokeWidth, width);
     volume::setSmokeDomain(s, width);
-    if (args.has("--dt")) s.dt = float(parseNumber("--dt", args.get("--dt")));
-    const int steps = args.has("--steps") ? int(parseInteger("--steps", args.get("--steps"), 1, 1000000)) : 100;
-    const int every = args.has("--every") ? int(parseInteger("--every", args.get("--every"), 1, 1000000)) : 10;
-    if (args.has("--buoyancy")) {
-        const glm::vec3 b = parseTriple("--buoyancy", args.get("--buoyancy") + ",0");
-        s.buoyancyDensity = b.x;
-        s.buoyancyTemperature = b.y;
+    readParam(args, volume::kSmokeDt, s.dt);
+    int steps = int(volume::kSmokeSteps.def[0]);
+    readParam(args, volume::kSmokeSteps, steps);
+    checkParam(volume::kSmokeSteps, steps, "simulate");
+    int every = int(kEvery.def[0]);
+    readParam(args, kEvery, every);
+    checkParam(kEvery, every, "simulate");
+    glm::vec2 buoyancy(s.buoyancyDensity, s.buoyancyTemperature);
+    if (readParam(args, volume::kSmokeBuoyancy, buoyancy)) {
+        s.buoyancyDensity = buoyancy.x;
+        s.buoyancyTemperature = buoyancy.y;
     }
-    if (args.has("--vorticity")) s.vorticity = float(parseNumber("--vorticity", args.get("--vorticity")));
-    if (args.has("--jitter")) s.jitter = float(parseNumber("--jitter", args.get("--jitter")));
+    readParam(args, volume::kSmokeVorticity, s.vorticity);
+    readParam(args, volume::kSmokeJitter, s.jitter);
     if (args.has("--cubic")) s.interp = volume::SmokeInterp::MonotonicCubic;
-    if (args.has("--tol")) s.pressureTolerance = parseNumber("--tol", args.get("--tol"));
-    if (args.has("--seed")) s.seed = uint64_t(parseInteger("--seed", args.get("--seed"), 0, (1ll << 62)));
+    readParam(args, volume::kSmokeTolerance, s.pressureTolerance);
+    readParam(args, volume::kSmokeSeed, s.seed);
     std::vector<volume::SmokeShape> sources = args.has("--source") ? parseShapes("--source", args.get("--source"))
                                                                    : std::vector<volume::SmokeShape>{};
     if (!args.has("--source")) sources.push_back(volume::defaultSmokeSource(s, width));   // one sphere at the bottom centre
-    const float sourceDensity = args.has("--source-density") ? float(parseNumber("--source-density", args.get("--source-density"))) : 1.0f;
-    const float sourceTemp = args.has("--source-temperature") ? float(parseNumber("--source-temperature", args.get("--source-temperature"))) : 1.0f;
-    const glm::vec3 sourceVel = args.has("--source-velocity") ? parseTriple("--source-velocity", args.get("--source-velocity")) : glm::vec3(0.0f);
-    for (const volume::SmokeShape& sh : sources) s.sources.push_back({sh, sourceDensity, sourceTemp, sourceVel});
+    volume::SmokeSource source;
+    readParam(args, volume::kSmokeSourceDensity, source.density);
+    readParam(args, volume::kSmokeSourceTemperature, source.temperature);
+    readParam(args, volume::kSmokeSourceVelocity, source.velocity);
+    for (const volume::SmokeShape& sh : sources) {
+        source.shape = sh;
+        s.sources.push_back(source);
+    }
     if (args.has("--obstacle")) s.obstacles = parseShapes("--obstacle", args.get("--obstacle"));
     const bool writeTemperature = args.has("--temperature");
     const std::string out = outputFile(args, gridFileExtensions());
@@ -122,23 +131,25 @@ int runSimulate(const Args& args)
 
 Command simulateCommand()
 {
+    using namespace volume;
+    const std::string cfl = "; a step that moves anything more than " + paramNumber(SmokeSettings{}.cflLimit) + " cells (the CFL limit) is refused";
     return {"simulate", "[options] -o SMOKE.npy|.vdb",
             "simulate smoke (stable fluids, vorticity confinement) and write density frames SMOKE_NNNN.npy",
-            {{"--grid", "X,Y,Z", "cells per axis, 3..512 each (default 64,96,64)"},
-             {"--size", "W", "domain width along x, metres (default 1); cells are cubes"},
-             {"--dt", "S", "time step, seconds (default 0.02); a step over the CFL limit 5 is refused"},
-             {"--steps", "N", "steps to run (default 100)"},
-             {"--every", "N", "write a frame every N steps and after the last (default 10)"},
-             {"--buoyancy", "A,B", "force per unit density (down) and temperature (up), m/s^2 (default 0.05,2)"},
-             {"--vorticity", "E", "vorticity confinement epsilon, 0 = off (default 0.3)"},
-             {"--jitter", "J", "source density noise in [0, 1] (default 0.2)"},
+            {paramOption(kSmokeCells),
+             paramOption(kSmokeWidth),
+             paramOption(kSmokeDt, cfl),
+             paramOption(kSmokeSteps),
+             paramOption(kEvery),
+             paramOption(kSmokeBuoyancy),
+             paramOption(kSmokeVorticity),
+             paramOption(kSmokeJitter),
              {"--cubic", "", "monotonic tricubic interpolation in the advection (default trilinear)"},
-             {"--tol", "T", "relative residual of the pressure solve (default 1e-6)"},
-             {"--seed", "N", "seed of the source noise (default 1); the same seed gives the same bits"},
+             paramOption(kSmokeTolerance),
+             paramOption(kSmokeSeed),
              {"--source", "X,Y,Z,R;...", "source spheres (or box:X,Y,Z,HX,HY,HZ), metres; default one at the bottom centre"},
-             {"--source-density", "D", "density the sources set, [0, 1] (default 1)"},
-             {"--source-temperature", "T", "temperature the sources set (default 1)"},
-             {"--source-velocity", "X,Y,Z", "velocity inside the sources, m/s (default 0)"},
+             paramOption(kSmokeSourceDensity),
+             paramOption(kSmokeSourceTemperature),
+             paramOption(kSmokeSourceVelocity),
              {"--obstacle", "X,Y,Z,R;...", "obstacle spheres (or box:X,Y,Z,HX,HY,HZ), metres"},
              {"--temperature", "", "also write temperature frames SMOKE_NNNN.temperature.npy"},
              kOutput, kThreads, kQuiet},

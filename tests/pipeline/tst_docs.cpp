@@ -3,7 +3,9 @@
 //    exactly the tests CTest registers in this build (`ctest -N`), one well-formed row each;
 //  - docs/CLI.md gives each command exactly the options of its `sylva COMMAND --help`: every option the help
 //    lists appears in that command's section, and every option the page gives a command (in its section, or
-//    in a code span `sylva COMMAND ...` anywhere) is one its help lists.
+//    in a code span `sylva COMMAND ...` anywhere) is one its help lists;
+//  - the option tables of `sylva volume cloud` and `sylva simulate` in docs/CLI.md are, row for row, the
+//    parameters' declarations (core/volume: kCloudParams, kSmokeParams): help, default and range.
 #include <QDir>
 #include <QDirIterator>
 #include <QFile>
@@ -13,6 +15,8 @@
 #include <map>
 #include <set>
 
+#include "core/volume/pyroclastic.h"
+#include "core/volume/smoke.h"
 #include "tests/common/run_program.h"
 
 namespace {
@@ -289,6 +293,38 @@ private Q_SLOTS:
             }
         }
         qInfo("%zu commands, %zu option mentions checked", help.size(), claims.size());
+        QVERIFY2(problems.isEmpty(), qPrintable("\n  " + problems.join("\n  ")));
+    }
+
+    // docs/CLI.md's parameter tables against the declarations they document, row for row.
+    void cliParamTablesMatchDeclarations()
+    {
+        const QString doc = readText(sourcePath("docs/CLI.md"));
+        QVERIFY2(!doc.isEmpty(), "docs/CLI.md is missing");
+        const QString header = "| option | meaning | default | range |";
+        QStringList problems;
+        auto check = [&](const QString& heading, const auto& specs) {
+            const QStringList lines = sectionLines(doc, heading);
+            const qsizetype at = lines.indexOf(header);
+            if (at < 0) {
+                problems << "CLI.md, section " + heading + ": no table with the header '" + header + "'";
+                return;
+            }
+            QStringList rows;
+            for (qsizetype i = at + 2; i < lines.size() && lines[i].startsWith('|'); ++i) rows << lines[i];
+            QStringList want;
+            for (const sylva::ParamSpec* s : specs) {
+                const std::string range = sylva::paramRange(*s);
+                want << QString::fromStdString("| `--" + std::string(s->key) + " " + s->metavar + "` | " + s->help + " | " +
+                                               sylva::paramDefault(*s) + " | " + (range.empty() ? "-" : range) + " |");
+            }
+            for (qsizetype i = 0; i < std::max(rows.size(), want.size()); ++i) {
+                const QString has = i < rows.size() ? rows[i] : "(no row)", should = i < want.size() ? want[i] : "(no parameter)";
+                if (has != should) problems << "CLI.md, section " + heading + ", row " + QString::number(i + 1) + ":\n    has  " + has + "\n    want " + should;
+            }
+        };
+        check("## `sylva volume cloud", sylva::volume::kCloudParams);
+        check("## `sylva simulate", sylva::volume::kSmokeParams);
         QVERIFY2(problems.isEmpty(), qPrintable("\n  " + problems.join("\n  ")));
     }
 };
