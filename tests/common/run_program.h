@@ -1,5 +1,5 @@
-// The command-line tests' one way to run a program of ours in a child process: its exit code (-1 when it
-// did not exit normally), standard output and standard error.
+// The tests' one way to run a program in a child process: its exit code (-1 when it did not start, did not
+// exit normally or ran past its time, and then standard error says which), standard output and standard error.
 #pragma once
 
 #include <QProcess>
@@ -18,13 +18,22 @@ struct Run {
     QString out, err;
 };
 
+// `program ARGS` in the folder workDir (when given; else this process's), killed after timeoutMs.
 inline Run runProgram(const QString& program, const QStringList& args,
-                      const QProcessEnvironment& env = QProcessEnvironment::systemEnvironment(), int timeoutMs = 600000)
+                      const QProcessEnvironment& env = QProcessEnvironment::systemEnvironment(), int timeoutMs = 600000,
+                      const QString& workDir = {})
 {
     QProcess p;
     p.setProcessEnvironment(env);
+    if (!workDir.isEmpty()) p.setWorkingDirectory(workDir);
     p.start(program, args);
-    p.waitForFinished(timeoutMs);
+    if (!p.waitForStarted()) return {-1, QString(), program + " did not start: " + p.errorString()};
+    if (!p.waitForFinished(timeoutMs)) {
+        p.kill();
+        p.waitForFinished();
+        return {-1, QString::fromUtf8(p.readAllStandardOutput()),
+                QString::fromUtf8(p.readAllStandardError()) + "\n" + program + " timed out after " + QString::number(timeoutMs / 1000) + " s"};
+    }
     return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
             QString::fromUtf8(p.readAllStandardError())};
 }

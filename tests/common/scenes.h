@@ -1,6 +1,7 @@
-// The small forest the render tests share: three grown trees of two species on the ground and a
-// close camera, small enough for CI.
+// The small scenes, plants and meshes the render tests share, each small enough for CI.
 #pragma once
+
+#include <QTest>
 
 #include <vector>
 
@@ -8,9 +9,12 @@
 #include "core/render/render_scene.h"
 #include "core/scene/scene.h"
 #include "pipeline/grow/tree_grower.h"
+#include "pipeline/scene/scene_file.h"
+#include "tests/common/files.h"
 
 namespace sylva::test {
 
+// Three grown trees of two species on the ground and a close camera.
 inline Scene smallForest()
 {
     Scene s;
@@ -52,6 +56,64 @@ inline std::vector<SpeciesAssets> oneShrub()
     std::vector<SpeciesAssets> assets(1);
     assets[0].mesh = growTree(a).mesh;
     return assets;
+}
+
+// The GPU tests' small scene: two grown shrubs (about 4k triangles each) on the ground, leaf preset at
+// 16 nodes, 96x64 pixels: seconds to grow, light and trace on the CPU, which is the oracle.
+inline Scene twoShrubs()
+{
+    Scene s;
+    s.species.resize(1);
+    s.species[0].name = "shrub";
+    s.species[0].grow = GrowSpec{"shrub", 2, 4000, 2.0f};
+    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    s.species[0].grid = 16;
+    InstanceDesc a, b;
+    b.position = {1.5, 0.0, 1.0};
+    b.rotationDeg = {0.0f, 70.0f, 0.0f};
+    s.instances = {a, b};
+    s.camera.position = {0.0, 1.5, -5.0};
+    s.camera.target = {0.5, 0.8, 0.5};
+    s.render.width = 96;
+    s.render.height = 64;
+    return s;
+}
+
+// A leaf quad at z = 0 (x, y in [-1, 1], uv = (x + 1) / 2, (y + 1) / 2) whose cut-out's left half is
+// transparent, and a wood wall quad at z = 2 behind it: rays through the left half hit the wall.
+inline SpeciesAssets cardAndWall()
+{
+    SpeciesAssets a;
+    TriangleMesh& m = a.mesh;
+    const glm::vec3 q[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+    for (int i = 0; i < 4; ++i) {
+        m.positions.push_back(q[i]);
+        m.uvs.emplace_back((q[i].x + 1.0f) / 2.0f, (q[i].y + 1.0f) / 2.0f);
+    }
+    for (int i = 0; i < 4; ++i) {
+        m.positions.push_back(q[i] + glm::vec3(0, 0, 2));
+        m.uvs.emplace_back(0.0f, 0.0f);
+    }
+    m.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
+    m.triangleMaterial = {0, 0, 1, 1};
+    m.materials.resize(2);
+    m.materials[0].isLeaf = true;
+    ImageRgba cut(8, 8, glm::vec4(1.0f));
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 4; ++x) cut.at(x, y)[3] = 0.0f;   // left half transparent
+    a.cutout = {cut, ImageRgba()};
+    return a;
+}
+
+// The message readSceneFile refuses the scene file at `path` with, or kNoError.
+inline std::string sceneFileError(const std::string& path) { return errorOf([&] { readSceneFile(path); }); }
+
+// The rows of a test function run once per acceleration structure: column "accel" (an AccelKind).
+inline void accelRows()
+{
+    QTest::addColumn<int>("accel");
+    QTest::newRow("bvh") << int(AccelKind::Bvh);
+    QTest::newRow("kdtree") << int(AccelKind::KdTree);
 }
 
 } // namespace sylva::test

@@ -13,9 +13,12 @@
 #include "core/lb/lb_params.h"
 #include "core/lb/lb_solver.h"
 #include "core/sky/sky_light.h"
+#include "tests/common/grids.h"
 
 using namespace sylva;
 using namespace sylva::lb;
+using sylva::test::maxAbs;
+using sylva::test::relL2;
 
 namespace {
 
@@ -34,23 +37,6 @@ DensityGrid randomDensity(glm::ivec3 dims, std::mt19937& rng)
                 g.woodFraction[n] = u(rng) < 0.1f ? 1.0f : 0.0f;
             }
     return g;
-}
-
-double relL2(const LightingGrid& a, const LightingGrid& b)
-{
-    double d = 0.0, n = 0.0;
-    for (size_t i = 0; i < a.rgb.size(); ++i) {
-        d += double(a.rgb[i] - b.rgb[i]) * double(a.rgb[i] - b.rgb[i]);
-        n += double(b.rgb[i]) * double(b.rgb[i]);
-    }
-    return std::sqrt(d / n);
-}
-
-double maxAbs(const LightingGrid& a, const LightingGrid& b)
-{
-    double m = 0.0;
-    for (size_t i = 0; i < a.rgb.size(); ++i) m = std::max(m, double(std::fabs(a.rgb[i] - b.rgb[i])));
-    return m;
 }
 
 glm::vec3 randomSun(std::mt19937& rng, bool upper)

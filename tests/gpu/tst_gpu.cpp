@@ -26,8 +26,8 @@
 #include "pipeline/render/volume_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "tests/common/linear_compare.h"
+#include "tests/common/scenes.h"
 #include "tests/gpu/egl_context.h"
-#include "tests/gpu/shrub_scene.h"
 #if SYLVA_HAVE_CUDA
 #include "cuda/gl_interop.h"
 #include "cuda/lb_cuda.h"
@@ -245,9 +245,7 @@ private Q_SLOTS:
     // The GPU film composes and tone-maps to the CPU picture in every mode.
     void nestedRaysMatchCpu_data()
     {
-        QTest::addColumn<int>("accel");
-        QTest::newRow("bvh") << int(AccelKind::Bvh);
-        QTest::newRow("kdtree") << int(AccelKind::KdTree);
+        test::accelRows();
     }
 
     // Four levels (the top, three nested groups) on the device: the same hits, instance paths and t as

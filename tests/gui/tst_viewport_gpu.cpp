@@ -15,7 +15,7 @@
 #include "pipeline/render/view_frame.h"
 #include "studio/render_worker.h"
 #include "studio/viewport.h"
-#include "tests/gpu/shrub_scene.h"
+#include "tests/common/scenes.h"
 #include "tests/gui/studio_test_util.h"
 
 using namespace sylva;

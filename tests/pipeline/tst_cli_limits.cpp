@@ -14,6 +14,7 @@
 #include "core/grid/grid.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/io/npy.h"
+#include "tests/common/files.h"
 #include "tests/common/run_program.h"
 
 using namespace sylva;
@@ -33,9 +34,7 @@ class TestCliLimits : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_dir = QString(SYLVA_TEST_OUTPUT) + "/cli_limits";
-        QDir(m_dir).removeRecursively();
-        QDir().mkpath(m_dir);
+        m_dir = test::outputDir("cli_limits");
         // A valid 6x5x7 density grid, half full: the refusals below are about the parameters alone.
         NpyArray d;
         d.shape = {6, 5, 7};

@@ -14,15 +14,13 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/io/atomic_file.h"
 #include "pipeline/io/npy.h"
+#include "tests/common/run_program.h"
 
 using namespace sylva;
 
 namespace {
 
-struct Run {
-    int code = -1;
-    QString out, err;
-};
+using test::Run;
 
 QString outDir()
 {
@@ -40,12 +38,7 @@ QProcessEnvironment environment()
 
 Run runSylva(const QStringList& args, const QProcessEnvironment& env = environment())
 {
-    QProcess p;
-    p.setProcessEnvironment(env);
-    p.start(SYLVA_CLI_PATH, args);
-    p.waitForFinished(600000);
-    return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
-            QString::fromUtf8(p.readAllStandardError())};
+    return test::runProgram(SYLVA_CLI_PATH, args, env);
 }
 
 // Files whose name starts with ".tmp." (AtomicFile's temporary files) anywhere under dir.

@@ -14,7 +14,7 @@
 #include "core/render/render_scene.h"
 #include "core/render/shade.h"
 #include "core/terrain/landscape_light.h"
-#include "small_forest.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 

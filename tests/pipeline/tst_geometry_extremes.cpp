@@ -22,6 +22,7 @@
 #include "pipeline/grow/obj_writer.h"
 #include "pipeline/lighting_job.h"
 #include "pipeline/render/render_job.h"
+#include "tests/common/files.h"
 
 using namespace sylva;
 
@@ -202,9 +203,7 @@ class TestGeometryExtremes : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_dir = QString(SYLVA_TEST_OUTPUT) + "/geometry_extremes";
-        QDir(m_dir).removeRecursively();
-        QDir().mkpath(m_dir);
+        m_dir = test::outputDir("geometry_extremes");
     }
 
     // Zero-area triangles (repeated corners, collinear corners) next to one real triangle: the

@@ -6,6 +6,7 @@
 
 #include "core/base/error.h"
 #include "pipeline/io/image_io.h"
+#include "tests/common/files.h"
 
 using namespace sylva;
 
@@ -17,8 +18,7 @@ class TestImageIo : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_dir = QString(SYLVA_TEST_OUTPUT) + "/image_io";
-        QDir().mkpath(m_dir);
+        m_dir = test::outputDir("image_io", false);
     }
 
     void palettePngKeepsTransparency()

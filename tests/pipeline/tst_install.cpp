@@ -18,36 +18,19 @@
 #include <QStandardPaths>
 
 #include "pipeline/io/image_io.h"
+#include "tests/common/files.h"
 #include "tests/common/run_program.h"
 
 namespace {
 
-struct Run {
-    int code = -1;
-    QString out, err;
-};
+using sylva::test::readText;
+using sylva::test::Run;
 
 Run run(const QString& program, const QStringList& args, const QString& cwd = QString(), int timeoutMs = 120000)
 {
-    QProcess p;
-    if (!cwd.isEmpty()) p.setWorkingDirectory(cwd);
-    p.start(program, args);
-    if (!p.waitForFinished(timeoutMs)) {
-        p.kill();
-        p.waitForFinished();
-        return {-1, QString(), program + " timed out"};
-    }
-    return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
-            QString::fromUtf8(p.readAllStandardError())};
+    return sylva::test::runProgram(program, args, QProcessEnvironment::systemEnvironment(), timeoutMs, cwd);
 }
 
-QString readText(const QString& path)
-{
-    QFile f(path);
-    return f.open(QIODevice::ReadOnly) ? QString::fromUtf8(f.readAll()) : QString();
-}
-
-// The command table as the binary's --help pages show it: command -> option names (as typed).
 } // namespace
 
 class TestInstall : public QObject {

@@ -29,7 +29,7 @@
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "tests/common/golden.h"
-#include "tests/pipeline/small_forest.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 
@@ -99,16 +99,6 @@ Scene flattened(const Scene& land, const RenderScene& rs, Keep keep)
             }
         }
     return s;
-}
-
-std::string errorOf(const std::string& path)
-{
-    try {
-        readSceneFile(path);
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
 }
 
 } // namespace
@@ -258,9 +248,7 @@ private Q_SLOTS:
     // components), and packets of every size from 1 to 64.
     void packetsAnswerAsSingleRays_data()
     {
-        QTest::addColumn<int>("accel");
-        QTest::newRow("bvh") << int(AccelKind::Bvh);
-        QTest::newRow("kdtree") << int(AccelKind::KdTree);
+        test::accelRows();
     }
     void packetsAnswerAsSingleRays()
     {
@@ -711,17 +699,17 @@ private Q_SLOTS:
         QCOMPARE(r.terrain.tiles.seed, uint64_t(3));
         QCOMPARE(r.terrain.density.upper, 5.0);
 
-        const std::string unknown = errorOf(write("unknown.sylva.json", ", \"cells\": 4, \"tiles\": {\"plants\": [{\"species\": \"oak\"}]}"));
+        const std::string unknown = test::sceneFileError(write("unknown.sylva.json", ", \"cells\": 4, \"tiles\": {\"plants\": [{\"species\": \"oak\"}]}"));
         QVERIFY2(unknown.find("terrain.tiles.plants[0].species") != std::string::npos && unknown.find("oak") != std::string::npos, unknown.c_str());
-        const std::string empty = errorOf(write("empty.sylva.json",
+        const std::string empty = test::sceneFileError(write("empty.sylva.json",
                                                 ", \"cells\": 4, \"tiles\": {\"plants\": [{\"species\": \"shrub\"}]}, \"tiling\": {\"set\": []}"));
         QVERIFY2(empty.find("terrain.tiling.set") != std::string::npos && empty.find("empty") != std::string::npos, empty.c_str());
-        const std::string cannot = errorOf(write("cannot.sylva.json", ", \"cells\": 4, \"tiles\": {\"plants\": [{\"species\": \"shrub\"}]},"
+        const std::string cannot = test::sceneFileError(write("cannot.sylva.json", ", \"cells\": 4, \"tiles\": {\"plants\": [{\"species\": \"shrub\"}]},"
                                                                      " \"tiling\": {\"set\": [[0, 0, 0, 0], [1, 1, 1, 0]]}"));
         QVERIFY2(cannot.find("cannot tile") != std::string::npos, cannot.c_str());
-        const std::string noTiles = errorOf(write("notiles.sylva.json", ", \"cells\": 4"));
+        const std::string noTiles = test::sceneFileError(write("notiles.sylva.json", ", \"cells\": 4"));
         QVERIFY2(noTiles.find("terrain.tiles") != std::string::npos, noTiles.c_str());
-        const std::string noPlants = errorOf(write("noplants.sylva.json", ", \"cells\": 4, \"tiles\": {\"plants\": []}"));
+        const std::string noPlants = test::sceneFileError(write("noplants.sylva.json", ", \"cells\": 4, \"tiles\": {\"plants\": []}"));
         QVERIFY2(noPlants.find("at least one species") != std::string::npos, noPlants.c_str());
     }
 };

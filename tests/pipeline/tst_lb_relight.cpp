@@ -14,9 +14,12 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/io/npy.h"
 #include "pipeline/lighting_job.h"
+#include "tests/common/files.h"
+#include "tests/common/grids.h"
 #include "tests/common/run_program.h"
 
 using namespace sylva;
+using sylva::test::relL2;
 using sylva::test::Run;
 using sylva::test::runSylva;
 
@@ -37,16 +40,6 @@ DensityGrid randomDensity(glm::ivec3 dims, uint32_t seed)
     return g;
 }
 
-double relL2(const LightingGrid& a, const LightingGrid& b)
-{
-    double d = 0.0, n = 0.0;
-    for (size_t i = 0; i < a.rgb.size(); ++i) {
-        d += double(a.rgb[i] - b.rgb[i]) * double(a.rgb[i] - b.rgb[i]);
-        n += double(b.rgb[i]) * double(b.rgb[i]);
-    }
-    return std::sqrt(d / n);
-}
-
 QJsonObject sidecar(const QString& npy)
 {
     QFile f(npy + ".json");
@@ -63,9 +56,7 @@ class TestLbRelight : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_dir = QString(SYLVA_TEST_OUTPUT) + "/lb_relight";
-        QDir(m_dir).removeRecursively();
-        QDir().mkpath(m_dir);
+        m_dir = test::outputDir("lb_relight");
         writeDensityGrid((m_dir + "/d.npy").toStdString(), randomDensity({10, 14, 9}, 3));
     }
 

@@ -11,6 +11,7 @@
 #include "pipeline/grow/obj_writer.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/lighting_job.h"
+#include "tests/common/files.h"
 
 using namespace sylva;
 
@@ -23,9 +24,7 @@ class TestLightingJob : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_dir = QString(SYLVA_TEST_OUTPUT) + "/lighting_job";
-        QDir(m_dir).removeRecursively();
-        QDir().mkpath(m_dir);
+        m_dir = test::outputDir("lighting_job");
         GrowOptions g;
         g.species = TreeSpecies::Shrub;
         g.targetTriangles = 4000;

@@ -19,8 +19,9 @@
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/render/render_job.h"
-#include "small_forest.h"
+#include "tests/common/files.h"
 #include "tests/common/golden.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 
@@ -109,8 +110,7 @@ class TestRender : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_out = QString(SYLVA_TEST_OUTPUT) + "/render";
-        QDir().mkpath(m_out);
+        m_out = test::outputDir("render", false);
     }
 
     void accelMatchesBruteForce_data()
@@ -186,9 +186,7 @@ private Q_SLOTS:
 
     void instancesMatchFlattenedCopy_data()
     {
-        QTest::addColumn<int>("accel");
-        QTest::newRow("bvh") << int(AccelKind::Bvh);
-        QTest::newRow("kdtree") << int(AccelKind::KdTree);
+        test::accelRows();
     }
 
     // Fifty rotated, scaled, translated instances trace exactly like one flattened copy of their triangles.
@@ -256,30 +254,11 @@ private Q_SLOTS:
     // A ray through a transparent texel of a leaf hits what is behind it; through an opaque texel, the leaf.
     void alphaCutoutLetsRaysThrough()
     {
-        TriangleMesh m;
-        // Leaf quad at z = 0 (x,y in [-1,1]) with uv = (x+1)/2, wall quad at z = 2.
-        const glm::vec3 q[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-        for (int i = 0; i < 4; ++i) {
-            m.positions.push_back(q[i]);
-            m.uvs.emplace_back((q[i].x + 1.0f) / 2.0f, (q[i].y + 1.0f) / 2.0f);
-        }
-        for (int i = 0; i < 4; ++i) {
-            m.positions.push_back(q[i] + glm::vec3(0, 0, 2));
-            m.uvs.emplace_back(0.0f, 0.0f);
-        }
-        m.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
-        m.triangleMaterial = {0, 0, 1, 1};
-        m.materials.resize(2);
-        m.materials[0].isLeaf = true;
-        SpeciesAssets a = assetsFor(m);
-        ImageRgba cut(8, 8, glm::vec4(1.0f));
-        for (int y = 0; y < 8; ++y)
-            for (int x = 0; x < 4; ++x) cut.at(x, y)[3] = 0.0f;   // left half transparent
-        a.cutout = {cut, ImageRgba()};
+        // Leaf quad at z = 0 (x,y in [-1,1]) with uv = (x+1)/2, its cut-out's left half transparent; wall quad at z = 2.
         Scene s = sceneFor({InstanceDesc{}});
         s.camera.position = {0.0, 0.0, -5.0};
         s.camera.target = {0.0, 0.0, 0.0};
-        std::vector<SpeciesAssets> assets{a};
+        std::vector<SpeciesAssets> assets{test::cardAndWall()};
         const RenderScene rs = buildRenderScene(s, assets, glm::vec3(1.0f));
         const RenderView v = rs.view();
         auto shoot = [&](float x, float* t) {
@@ -307,9 +286,7 @@ private Q_SLOTS:
     // kd-tree runs the triangles in slot order) and trace the same film as the whole scene, bit for bit.
     void hostTracedFrameTracesAlike_data()
     {
-        QTest::addColumn<int>("accel");
-        QTest::newRow("bvh") << int(AccelKind::Bvh);
-        QTest::newRow("kdtree") << int(AccelKind::KdTree);
+        test::accelRows();
     }
     void hostTracedFrameTracesAlike()
     {

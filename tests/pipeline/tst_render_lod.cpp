@@ -15,7 +15,7 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/render/render_job.h"
-#include "small_forest.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 
@@ -58,32 +58,6 @@ double recordLeafArea(const RenderScene& rs, size_t record)
     }
     return area;
 }
-
-// A leaf quad at z = 0 (x, y in [-1, 1], left half of its cut-out transparent) and a wall at z = 2.
-SpeciesAssets cardAndWall()
-{
-    SpeciesAssets a;
-    TriangleMesh& m = a.mesh;
-    const glm::vec3 q[4] = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
-    for (int i = 0; i < 4; ++i) {
-        m.positions.push_back(q[i]);
-        m.uvs.emplace_back((q[i].x + 1.0f) / 2.0f, (q[i].y + 1.0f) / 2.0f);
-    }
-    for (int i = 0; i < 4; ++i) {
-        m.positions.push_back(q[i] + glm::vec3(0, 0, 2));
-        m.uvs.emplace_back(0.0f, 0.0f);
-    }
-    m.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 5, 6}, {4, 6, 7}};
-    m.triangleMaterial = {0, 0, 1, 1};
-    m.materials.resize(2);
-    m.materials[0].isLeaf = true;
-    ImageRgba cut(8, 8, glm::vec4(1.0f));
-    for (int y = 0; y < 8; ++y)
-        for (int x = 0; x < 4; ++x) cut.at(x, y)[3] = 0.0f;
-    a.cutout = {cut, ImageRgba()};
-    return a;
-}
-
 
 } // namespace
 
@@ -287,7 +261,7 @@ private Q_SLOTS:
                 s.camera.target = {0.0, 0.0, 1.0};
                 s.render.accel = accel;
                 s.render.alphaDistance = 50.0f;
-                const std::vector<SpeciesAssets> assets{cardAndWall()};
+                const std::vector<SpeciesAssets> assets{test::cardAndWall()};
                 const RenderScene rs = buildRenderScene(s, assets, glm::vec3(1.0f));
                 const RenderView v = rs.view();
                 const float card = float(cardAt), wall = float(cardAt) + 2.0f;

@@ -24,6 +24,7 @@
 #include "pipeline/render/render_passes.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/exports.h"
+#include "tests/common/run_program.h"
 
 using namespace sylva;
 
@@ -167,17 +168,9 @@ void checkComposition(const ExrChannels& e, const glm::vec3& sky, int* withDirec
     }
 }
 
-struct CliResult {
-    int code;
-    QString out, err;
-};
-CliResult runCli(const QStringList& args)
+test::Run runCli(const QStringList& args)
 {
-    QProcess p;
-    p.start(SYLVA_CLI_PATH, args);
-    p.waitForFinished(300000);
-    return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
-            QString::fromUtf8(p.readAllStandardError())};
+    return test::runProgram(SYLVA_CLI_PATH, args, QProcessEnvironment::systemEnvironment(), 300000);
 }
 
 } // namespace
@@ -337,7 +330,7 @@ private Q_SLOTS:
         const QString scene = m_dir.filePath("card.sylva.json");
         writeSceneFile(sc, scene.toStdString());
         const QString out = m_dir.filePath("cli.exr");
-        const CliResult r = runCli({"render", scene, "--passes", "-o", out, "--quiet"});
+        const test::Run r = runCli({"render", scene, "--passes", "-o", out, "--quiet"});
         QVERIFY2(r.code == 0, qPrintable(r.err));
         const ExrChannels e = readExr(out);
         QVERIFY2(e.channels.size() == kExpectedChannels.size(), qPrintable(channelList(e)));
@@ -347,12 +340,12 @@ private Q_SLOTS:
         QVERIFY(withDirect > 0);
 
         const QString png = m_dir.filePath("cli.png");
-        const CliResult bad = runCli({"render", scene, "--passes", "-o", png, "--quiet"});
+        const test::Run bad = runCli({"render", scene, "--passes", "-o", png, "--quiet"});
         QCOMPARE(bad.code, 2);
         QVERIFY2(bad.err.contains("--passes") && bad.err.contains(".exr"), qPrintable(bad.err));
         QVERIFY(!QFile::exists(png));
         const QString banded = m_dir.filePath("banded.exr");
-        const CliResult bands = runCli({"render", scene, "--passes", "--band-rows", "8", "-o", banded, "--quiet"});
+        const test::Run bands = runCli({"render", scene, "--passes", "--band-rows", "8", "-o", banded, "--quiet"});
         QCOMPARE(bands.code, 2);
         QVERIFY(!QFile::exists(banded));
     }

@@ -10,6 +10,7 @@
 #include "core/base/error.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
+#include "tests/common/files.h"
 
 using namespace sylva;
 
@@ -73,9 +74,7 @@ class TestRenderStages : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_dir = QString(SYLVA_TEST_OUTPUT) + "/render_stages";
-        QDir(m_dir).removeRecursively();
-        QDir().mkpath(m_dir);
+        m_dir = test::outputDir("render_stages");
     }
 
     // One species with 100 instances grows, voxelizes and solves once; two species with 50 each, twice.

@@ -18,8 +18,11 @@
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_fields.h"
 #include "pipeline/scene/scene_file.h"
+#include "tests/common/files.h"
 
 using namespace sylva;
+using test::errorOf;
+using test::writeText;
 
 namespace {
 
@@ -27,26 +30,8 @@ const char* kName = "scene.json";
 
 QString sharedTree() { return QStringLiteral(SYLVA_RESOURCES "/trees/quaternius/OBJ/Tree_1.obj"); }
 
-void writeText(const QString& path, const QByteArray& text)
-{
-    QDir().mkpath(QFileInfo(path).absolutePath());
-    QFile f(path);
-    QVERIFY2(f.open(QIODevice::WriteOnly | QIODevice::Truncate), qPrintable(path));
-    QCOMPARE(f.write(text), text.size());
-}
-
 // One triangle: enough for a file that exists and reads as a mesh.
 void writeTinyObj(const QString& path) { writeText(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"); }
-
-std::string errorOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
 
 void compareLb(const lb::LbParams& a, const lb::LbParams& b)
 {

@@ -27,6 +27,7 @@
 #include "pipeline/services/reference_stats.h"
 #include "pipeline/services/render_stats.h"
 #include "pipeline/services/sidecars.h"
+#include "tests/common/files.h"
 
 using namespace sylva;
 
@@ -86,9 +87,7 @@ class TestServices : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_dir = QString(SYLVA_TEST_OUTPUT) + "/services";
-        QDir(m_dir).removeRecursively();
-        QDir().mkpath(m_dir);
+        m_dir = test::outputDir("services");
     }
 
     void dimsText() { QCOMPARE(gridDimsText(GridGeometry{{4, 5, 6}, {}, 1.0}), std::string("4x5x6")); }

@@ -22,20 +22,14 @@
 #include "core/sky/virtual_lights.h"
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/render/render_job.h"
+#include "tests/common/files.h"
 #include "tests/common/run_program.h"
 
 using namespace sylva;
 
 namespace {
 
-QString outDir()
-{
-    const QString dir = QString(SYLVA_TEST_OUTPUT) + "/sky_map";
-    QDir().mkpath(dir);
-    return dir;
-}
-
-std::string outPath(const char* name) { return (outDir() + "/" + name).toStdString(); }
+std::string outPath(const char* name) { return (test::outputDir("sky_map", false) + "/" + name).toStdString(); }
 
 // Writes a float RGB EXR through OpenImageIO.
 void writeFloatExr(const std::string& path, int w, int h, const std::vector<float>& rgb, int channels = 3)
@@ -58,15 +52,7 @@ std::vector<float> readFloat(const std::string& path, int* w, int* h, int* nc)
     return px;
 }
 
-std::string errorOf(const std::string& path)
-{
-    try {
-        readEnvMap(path);
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return {};
-}
+std::string errorOf(const std::string& path) { return test::errorOf([&] { readEnvMap(path); }); }
 
 using test::Run;
 using test::runSylva;

@@ -22,7 +22,7 @@
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
-#include "tests/pipeline/small_forest.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 

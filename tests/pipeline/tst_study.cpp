@@ -18,36 +18,18 @@
 #include <map>
 #include <tuple>
 
+#include "tests/common/files.h"
+#include "tests/common/run_program.h"
+
 namespace {
 
-struct Run {
-    int code = -1;
-    QString out, err;
-};
+using sylva::test::readText;
+using sylva::test::Run;
 
-Run sylva(const QStringList& args, const QProcessEnvironment& env = QProcessEnvironment::systemEnvironment())
+// `sylva ARGS`, with minutes to finish.
+Run runStudy(const QStringList& args, const QProcessEnvironment& env = QProcessEnvironment::systemEnvironment())
 {
-    QProcess p;
-    p.setProcessEnvironment(env);
-    p.start(SYLVA_CLI_PATH, args);
-    Run r;
-    if (!p.waitForFinished(1500 * 1000)) {
-        p.kill();
-        p.waitForFinished();
-        r.err = "timed out";
-        return r;
-    }
-    r.code = p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1;
-    r.out = QString::fromUtf8(p.readAllStandardOutput());
-    r.err = QString::fromUtf8(p.readAllStandardError());
-    return r;
-}
-
-QString readAll(const QString& path)
-{
-    QFile f(path);
-    if (!f.open(QIODevice::ReadOnly)) return {};
-    return QString::fromUtf8(f.readAll());
+    return sylva::test::runProgram(SYLVA_CLI_PATH, args, env, 1500 * 1000);
 }
 
 } // namespace
@@ -154,9 +136,9 @@ private Q_SLOTS:
             QVERIFY(f.open(QIODevice::WriteOnly));
             f.write("# Accuracy\n\nold intro\n\n## Normalization\n\nKept text 4711.\n\n## Old generated section\n\nold numbers\n");
         }
-        const Run r = sylva({"study", "lb", "--quick", "--out", dir.path()});
+        const Run r = runStudy({"study", "lb", "--quick", "--out", dir.path()});
         QVERIFY2(r.code == 0, qPrintable(r.err + r.out));
-        const QString md = readAll(dir.filePath("ACCURACY.md"));
+        const QString md = readText(dir.filePath("ACCURACY.md"));
         QVERIFY(md.startsWith("# Accuracy\n"));
         QVERIFY(md.contains("## Normalization\n\nKept text 4711.\n"));
         QVERIFY(!md.contains("old numbers"));
@@ -185,16 +167,16 @@ private Q_SLOTS:
         // Regenerating from the stored numbers without gnuplot: the tables stay, the plots are skipped and said so.
         QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
         env.insert("SYLVA_GNUPLOT", dir.filePath("no-such-gnuplot"));
-        const Run again = sylva({"study", "report", "--out", dir.path()}, env);
+        const Run again = runStudy({"study", "report", "--out", dir.path()}, env);
         QVERIFY2(again.code == 0, qPrintable(again.err + again.out));
-        const QString md2 = readAll(dir.filePath("ACCURACY.md"));
+        const QString md2 = readText(dir.filePath("ACCURACY.md"));
         QVERIFY(md2.contains("Kept text 4711."));
         QVERIFY(md2.contains("| 64 |"));
         QVERIFY(md2.contains("Plots: skipped"));
         QVERIFY(again.out.contains("plots skipped"));
 
         // Bad usage.
-        QCOMPARE(sylva({"study", "everything"}).code, 2);
+        QCOMPARE(runStudy({"study", "everything"}).code, 2);
     }
 
     // `sylva study scene --quick`: the forest-level grid against per-instance solves on a stand, and the
@@ -206,9 +188,9 @@ private Q_SLOTS:
     {
         QTemporaryDir dir;
         QVERIFY(dir.isValid());
-        const Run r = sylva({"study", "scene", "--quick", "--out", dir.path()});
+        const Run r = runStudy({"study", "scene", "--quick", "--out", dir.path()});
         QVERIFY2(r.code == 0, qPrintable(r.err + r.out));
-        const QString md = readAll(dir.filePath("ACCURACY.md"));
+        const QString md = readText(dir.filePath("ACCURACY.md"));
         QVERIFY(md.contains("## Scene scale: the forest-level grid and the relighting basis"));
         QVERIFY(md.contains("**default** resolution"));
         QVERIFY(md.contains("sylva study lb"));   // the LB part, not measured here, says how to measure it
@@ -256,9 +238,9 @@ private Q_SLOTS:
     {
         QTemporaryDir dir;
         QVERIFY(dir.isValid());
-        const Run r = sylva({"study", "sky", "--quick", "--out", dir.path()});
+        const Run r = runStudy({"study", "sky", "--quick", "--out", dir.path()});
         QVERIFY2(r.code == 0, qPrintable(r.err + r.out));
-        const QString md = readAll(dir.filePath("ACCURACY.md"));
+        const QString md = readText(dir.filePath("ACCURACY.md"));
         QVERIFY(md.contains("## Sky light: virtual lights, interleaving and samples"));
         QVERIFY(md.contains("### Preetham"));
         QVERIFY(md.contains("sylva study lb"));   // the parts not measured say how to measure them

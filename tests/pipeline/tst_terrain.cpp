@@ -17,7 +17,7 @@
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/io/dem_io.h"
 #include "pipeline/scene/scene_file.h"
-#include "tests/pipeline/small_forest.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 
@@ -69,16 +69,6 @@ void writeFloatImage(const std::string& path, int w, int h, const std::vector<fl
     QVERIFY(out->open(path, OIIO::ImageSpec(w, h, 1, OIIO::TypeDesc::FLOAT)));
     QVERIFY(out->write_image(OIIO::TypeDesc::FLOAT, v.data()));
     QVERIFY(out->close());
-}
-
-std::string errorOf(const std::string& path)
-{
-    try {
-        readSceneFile(path);
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
 }
 
 } // namespace
@@ -248,7 +238,7 @@ private Q_SLOTS:
         const std::string scene = file("bad.sylva.json");
         auto withTerrain = [&](const std::string& terrain) {
             writeText(scene, R"({"version": 1, "species": [{"name": "s", "grow": {"species": "shrub"}}], "instances": [], "terrain": )" + terrain + "}");
-            return errorOf(scene);
+            return test::sceneFileError(scene);
         };
         auto expect = [](const std::string& message, const char* part) {
             QVERIFY2(message.find(part) != std::string::npos, qPrintable(QString::fromStdString("'" + message + "' lacks '" + part + "'")));
@@ -275,10 +265,10 @@ private Q_SLOTS:
         expect(big, "MiB are available");
         // No instances and no terrain is still an error.
         writeText(scene, R"({"version": 1, "species": [{"name": "s", "grow": {"species": "shrub"}}], "instances": []})");
-        expect(errorOf(scene), "needs at least one instance (or a terrain)");
+        expect(test::sceneFileError(scene), "needs at least one instance (or a terrain)");
         writeText(scene, R"({"version": 1, "species": [{"name": "s", "grow": {"species": "shrub"}}],
             "instances": [{"species": "s", "position": [0, 0, 0], "on_terrain": true}]})");
-        expect(errorOf(scene), "instances[0].on_terrain: needs a terrain");
+        expect(test::sceneFileError(scene), "instances[0].on_terrain: needs a terrain");
     }
 };
 

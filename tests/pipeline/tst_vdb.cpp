@@ -28,12 +28,14 @@
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/exports.h"
+#include "tests/common/files.h"
 #include "tests/common/run_program.h"
 
 using namespace sylva;
 
 namespace {
 
+using test::errorOf;
 using test::Run;
 using test::runSylva;
 
@@ -108,16 +110,6 @@ openvdb::FloatGrid::Ptr sparseFloat(const std::string& name, const openvdb::math
     return g;
 }
 
-std::string errorOf(const std::function<void()>& f)
-{
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
-
 } // namespace
 
 class TestVdb : public QObject {
@@ -130,9 +122,7 @@ class TestVdb : public QObject {
 private Q_SLOTS:
     void initTestCase()
     {
-        m_dir = QString(SYLVA_TEST_OUTPUT) + "/vdb";
-        QDir(m_dir).removeRecursively();
-        QDir().mkpath(m_dir);
+        m_dir = test::outputDir("vdb");
         openvdb::initialize();
     }
 

@@ -26,7 +26,7 @@
 #include "pipeline/render/volume_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/scene/scene_volumes.h"
-#include "tests/pipeline/small_forest.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 
