@@ -1,4 +1,5 @@
-// Study results to and from JSON (QJsonDocument), the Pareto front, run descriptions.
+// Study results to and from JSON (Qt's QJsonDocument, each record's keys listed once), the Pareto front,
+// run descriptions.
 #include "pipeline/study/study_data.h"
 
 #include <algorithm>
@@ -6,6 +7,7 @@
 #include <fstream>
 #include <numeric>
 #include <thread>
+#include <type_traits>
 
 #include <QFile>
 #include <QJsonArray>
@@ -18,406 +20,150 @@
 namespace sylva::study {
 namespace {
 
-QString qs(const std::string& s) { return QString::fromStdString(s); }
-std::string str(const QJsonObject& o, const char* key) { return o.value(QLatin1String(key)).toString().toStdString(); }
-double num(const QJsonObject& o, const char* key) { return o.value(QLatin1String(key)).toDouble(); }
-int integer(const QJsonObject& o, const char* key) { return o.value(QLatin1String(key)).toInt(); }
-bool flag(const QJsonObject& o, const char* key) { return o.value(QLatin1String(key)).toBool(); }
-
-QJsonObject runToJson(const RunInfo& r)
+// Each record's fields, listed once as (JSON key, member): the writer and the reader below walk the same
+// list, so a key cannot be written under one name and read under another. `io` is a Writer or a Reader;
+// R is the record, const when written.
+template <class Io, class R>
+void fields(Io& io, R& r)
 {
+    using T = std::remove_const_t<R>;
+    if constexpr (std::is_same_v<T, RunInfo>) {
+        io("date", r.date); io("machine", r.machine); io("quick", r.quick); io("seconds", r.seconds);
+        io("load_before", r.loadBefore); io("load_after", r.loadAfter);
+    } else if constexpr (std::is_same_v<T, LbReference>) {
+        io("grid", r.grid); io("dims", r.dims); io("paths", r.paths); io("noise", r.noise); io("seconds", r.seconds);
+        io("cached", r.cached);
+    } else if constexpr (std::is_same_v<T, LbRow>) {
+        io("grid", r.grid); io("dims", r.dims); io("steps", r.steps); io("fp16", r.fp16); io("seconds", r.seconds);
+        io("cpu_seconds", r.cpuSeconds); io("steps_taken", r.stepsTaken); io("err_same", r.errSame); io("err_fine", r.errFine);
+        io("default", r.isDefault);
+    } else if constexpr (std::is_same_v<T, LbCase>) {
+        io("name", r.name); io("title", r.title); io("preset", r.preset); io("fine_grid", r.fineGrid); io("skipped", r.skipped);
+        io("references", r.references); io("rows", r.rows);
+    } else if constexpr (std::is_same_v<T, LbData>) {
+        io("run", r.run); io("note", r.note); io("default_config", r.defaultConfig); io("cases", r.cases);
+    } else if constexpr (std::is_same_v<T, VoxelRow>) {
+        io("case", r.caseName); io("grid", r.grid); io("subcells", r.subcells); io("voxel_seconds", r.voxelSeconds);
+        io("mean_vs_3", r.meanVs3); io("density_err", r.densityErr); io("lb_err", r.lbErr);
+    } else if constexpr (std::is_same_v<T, VoxelData>) {
+        io("run", r.run); io("reference_subcells", r.referenceSubcells); io("rows", r.rows);
+    } else if constexpr (std::is_same_v<T, SppRow>) {
+        io("spp", r.spp); io("trace_seconds", r.traceSeconds); io("trace_cpu", r.traceCpu); io("err", r.err);
+    } else if constexpr (std::is_same_v<T, LodRow>) {
+        io("label", r.label); io("alpha_distance", r.alphaDistance); io("prune_distance", r.pruneDistance);
+        io("build_seconds", r.buildSeconds); io("trace_seconds", r.traceSeconds); io("trace_cpu", r.traceCpu); io("err", r.err);
+        io("err_off", r.errOff); io("instanced_triangles", r.instancedTriangles); io("prune_megabytes", r.pruneMegabytes);
+        io("default", r.isDefault);
+    } else if constexpr (std::is_same_v<T, PresetRow>) {
+        io("name", r.name); io("build_seconds", r.buildSeconds); io("trace_seconds", r.traceSeconds); io("trace_cpu", r.traceCpu);
+        io("err", r.err);
+    } else if constexpr (std::is_same_v<T, RenderData>) {
+        io("run", r.run); io("spp_scene", r.sppScene); io("spp_width", r.sppWidth); io("spp_height", r.sppHeight);
+        io("spp_reference", r.sppReference); io("spp", r.spp); io("lod_scene", r.lodScene); io("lod_width", r.lodWidth);
+        io("lod_height", r.lodHeight); io("lod_spps", r.lodSpps); io("lod_reference_spp", r.lodReferenceSpp);
+        io("lod_reference_seconds", r.lodReferenceSeconds); io("lod", r.lod); io("preset_reference_spp", r.presetReferenceSpp);
+        io("preset_reference_seconds", r.presetReferenceSeconds); io("presets", r.presets);
+    } else if constexpr (std::is_same_v<T, ForestGridRow>) {
+        io("resolution", r.resolution); io("automatic", r.automatic); io("dims", r.dims); io("cells_per_crown", r.cellsPerCrown);
+        io("seconds", r.seconds); io("image_err", r.imageErr); io("factor_rms", r.factorRms); io("factor_max", r.factorMax);
+        io("interior", r.interior); io("edge", r.edge); io("default", r.isDefault);
+    } else if constexpr (std::is_same_v<T, BasisRow>) {
+        io("fp16", r.fp16); io("directions", r.directions); io("basis_seconds", r.basisSeconds); io("basis_cpu", r.basisCpu);
+        io("direct_seconds", r.directSeconds); io("direct_cpu", r.directCpu); io("relight_ms", r.relightMs);
+        io("megabytes", r.megabytes); io("err_median", r.errMedian); io("err_max", r.errMax); io("default", r.isDefault);
+    } else if constexpr (std::is_same_v<T, SceneData>) {
+        io("run", r.run); io("stand_scene", r.standScene); io("width", r.width); io("height", r.height); io("spp", r.spp);
+        io("species_grid", r.speciesGrid); io("crown_width", r.crownWidth); io("species_dims", r.speciesDims);
+        io("reference_dims", r.referenceDims); io("reference_seconds", r.referenceSeconds); io("floor_err", r.floorErr);
+        io("isolated_factor", r.isolatedFactor); io("oracle_err", r.oracleErr); io("reference_interior", r.referenceInterior);
+        io("reference_edge", r.referenceEdge); io("forest", r.forest); io("suns", r.suns); io("basis", r.basis);
+    } else {
+        static_assert(sizeof(T) == 0, "a study record without a field list");
+    }
+}
+
+// Turns a record into a QJsonObject: strings, numbers (float as double), booleans, arrays, nested records.
+struct Writer {
     QJsonObject o;
-    o["date"] = qs(r.date);
-    o["machine"] = qs(r.machine);
-    o["quick"] = r.quick;
-    o["seconds"] = r.seconds;
-    o["load_before"] = r.loadBefore;
-    o["load_after"] = r.loadAfter;
-    return o;
-}
+    static QJsonValue value(const std::string& v) { return QString::fromStdString(v); }
+    static QJsonValue value(bool v) { return v; }
+    static QJsonValue value(int v) { return v; }
+    static QJsonValue value(double v) { return v; }
+    static QJsonValue value(float v) { return double(v); }
+    template <class T>
+    static QJsonValue value(const std::vector<T>& v)
+    {
+        QJsonArray a;
+        for (const T& x : v) a.append(value(x));
+        return a;
+    }
+    template <class R>
+    static QJsonValue value(const R& record)
+    {
+        Writer w;
+        fields(w, record);
+        return w.o;
+    }
+    template <class T>
+    void operator()(const char* key, const T& v) { o.insert(QLatin1String(key), value(v)); }
+};
 
-RunInfo runFromJson(const QJsonObject& o)
-{
-    RunInfo r;
-    r.date = str(o, "date");
-    r.machine = str(o, "machine");
-    r.quick = flag(o, "quick");
-    r.seconds = num(o, "seconds");
-    r.loadBefore = num(o, "load_before");
-    r.loadAfter = num(o, "load_after");
-    return r;
-}
+// Reads a record's members from a QJsonObject; an absent key reads as 0, false, "" or empty.
+struct Reader {
+    QJsonObject o;
+    static void get(const QJsonValue& v, std::string& out) { out = v.toString().toStdString(); }
+    static void get(const QJsonValue& v, bool& out) { out = v.toBool(); }
+    static void get(const QJsonValue& v, int& out) { out = v.toInt(); }
+    static void get(const QJsonValue& v, double& out) { out = v.toDouble(); }
+    static void get(const QJsonValue& v, float& out) { out = float(v.toDouble()); }
+    template <class T>
+    static void get(const QJsonValue& v, std::vector<T>& out)
+    {
+        out.clear();
+        for (const QJsonValue& x : v.toArray()) get(x, out.emplace_back());
+    }
+    template <class R>
+    static void get(const QJsonValue& v, R& record)
+    {
+        Reader r{v.toObject()};
+        fields(r, record);
+    }
+    template <class T>
+    void operator()(const char* key, T& v) { get(o.value(QLatin1String(key)), v); }
+};
 
-void save(const std::string& path, const QJsonObject& root)
+template <class R>
+void save(const std::string& path, const R& record)
 {
-    const QByteArray text = QJsonDocument(root).toJson(QJsonDocument::Indented);
+    const QByteArray text = QJsonDocument(Writer::value(record).toObject()).toJson(QJsonDocument::Indented);
     AtomicFile f(path);
     f.write(text.constData(), size_t(text.size()));
     f.commit();
 }
 
-bool load(const std::string& path, QJsonObject* root)
+template <class R>
+bool load(const std::string& path, R* record)
 {
-    QFile f(qs(path));
+    QFile f(QString::fromStdString(path));
     if (!f.exists()) return false;
     if (!f.open(QIODevice::ReadOnly)) throw Error(path + ": cannot read: " + f.errorString().toStdString());
     QJsonParseError err;
     const QJsonDocument doc = QJsonDocument::fromJson(f.readAll(), &err);
     if (doc.isNull() || !doc.isObject()) throw Error(path + ": not a study result file: " + err.errorString().toStdString());
-    *root = doc.object();
+    Reader::get(doc.object(), *record);
     return true;
-}
-
-template <typename T, typename F>
-QJsonArray array(const std::vector<T>& v, F f)
-{
-    QJsonArray a;
-    for (const T& x : v) a.append(f(x));
-    return a;
-}
-
-template <typename T, typename F>
-std::vector<T> list(const QJsonValue& v, F f)
-{
-    std::vector<T> out;
-    for (const QJsonValue& x : v.toArray()) out.push_back(f(x.toObject()));
-    return out;
 }
 
 } // namespace
 
-void saveLb(const std::string& path, const LbData& d)
-{
-    QJsonObject root;
-    root["run"] = runToJson(d.run);
-    root["note"] = qs(d.note);
-    root["default_config"] = qs(d.defaultConfig);
-    root["cases"] = array(d.cases, [](const LbCase& c) {
-        QJsonObject o;
-        o["name"] = qs(c.name);
-        o["title"] = qs(c.title);
-        o["preset"] = qs(c.preset);
-        o["fine_grid"] = c.fineGrid;
-        o["skipped"] = qs(c.skipped);
-        o["references"] = array(c.references, [](const LbReference& r) {
-            QJsonObject x;
-            x["grid"] = r.grid;
-            x["dims"] = qs(r.dims);
-            x["paths"] = r.paths;
-            x["noise"] = r.noise;
-            x["seconds"] = r.seconds;
-            x["cached"] = r.cached;
-            return x;
-        });
-        o["rows"] = array(c.rows, [](const LbRow& r) {
-            QJsonObject x;
-            x["grid"] = r.grid;
-            x["dims"] = qs(r.dims);
-            x["steps"] = qs(r.steps);
-            x["fp16"] = r.fp16;
-            x["seconds"] = r.seconds;
-            x["cpu_seconds"] = r.cpuSeconds;
-            x["steps_taken"] = r.stepsTaken;
-            x["err_same"] = r.errSame;
-            x["err_fine"] = r.errFine;
-            x["default"] = r.isDefault;
-            return x;
-        });
-        return o;
-    });
-    save(path, root);
-}
-
-bool loadLb(const std::string& path, LbData* d)
-{
-    QJsonObject root;
-    if (!load(path, &root)) return false;
-    d->run = runFromJson(root.value("run").toObject());
-    d->note = str(root, "note");
-    d->defaultConfig = str(root, "default_config");
-    d->cases = list<LbCase>(root.value("cases"), [](const QJsonObject& o) {
-        LbCase c;
-        c.name = str(o, "name");
-        c.title = str(o, "title");
-        c.preset = str(o, "preset");
-        c.fineGrid = integer(o, "fine_grid");
-        c.skipped = str(o, "skipped");
-        c.references = list<LbReference>(o.value("references"), [](const QJsonObject& x) {
-            LbReference r;
-            r.grid = integer(x, "grid");
-            r.dims = str(x, "dims");
-            r.paths = num(x, "paths");
-            r.noise = num(x, "noise");
-            r.seconds = num(x, "seconds");
-            r.cached = flag(x, "cached");
-            return r;
-        });
-        c.rows = list<LbRow>(o.value("rows"), [](const QJsonObject& x) {
-            LbRow r;
-            r.grid = integer(x, "grid");
-            r.dims = str(x, "dims");
-            r.steps = str(x, "steps");
-            r.fp16 = flag(x, "fp16");
-            r.seconds = num(x, "seconds");
-            r.cpuSeconds = num(x, "cpu_seconds");
-            r.stepsTaken = integer(x, "steps_taken");
-            r.errSame = num(x, "err_same");
-            r.errFine = num(x, "err_fine");
-            r.isDefault = flag(x, "default");
-            return r;
-        });
-        return c;
-    });
-    return true;
-}
-
-void saveVoxel(const std::string& path, const VoxelData& d)
-{
-    QJsonObject root;
-    root["run"] = runToJson(d.run);
-    root["reference_subcells"] = d.referenceSubcells;
-    root["rows"] = array(d.rows, [](const VoxelRow& r) {
-        QJsonObject x;
-        x["case"] = qs(r.caseName);
-        x["grid"] = r.grid;
-        x["subcells"] = r.subcells;
-        x["voxel_seconds"] = r.voxelSeconds;
-        x["mean_vs_3"] = r.meanVs3;
-        x["density_err"] = r.densityErr;
-        x["lb_err"] = r.lbErr;
-        return x;
-    });
-    save(path, root);
-}
-
-bool loadVoxel(const std::string& path, VoxelData* d)
-{
-    QJsonObject root;
-    if (!load(path, &root)) return false;
-    d->run = runFromJson(root.value("run").toObject());
-    d->referenceSubcells = integer(root, "reference_subcells");
-    d->rows = list<VoxelRow>(root.value("rows"), [](const QJsonObject& x) {
-        VoxelRow r;
-        r.caseName = str(x, "case");
-        r.grid = integer(x, "grid");
-        r.subcells = integer(x, "subcells");
-        r.voxelSeconds = num(x, "voxel_seconds");
-        r.meanVs3 = num(x, "mean_vs_3");
-        r.densityErr = num(x, "density_err");
-        r.lbErr = num(x, "lb_err");
-        return r;
-    });
-    return true;
-}
-
-void saveRender(const std::string& path, const RenderData& d)
-{
-    QJsonObject root;
-    root["run"] = runToJson(d.run);
-    root["spp_scene"] = qs(d.sppScene);
-    root["spp_width"] = d.sppWidth;
-    root["spp_height"] = d.sppHeight;
-    root["spp_reference"] = d.sppReference;
-    root["spp"] = array(d.spp, [](const SppRow& r) {
-        QJsonObject x;
-        x["spp"] = r.spp;
-        x["trace_seconds"] = r.traceSeconds;
-        x["trace_cpu"] = r.traceCpu;
-        x["err"] = r.err;
-        return x;
-    });
-    root["lod_scene"] = qs(d.lodScene);
-    root["lod_width"] = d.lodWidth;
-    root["lod_height"] = d.lodHeight;
-    root["lod_spps"] = array(d.lodSpps, [](int v) { return QJsonValue(v); });
-    root["lod_reference_spp"] = d.lodReferenceSpp;
-    root["lod_reference_seconds"] = d.lodReferenceSeconds;
-    root["lod"] = array(d.lod, [](const LodRow& r) {
-        QJsonObject x;
-        x["label"] = qs(r.label);
-        x["alpha_distance"] = double(r.alphaDistance);
-        x["prune_distance"] = double(r.pruneDistance);
-        x["build_seconds"] = r.buildSeconds;
-        x["trace_seconds"] = array(r.traceSeconds, [](double v) { return QJsonValue(v); });
-        x["trace_cpu"] = array(r.traceCpu, [](double v) { return QJsonValue(v); });
-        x["err"] = array(r.err, [](double v) { return QJsonValue(v); });
-        x["err_off"] = array(r.errOff, [](double v) { return QJsonValue(v); });
-        x["instanced_triangles"] = r.instancedTriangles;
-        x["prune_megabytes"] = r.pruneMegabytes;
-        x["default"] = r.isDefault;
-        return x;
-    });
-    root["preset_reference_spp"] = d.presetReferenceSpp;
-    root["preset_reference_seconds"] = d.presetReferenceSeconds;
-    root["presets"] = array(d.presets, [](const PresetRow& r) {
-        QJsonObject x;
-        x["name"] = qs(r.name);
-        x["build_seconds"] = r.buildSeconds;
-        x["trace_seconds"] = r.traceSeconds;
-        x["trace_cpu"] = r.traceCpu;
-        x["err"] = r.err;
-        return x;
-    });
-    save(path, root);
-}
-
-bool loadRender(const std::string& path, RenderData* d)
-{
-    QJsonObject root;
-    if (!load(path, &root)) return false;
-    d->run = runFromJson(root.value("run").toObject());
-    d->sppScene = str(root, "spp_scene");
-    d->sppWidth = integer(root, "spp_width");
-    d->sppHeight = integer(root, "spp_height");
-    d->sppReference = integer(root, "spp_reference");
-    d->spp = list<SppRow>(root.value("spp"), [](const QJsonObject& x) {
-        SppRow r;
-        r.spp = integer(x, "spp");
-        r.traceSeconds = num(x, "trace_seconds");
-        r.traceCpu = num(x, "trace_cpu");
-        r.err = num(x, "err");
-        return r;
-    });
-    d->lodScene = str(root, "lod_scene");
-    d->lodWidth = integer(root, "lod_width");
-    d->lodHeight = integer(root, "lod_height");
-    d->lodSpps.clear();
-    for (const QJsonValue& v : root.value("lod_spps").toArray()) d->lodSpps.push_back(v.toInt());
-    d->lodReferenceSpp = integer(root, "lod_reference_spp");
-    d->lodReferenceSeconds = num(root, "lod_reference_seconds");
-    d->lod = list<LodRow>(root.value("lod"), [](const QJsonObject& x) {
-        LodRow r;
-        r.label = str(x, "label");
-        r.alphaDistance = float(num(x, "alpha_distance"));
-        r.pruneDistance = float(num(x, "prune_distance"));
-        r.buildSeconds = num(x, "build_seconds");
-        for (const QJsonValue& v : x.value("trace_seconds").toArray()) r.traceSeconds.push_back(v.toDouble());
-        for (const QJsonValue& v : x.value("trace_cpu").toArray()) r.traceCpu.push_back(v.toDouble());
-        for (const QJsonValue& v : x.value("err").toArray()) r.err.push_back(v.toDouble());
-        for (const QJsonValue& v : x.value("err_off").toArray()) r.errOff.push_back(v.toDouble());
-        r.instancedTriangles = num(x, "instanced_triangles");
-        r.pruneMegabytes = num(x, "prune_megabytes");
-        r.isDefault = flag(x, "default");
-        return r;
-    });
-    d->presetReferenceSpp = integer(root, "preset_reference_spp");
-    d->presetReferenceSeconds = num(root, "preset_reference_seconds");
-    d->presets = list<PresetRow>(root.value("presets"), [](const QJsonObject& x) {
-        PresetRow r;
-        r.name = str(x, "name");
-        r.buildSeconds = num(x, "build_seconds");
-        r.traceSeconds = num(x, "trace_seconds");
-        r.traceCpu = num(x, "trace_cpu");
-        r.err = num(x, "err");
-        return r;
-    });
-    return true;
-}
-
-void saveScene(const std::string& path, const SceneData& d)
-{
-    QJsonObject root;
-    root["run"] = runToJson(d.run);
-    root["stand_scene"] = qs(d.standScene);
-    root["width"] = d.width;
-    root["height"] = d.height;
-    root["spp"] = d.spp;
-    root["species_grid"] = d.speciesGrid;
-    root["crown_width"] = d.crownWidth;
-    root["species_dims"] = qs(d.speciesDims);
-    root["reference_dims"] = qs(d.referenceDims);
-    root["reference_seconds"] = d.referenceSeconds;
-    root["floor_err"] = d.floorErr;
-    root["isolated_factor"] = d.isolatedFactor;
-    root["oracle_err"] = d.oracleErr;
-    root["reference_interior"] = d.referenceInterior;
-    root["reference_edge"] = d.referenceEdge;
-    root["forest"] = array(d.forest, [](const ForestGridRow& r) {
-        QJsonObject x;
-        x["resolution"] = r.resolution;
-        x["automatic"] = r.automatic;
-        x["dims"] = qs(r.dims);
-        x["cells_per_crown"] = r.cellsPerCrown;
-        x["seconds"] = r.seconds;
-        x["image_err"] = r.imageErr;
-        x["factor_rms"] = r.factorRms;
-        x["factor_max"] = r.factorMax;
-        x["interior"] = r.interior;
-        x["edge"] = r.edge;
-        x["default"] = r.isDefault;
-        return x;
-    });
-    root["suns"] = d.suns;
-    root["basis"] = array(d.basis, [](const BasisRow& r) {
-        QJsonObject x;
-        x["fp16"] = r.fp16;
-        x["directions"] = r.directions;
-        x["basis_seconds"] = r.basisSeconds;
-        x["basis_cpu"] = r.basisCpu;
-        x["direct_seconds"] = r.directSeconds;
-        x["direct_cpu"] = r.directCpu;
-        x["relight_ms"] = r.relightMs;
-        x["megabytes"] = r.megabytes;
-        x["err_median"] = r.errMedian;
-        x["err_max"] = r.errMax;
-        x["default"] = r.isDefault;
-        return x;
-    });
-    save(path, root);
-}
-
-bool loadScene(const std::string& path, SceneData* d)
-{
-    QJsonObject root;
-    if (!load(path, &root)) return false;
-    d->run = runFromJson(root.value("run").toObject());
-    d->standScene = str(root, "stand_scene");
-    d->width = integer(root, "width");
-    d->height = integer(root, "height");
-    d->spp = integer(root, "spp");
-    d->speciesGrid = integer(root, "species_grid");
-    d->crownWidth = num(root, "crown_width");
-    d->speciesDims = str(root, "species_dims");
-    d->referenceDims = str(root, "reference_dims");
-    d->referenceSeconds = num(root, "reference_seconds");
-    d->floorErr = num(root, "floor_err");
-    d->isolatedFactor = num(root, "isolated_factor");
-    d->oracleErr = num(root, "oracle_err");
-    d->referenceInterior = num(root, "reference_interior");
-    d->referenceEdge = num(root, "reference_edge");
-    d->forest = list<ForestGridRow>(root.value("forest"), [](const QJsonObject& x) {
-        ForestGridRow r;
-        r.resolution = integer(x, "resolution");
-        r.automatic = flag(x, "automatic");
-        r.dims = str(x, "dims");
-        r.cellsPerCrown = num(x, "cells_per_crown");
-        r.seconds = num(x, "seconds");
-        r.imageErr = num(x, "image_err");
-        r.factorRms = num(x, "factor_rms");
-        r.factorMax = num(x, "factor_max");
-        r.interior = num(x, "interior");
-        r.edge = num(x, "edge");
-        r.isDefault = flag(x, "default");
-        return r;
-    });
-    d->suns = integer(root, "suns");
-    d->basis = list<BasisRow>(root.value("basis"), [](const QJsonObject& x) {
-        BasisRow r;
-        r.fp16 = flag(x, "fp16");
-        r.directions = integer(x, "directions");
-        r.basisSeconds = num(x, "basis_seconds");
-        r.basisCpu = num(x, "basis_cpu");
-        r.directSeconds = num(x, "direct_seconds");
-        r.directCpu = num(x, "direct_cpu");
-        r.relightMs = num(x, "relight_ms");
-        r.megabytes = num(x, "megabytes");
-        r.errMedian = num(x, "err_median");
-        r.errMax = num(x, "err_max");
-        r.isDefault = flag(x, "default");
-        return r;
-    });
-    return true;
-}
+void saveLb(const std::string& path, const LbData& d) { save(path, d); }
+bool loadLb(const std::string& path, LbData* d) { return load(path, d); }
+void saveVoxel(const std::string& path, const VoxelData& d) { save(path, d); }
+bool loadVoxel(const std::string& path, VoxelData* d) { return load(path, d); }
+void saveRender(const std::string& path, const RenderData& d) { save(path, d); }
+bool loadRender(const std::string& path, RenderData* d) { return load(path, d); }
+void saveScene(const std::string& path, const SceneData& d) { save(path, d); }
+bool loadScene(const std::string& path, SceneData* d) { return load(path, d); }
 
 std::vector<size_t> paretoFront(const std::vector<double>& time, const std::vector<double>& error)
 {
