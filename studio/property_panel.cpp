@@ -23,6 +23,7 @@
 #include "studio/scene_item_pages.h"
 
 #include "studio/form_widgets.h"
+#include "studio/param_widgets.h"
 
 namespace sylva {
 using namespace widgets;
@@ -147,11 +148,8 @@ QWidget* PropertyPanel::buildSpeciesPage()
             sp.lighting.storage = old.storage;
         });
     });
-    m_speciesGrid = new QSpinBox;
-    m_speciesGrid->setObjectName("species.grid");
-    m_speciesGrid->setRange(8, 512);
+    m_speciesGrid = paramIntSpin(kSpeciesGrid, "species.grid", int(kSpeciesGrid.def[0]));   // the scene file's range
     m_speciesGrid->setKeyboardTracking(false);
-    m_speciesGrid->setToolTip(tr("LB grid nodes along the longest edge"));
     connect(m_speciesGrid, &QSpinBox::valueChanged, this, [this](int v) {
         const int i = m_item.row;
         apply(m_speciesGrid, tr("Change lighting grid"), [&](Scene& s) { s.species.at(size_t(i)).grid = v; });

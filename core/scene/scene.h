@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/base/param_spec.h"
 #include "core/lb/lb_params.h"
 #include "core/scene/volume.h"
 #include "core/sky/sky.h"
@@ -34,6 +35,11 @@ struct GrowSpec {
 inline constexpr int kDefaultStepsPerEdge = 1;
 lb::LbParams defaultSpeciesLighting(const lb::Preset& preset);
 
+// The species' LB grid size, declared once: the scene file's field (`lighting.grid`, scene_fields.cpp) and
+// the studio's property panel read it.
+inline constexpr ParamSpec kSpeciesGrid{.key = "grid", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 8, .hi = 512,
+                                        .def = {64}, .help = "LB grid nodes along the longest edge"};
+
 // One plant model shared by all its instances. Its lighting grid is solved once, in its own frame.
 struct SpeciesDesc {
     std::string name;                    // unique within the scene; instances refer to it
@@ -43,7 +49,7 @@ struct SpeciesDesc {
     std::string preset = "leaf";         // LB preset the lighting starts from
     lb::LbParams lighting;               // preset + overrides (sun is set from the scene's sun at solve time);
                                          // scene files start from defaultSpeciesLighting
-    int grid = 64;                       // LB grid nodes along the longest edge
+    int grid = int(kSpeciesGrid.def[0]); // LB grid nodes along the longest edge
     bool solid = false;                  // voxelized as a solid (interior filled, core/voxel/solid_voxelize.h): plastics
     bool lit = true;                     // false: no LB grid, conventional lighting (ambient = the diffuse colour x
                                          // the sun's radiance: the LB's open-space value; Geist & Westall,

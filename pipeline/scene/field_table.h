@@ -3,6 +3,7 @@
 // scenes; scene_fields.cpp declares the scene file's tables with it.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -13,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/base/param_spec.h"
 #include "pipeline/scene/json_codec.h"
 
 namespace sylva::json {
@@ -63,7 +65,7 @@ struct Field {
 
     const char* key = "";
     const char* type = "";              // doc: the JSON type
-    const char* rule = "";              // doc: the values it takes
+    std::string rule;                   // doc: the values it takes
     const char* shownDefault = nullptr; // doc default where the default record cannot show it ("required", "-")
     const char* missing = nullptr;      // set: required, and this is the problem when it is absent
     bool readWhenAbsent = false;        // read also when absent (with an undefined value): optional objects
@@ -78,10 +80,10 @@ struct Field {
     // A check across fields, run once this field is read (or found absent): object path, its JSON.
     std::function<void(JsonReader&, const QJsonObject&, const KeyPath&, T&)> then;
 
-    Field& doc(const char* t, const char* r)
+    Field& doc(const char* t, std::string r)
     {
         type = t;
-        rule = r;
+        rule = std::move(r);
         return *this;
     }
     Field& required(const char* problem)
@@ -255,6 +257,20 @@ public:
                 if constexpr (std::is_same_v<V, uint64_t>) w.integer(uint64_t(ref(get, t)));
                 else w.integer((long long)ref(get, t));
             });
+    }
+
+    // A parameter declared by a ParamSpec (core/base/param_spec.h): key, bounds and doc line from it.
+    template <class Get>
+    Field<T>& param(const ParamSpec& s, Get get)
+    {
+        const std::string rule = s.bounded() ? std::string(s.help) + ", " + paramRange(s) : std::string(s.help);
+        using V = std::remove_cvref_t<decltype(ref(get, std::declval<T&>()))>;
+        if constexpr (std::is_integral_v<V>) {
+            constexpr double most = double(std::numeric_limits<long long>::max());
+            return integer(s.key, get, (long long)std::max(s.lo, -most), (long long)std::min(s.hi, most)).doc("integer", rule);
+        } else {
+            return number(s.key, get, Bounds{.lo = s.lo, .hi = s.hi, .loOpen = s.loOpen, .hiOpen = s.hiOpen}).doc("number", rule);
+        }
     }
 
     // A float or double, checked against bounds.

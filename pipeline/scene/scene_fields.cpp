@@ -41,21 +41,6 @@ SceneWriteContext& out(JsonWriter& w) { return static_cast<SceneWriteContext&>(w
 constexpr long long kMaxSeed = 1LL << 62;
 const float kNoUpperBound = std::numeric_limits<float>::max();
 
-// A per-channel LB parameter: one number for all channels or [r, g, b].
-json::Field<SpeciesDesc>& channels(TableBuilder<SpeciesDesc>& b, const char* key, float lb::ChannelParams::*member)
-{
-    return b.custom(
-        key,
-        [member](JsonReader& r, const QJsonValue& v, const KeyPath& p, SpeciesDesc& d) {
-            const glm::vec3 rgb = r.perChannel(v, p);
-            for (int c = 0; c < 3; ++c) d.lighting.channels[size_t(c)].*member = rgb[c];
-        },
-        [member](JsonWriter& w, const SpeciesDesc& d, const KeyPath& p, int) {
-            const auto& ch = d.lighting.channels;
-            w.vector3(glm::vec3(ch[0].*member, ch[1].*member, ch[2].*member), p);
-        });
-}
-
 const Table<GrowSpec>& growTable()
 {
     static const Table<GrowSpec> table = [] {
@@ -85,16 +70,16 @@ const Table<SpeciesDesc>& lightingTable()
              [](JsonWriter& w, const SpeciesDesc& d, const KeyPath&, int) { w.string(d.preset); })
             .doc("string", "`leaf`, `dogrose`, `cloud`, `pmma` (LB_MODEL.md presets)")
             .readWhenAbsent = true;   // first: the overrides below apply to the preset's parameters
-        channels(b, "sigma_a", &lb::ChannelParams::sigmaA)
+        channelsField(b, "sigma_a", &lb::ChannelParams::sigmaA)
             .doc("number or `[r, g, b]`", "absorption per lattice step; one number sets all channels").shown("preset's");
-        channels(b, "sigma_s", &lb::ChannelParams::sigmaS)
+        channelsField(b, "sigma_s", &lb::ChannelParams::sigmaS)
             .doc("number or `[r, g, b]`", "scattering per lattice step").shown("preset's");
-        channels(b, "g", &lb::ChannelParams::g)
+        channelsField(b, "g", &lb::ChannelParams::g)
             .doc("number or `[r, g, b]`", "Henyey-Greenstein asymmetry").shown("preset's");
         b.boolean("zero_f0", [](auto& d) -> auto& { return d.lighting.zeroF0; })
             .doc("bool", "`true` for plants (zero f_0 each step), `false` keeps absorbed light (clouds, plastics)")
             .shown("preset's");
-        b.integer("grid", &SpeciesDesc::grid, 8, 512).doc("integer", "LB grid nodes along the longest edge, 8 .. 512");
+        b.param(kSpeciesGrid, &SpeciesDesc::grid);
         b.boolean("solid", [](auto& d) -> auto& { return d.solid; })
             .doc("bool",
                  "`true`: the mesh is voxelized as a solid (interior filled by winding numbers, open edges do not leak; "

@@ -36,6 +36,22 @@ void readLightingPreset(SceneReadContext& r, const QJsonValue& v, const json::Ke
 void checkLighting(SceneReadContext& r, const json::KeyPath& path, const SpeciesDesc& d);
 // The species record documented defaults are written from (the default preset's lighting).
 SpeciesDesc defaultSpecies();
+// A per-channel LB parameter of a record with `lighting` (a species, a volume): one number for all
+// channels or [r, g, b], read into and written from lighting.channels[c].*member.
+template <class T>
+json::Field<T>& channelsField(json::TableBuilder<T>& b, const char* key, float lb::ChannelParams::*member)
+{
+    return b.custom(
+        key,
+        [member](json::JsonReader& r, const QJsonValue& v, const json::KeyPath& p, T& d) {
+            const glm::vec3 rgb = r.perChannel(v, p);
+            for (int c = 0; c < 3; ++c) d.lighting.channels[size_t(c)].*member = rgb[c];
+        },
+        [member](json::JsonWriter& w, const T& d, const json::KeyPath& p, int) {
+            const auto& ch = d.lighting.channels;
+            w.vector3(glm::vec3(ch[0].*member, ch[1].*member, ch[2].*member), p);
+        });
+}
 
 // ---- instances ----
 void readInstanceSpecies(SceneReadContext& r, const QJsonValue& v, const json::KeyPath& path, InstanceDesc& inst);

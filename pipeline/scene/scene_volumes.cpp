@@ -35,20 +35,6 @@ namespace {
 SceneReadContext& in(JsonReader& r) { return static_cast<SceneReadContext&>(r); }
 SceneWriteContext& out(JsonWriter& w) { return static_cast<SceneWriteContext&>(w); }
 
-json::Field<VolumeDesc>& channels(TableBuilder<VolumeDesc>& b, const char* key, float lb::ChannelParams::*member)
-{
-    return b.custom(
-        key,
-        [member](JsonReader& r, const QJsonValue& v, const KeyPath& p, VolumeDesc& d) {
-            const glm::vec3 rgb = r.perChannel(v, p);
-            for (int c = 0; c < 3; ++c) d.lighting.channels[size_t(c)].*member = rgb[c];
-        },
-        [member](JsonWriter& w, const VolumeDesc& d, const KeyPath& p, int) {
-            const auto& ch = d.lighting.channels;
-            w.vector3(glm::vec3(ch[0].*member, ch[1].*member, ch[2].*member), p);
-        });
-}
-
 const Table<VolumePlacement>& placementTable()
 {
     static const Table<VolumePlacement> table = [] {
@@ -111,11 +97,11 @@ const Table<VolumeDesc>& volumeTable()
              [](JsonWriter& w, const VolumeDesc& d, const KeyPath&, int) { w.string(d.preset); })
             .doc("string", "optics: `cloud` (Geist & Westall: sigma_a 0.008, sigma_s 0.792, g 0.9), `smoke` (0.25, 0.25, 0.3), `pmma`")
             .readWhenAbsent = true;
-        channels(b, "sigma_a", &lb::ChannelParams::sigmaA)
+        channelsField(b, "sigma_a", &lb::ChannelParams::sigmaA)
             .doc("number or `[r, g, b]`", "absorption per node spacing at density 1; one number sets all channels")
             .shown("preset's");
-        channels(b, "sigma_s", &lb::ChannelParams::sigmaS).doc("number or `[r, g, b]`", "scattering per node spacing at density 1").shown("preset's");
-        channels(b, "g", &lb::ChannelParams::g).doc("number or `[r, g, b]`", "Henyey-Greenstein asymmetry, -1 .. 1").shown("preset's");
+        channelsField(b, "sigma_s", &lb::ChannelParams::sigmaS).doc("number or `[r, g, b]`", "scattering per node spacing at density 1").shown("preset's");
+        channelsField(b, "g", &lb::ChannelParams::g).doc("number or `[r, g, b]`", "Henyey-Greenstein asymmetry, -1 .. 1").shown("preset's");
         b.number("density_scale", &VolumeDesc::densityScale, above(0.0))
             .doc("number", "> 0: multiplies the grid's densities (the product must stay in [0, 1])");
         b.enumeration(
