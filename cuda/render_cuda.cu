@@ -187,7 +187,7 @@ void renderToRgba8(const DeviceScene& scene, RenderMode mode, float key, uint32_
     DeviceScene::Scratch& s = scene.scratch();
     SampleParts* film = s.filmFor(n);
     traceOnDevice(v, film);
-    toneMapFilm(CudaExec{}, film, v.width, v.height, mode, right.value_or(mode), v.sky, key, s.acc.get(), deviceRgba8);
+    toneMapFilm(CudaExec{}, film, v.width, v.height, mode, right.value_or(mode), v.sky.constant, key, s.acc.get(), deviceRgba8);
     check(cudaDeviceSynchronize(), "tone map");
 }
 

@@ -240,7 +240,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
         const int pw = std::max(1, w / passes[p].divisor), ph = std::max(1, h / passes[p].divisor);
         placeViewFrame(*m_frame, scene, sun, pw, ph, passes[p].spp);
         RenderView view = m_frame->rs.view();
-        if (refine.frames > 0) view.skyLightCount = 0;   // moving: the sun alone
+        if (refine.frames > 0) view.sky.lightCount = 0;   // moving: the sun alone
         // The first pass of a relit frame runs to its end even when the next sun is already asked for:
         // a sun drag shows every relit sun it can (one preview each) instead of restarting before any.
         const bool shield = relit && p == 0;
@@ -281,8 +281,8 @@ void RenderWorker::process(const Request& req, Progress& progress)
 Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp)
 {
     Refinement r;
-    if (view.skyLightCount == 0 && sceneSpp <= lastPassSpp) return r;   // the constant sky: the schedule as before
-    const int subsets = std::max(1, view.skyInterleave.subsets);
+    if (view.sky.lightCount == 0 && sceneSpp <= lastPassSpp) return r;   // the constant sky: the schedule as before
+    const int subsets = std::max(1, view.sky.interleave.subsets);
     r.samples = std::max(sceneSpp, subsets);
     r.perFrame = subsets;
     r.frames = (r.samples + r.perFrame - 1) / r.perFrame;

@@ -21,18 +21,20 @@ struct Ray {
     float tmax;
 };
 
-// Closest hit so far: t along the ray, barycentrics (u,v) of the triangle, the triangle's index in
-// its mesh and the instance path down to it: `inst` indexes the top level's instances; a hit inside
-// instance groups also records the `depth` group instances below it (nested[0] .. nested[depth-1],
-// outermost first, indices into RenderView::groupInstances). prim == kNoHit when nothing was hit.
-// 36 bytes.
+// Closest hit so far: t along the ray, the surface kind that was hit (a SurfaceKind of core/render/
+// surfaces/surface_list.h, 0 = nothing) and what that kind records of it: for a mesh reached through the
+// instances, barycentrics (u,v) of the triangle, the triangle's index and the instance path down to it
+// (`inst` indexes the top level's instances; a hit inside instance groups also records the `depth` group
+// instances below it, nested[0] .. nested[depth-1], outermost first, indices into RenderView::groupInstances);
+// other kinds say in their header what they keep in prim, inst and nested. 36 bytes.
 inline constexpr int kMaxNested = 3;   // = kMaxLevels - 1 (core/render/render_view.h)
 struct Hit {
     float t;
     float u, v;
     uint32_t prim;
     uint32_t inst;
-    uint32_t depth;
+    uint16_t depth;
+    uint16_t kind;
     uint32_t nested[kMaxNested];
 };
 

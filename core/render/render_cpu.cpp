@@ -20,13 +20,13 @@ constexpr int kTile = 8;
 static_assert(kTile * kTile <= kPacketRays);
 
 // The pixels [x0, x1) x [y0, y1) of the frame (at most kPacketRays) into out (row length `stride`): exactly
-// shadePixel's parts for each. A landscape's tile traces each sample's camera rays as one packet, then the
-// sun's shadow rays of the surfaces they found as another (trace_packet.h: the same answers as ray by ray);
-// other scenes, where packets do not pay, shade pixel by pixel.
+// shadePixel's parts for each. A landscape's tile traces each sample's camera rays as one packet, then for each
+// of the first kPacketLights lights the shadow rays of the surfaces they found as another (trace_packet.h: the
+// same answers as ray by ray); other scenes, where packets do not pay, shade pixel by pixel.
 void shadeTile(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts* out, size_t stride)
 {
     const int w = x1 - x0, n = w * (y1 - y0);
-    if (!v.landscapeEnabled) {
+    if (!v.landscape.enabled) {
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) out[size_t(y - y0) * stride + size_t(x - x0)] = shadePixel(v, x, y);
         return;
@@ -37,25 +37,25 @@ void shadeTile(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts*
     SurfacePoint surface[kPacketRays];
     bool found[kPacketRays], occluded[kPacketRays];
     int shadowOf[kPacketRays];
+    int seen[kPacketRays][kPacketLights];
+    const int packetLights = int(v.lightCount) < kPacketLights ? int(v.lightCount) : kPacketLights;
     const int sBegin = v.sampleBegin, sEnd = sampleEndOf(v);
     for (int i = 0; i < n; ++i) sum[i] = pixelSumStart();
     for (int s = sBegin; s < sEnd; ++s) {
         for (int i = 0; i < n; ++i) cam[i] = sampleRay(v, x0 + i % w, y0 + i / w, s);
         traceScenePacket<false>(v, cam, n, hit, found);
-        int shadows = 0;
-        for (int i = 0; i < n; ++i) {
-            shadowOf[i] = -1;
-            if (!found[i]) continue;
-            surface[i] = surfaceStage(v, cam[i], hit[i]);
-            if (!castsSunRay(v, surface[i])) continue;
-            shadowOf[i] = shadows;
-            shadow[shadows++] = sunShadowRay(v, surface[i]);
+        for (int i = 0; i < n; ++i)
+            if (found[i]) surface[i] = surfaceStage(v, cam[i], hit[i]);
+        for (int l = 0; l < packetLights; ++l) {
+            int shadows = 0;
+            for (int i = 0; i < n; ++i) {
+                shadowOf[i] = -1;
+                if (found[i] && lightShadowRay(v, v.lights[l], surface[i], shadow[shadows])) shadowOf[i] = shadows++;
+            }
+            traceScenePacket<true>(v, shadow, shadows, shadowHit, occluded);
+            for (int i = 0; i < n; ++i) seen[i][l] = shadowOf[i] < 0 ? 1 : (occluded[shadowOf[i]] ? 0 : 1);
         }
-        traceScenePacket<true>(v, shadow, shadows, shadowHit, occluded);
-        for (int i = 0; i < n; ++i) {
-            const int seen = shadowOf[i] < 0 ? 0 : (occluded[shadowOf[i]] ? 0 : 1);
-            pixelSumAdd(sum[i], shadeFound(v, cam[i], found[i], hit[i], surface[i], x0 + i % w, y0 + i / w, s, seen));
-        }
+        for (int i = 0; i < n; ++i) pixelSumAdd(sum[i], shadeFound(v, cam[i], found[i], hit[i], surface[i], x0 + i % w, y0 + i / w, s, seen[i]));
     }
     for (int i = 0; i < n; ++i) {
         pixelSumAverage(sum[i], sEnd - sBegin);

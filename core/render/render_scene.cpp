@@ -191,6 +191,8 @@ RenderView RenderScene::view() const
 #undef SYLVA_X
     v.instanceCount = uint32_t(instances.size());
     v.volumeCount = uint32_t(volumeInstances.size());
+    v.lightCount = uint32_t(lights.size());
+    v.spheres.count = uint32_t(sphereRecords.size());
     return v;
 }
 
@@ -222,11 +224,24 @@ const Scene& onTerrain(const Scene& scene, Scene& storage)
 
 } // namespace
 
+void placeLights(RenderScene& rs, const FrameSun& sun)
+{
+    rs.lights.clear();
+    LightRecord l{};
+    l.kind = LightKind::Distant;   // first: the light the LB grids are solved toward (lbLight)
+    l.direction = sun.direction;
+    l.radiance = sun.radiance;
+    rs.lights.push_back(l);
+    l = LightRecord{};
+    l.kind = LightKind::Sky;
+    rs.lights.push_back(l);
+}
+
 void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
 {
-    rs.base.skyModel = sky::SkyView{};
-    rs.base.skyLightCount = 0;
-    rs.base.skyInterleave = sky::Interleave{};
+    rs.base.sky.model = sky::SkyView{};
+    rs.base.sky.lightCount = 0;
+    rs.base.sky.interleave = sky::Interleave{};
     rs.skyMap.clear();
     rs.skyLights.clear();
     if (!d.analytic()) return;
@@ -238,10 +253,10 @@ void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
     sky::SkyView v = built.view();
     if (built.kind == sky::SkyKind::Map && built.map) rs.skyMap = built.map->rgb;
     v.map.rgb = nullptr;   // the frame's skyMap array (host or device) is read instead
-    rs.base.skyModel = v;
+    rs.base.sky.model = v;
     rs.skyLights = sky::skyLights(built, d.lights, 512, groundPlane);
-    rs.base.skyLightCount = uint32_t(rs.skyLights.size());
-    rs.base.skyInterleave = sky::makeInterleave(d.interleave, int(rs.skyLights.size()));
+    rs.base.sky.lightCount = uint32_t(rs.skyLights.size());
+    rs.base.sky.interleave = sky::makeInterleave(d.interleave, int(rs.skyLights.size()));
 }
 
 namespace {
@@ -274,7 +289,7 @@ void buildLandscapeLight(RenderScene& rs, const Scene& scene)
     LandscapeLightStats& st = rs.m_stats.landscapeLight;
     st = LandscapeLightStats{};
     rs.landLight.clear();
-    rs.base.landLightLayout = LandLightLayout{};
+    rs.base.landscape.lightLayout = LandLightLayout{};
     const ForestGridMode mode = scene.lighting.forestGrid;
     if (mode == ForestGridMode::Off || rs.landCells.empty()) return;
     const int optics = forestOptics(rs.forestSpecies);
@@ -285,7 +300,7 @@ void buildLandscapeLight(RenderScene& rs, const Scene& scene)
     const TerrainDesc& t = scene.terrain;
     LandscapeLightSettings settings;
     settings.resolution = scene.lighting.forestGridResolution;
-    LandscapeLight l = solveLandscapeLight(*t.field, rs.base.land, rs.landCells, rs.tileRecords, rs.tilePlants, terrainSnowY(t), terrainRockCos(t),
+    LandscapeLight l = solveLandscapeLight(*t.field, rs.base.landscape.layout, rs.landCells, rs.tileRecords, rs.tilePlants, terrainSnowY(t), terrainRockCos(t),
                                            rs.forestSpecies, forestGridParams(scene, optics), settings);
     st.solved = l.cellsWithPlants > 0;
     st.resolution = l.resolution;
@@ -304,7 +319,7 @@ void buildLandscapeLight(RenderScene& rs, const Scene& scene)
     st.applied = st.solved && !st.skipped;
     if (!st.applied) return;
     rs.landLight = std::move(l.nodes);
-    rs.base.landLightLayout = l.layout;
+    rs.base.landscape.lightLayout = l.layout;
 }
 
 // The forest-level LB grid (core/lb/forest_grid.h) over the scene's top-level instances of species with a
@@ -385,7 +400,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
         const HeightField& hf = *scene.terrain.field;
         rs.terrainHeights = hf.heights;
         rs.terrainRanges = hf.ranges;
-        rs.base.terrain = hf.layout;
+        rs.base.terrain.layout = hf.layout;
         rs.m_stats.terrainSamplesX = hf.layout.nx;
         rs.m_stats.terrainSamplesZ = hf.layout.nz;
     }
@@ -771,7 +786,7 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
     rs.tileRecords.clear();
     rs.tileNodes.clear();
     rs.tilePlants.clear();
-    rs.base.land = LandscapeLayout{};
+    rs.base.landscape.layout = LandscapeLayout{};
     rs.m_stats.landscape = LandscapeStats{};
     // The landscape (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly Complex
     // Plant Populations"): Wang tiles of the species' full meshes on the terrain's cells.
@@ -789,7 +804,7 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
         rs.tileRecords = std::move(lb.tiles);
         rs.tileNodes = std::move(lb.tileNodes);
         rs.tilePlants = std::move(lb.plants);
-        rs.base.land = lb.layout;
+        rs.base.landscape.layout = lb.layout;
         rs.m_stats.landscape = lb.stats;
     }
     buildLandscapeLight(rs, scene);
@@ -799,7 +814,7 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
 void setLandscapeDensity(RenderScene& rs, const Scene& scene)
 {
     if (rs.landCells.empty()) return;
-    setLandscapeDensity(rs.base.land, scene.terrain.density, scene.terrain.origin.y);
+    setLandscapeDensity(rs.base.landscape.layout, scene.terrain.density, scene.terrain.origin.y);
     buildLandscapeLight(rs, scene);
     countBytes(rs);
 }
@@ -878,36 +893,35 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     // Environment, camera, settings.
     RenderView& b = rs.base;
     const TerrainDesc& t = scene.terrain;
-    b.groundEnabled = groundPlaneShown(scene);   // a terrain is the ground
-    b.groundY = float(scene.ground.height - origin.y);
-    b.groundColor = scene.ground.color;
-    b.terrainEnabled = t.enabled();
+    b.ground.enabled = groundPlaneShown(scene);   // a terrain is the ground
+    b.ground.y = float(scene.ground.height - origin.y);
+    b.ground.color = scene.ground.color;
+    b.terrain.enabled = t.enabled();
     if (t.enabled()) {
-        b.terrainOrigin = glm::vec3(t.origin - origin);   // camera-relative, in double first
-        b.terrainRock = t.rock;
-        b.terrainSnow = t.snow;
-        b.terrainRockCos = terrainRockCos(t);
-        b.terrainSnowY = terrainSnowY(t);
+        b.terrain.origin = glm::vec3(t.origin - origin);   // camera-relative, in double first
+        b.terrain.rock = t.rock;
+        b.terrain.snow = t.snow;
+        b.terrain.rockCos = terrainRockCos(t);
+        b.terrain.snowY = terrainSnowY(t);
         // The height field's and the landscape's frames are rebased under the camera, in double (Dietrich et
         // al. 2006 at UTM coordinates: millions of metres from the world origin, centimetres near the camera).
-        const HeightFieldLayout& L = rs.base.terrain;
+        const HeightFieldLayout& L = rs.base.terrain.layout;
         const glm::dvec3 camLocal = origin - t.origin;   // the camera in the DEM's frame
         const auto nearest = [](double x, double step, uint32_t n) { return int32_t(std::clamp(std::floor(x / step), 0.0, double(n))); };
-        b.terrainBaseI = nearest(camLocal.x, double(L.dx), L.nx - 1);
-        b.terrainBaseJ = nearest(camLocal.z, double(L.dz), L.nz - 1);
-        b.terrainBase = glm::vec3(t.origin + glm::dvec3(double(b.terrainBaseI) * double(L.dx), 0.0, double(b.terrainBaseJ) * double(L.dz)) - origin);
-        b.landscapeEnabled = !rs.landCells.empty();
-        if (b.landscapeEnabled) {
-            const double C = double(b.land.cellSize);
-            b.landBaseCell = glm::ivec2(nearest(camLocal.x, C, b.land.cellsX), nearest(camLocal.z, C, b.land.cellsZ));
-            b.landBase = glm::vec3(t.origin + glm::dvec3(double(b.landBaseCell.x) * C, 0.0, double(b.landBaseCell.y) * C) - origin);
+        b.terrain.baseI = nearest(camLocal.x, double(L.dx), L.nx - 1);
+        b.terrain.baseJ = nearest(camLocal.z, double(L.dz), L.nz - 1);
+        b.terrain.base = glm::vec3(t.origin + glm::dvec3(double(b.terrain.baseI) * double(L.dx), 0.0, double(b.terrain.baseJ) * double(L.dz)) - origin);
+        b.landscape.enabled = !rs.landCells.empty();
+        if (b.landscape.enabled) {
+            const double C = double(b.landscape.layout.cellSize);
+            b.landscape.baseCell = glm::ivec2(nearest(camLocal.x, C, b.landscape.layout.cellsX), nearest(camLocal.z, C, b.landscape.layout.cellsZ));
+            b.landscape.base = glm::vec3(t.origin + glm::dvec3(double(b.landscape.baseCell.x) * C, 0.0, double(b.landscape.baseCell.y) * C) - origin);
         }
     }
     const FrameSun sun = frameSun(scene, sunRadiance);
-    b.sunDir = sun.direction;
-    b.sunRadiance = sun.radiance;
+    placeLights(rs, sun);
     b.lbRadiance = lbRadiance(scene, sun);
-    b.sky = composeSky(scene);
+    b.sky.constant = composeSky(scene);
     b.camera = makeCamera(scene.camera, width, height);
     b.width = width;
     b.height = height;

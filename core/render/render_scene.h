@@ -169,6 +169,10 @@ struct FrameSun {
     glm::vec3 radiance;
 };
 FrameSun frameSun(const Scene& scene, const glm::vec3& sunRadiance);
+// The frame's light list (RenderScene::lights): the sun (a distant light, first: the light the LB grids are
+// solved toward) and the sky (the environment; setFrameSky sets its virtual lights). placeTopLevel calls it;
+// a caller adds other lights after it (core/render/lights).
+void placeLights(RenderScene& rs, const FrameSun& sun);
 // The direction the species' LB grids are solved toward: the scene's sun, or a map sky's own sun when the
 // frame lights with it (sun_from_map), so the LB's light comes from where the drawn sun is.
 glm::vec3 lbSunDirection(const Scene& scene);

@@ -11,9 +11,9 @@
 #include "core/scene/scene.h"
 #include "core/sky/sky.h"
 #include "core/sky/virtual_lights.h"
+#include "core/render/lights/light_list.h"
+#include "core/render/surfaces/surface_list.h"
 #include "core/render/volume_trace.h"
-#include "core/terrain/height_field.h"
-#include "core/terrain/landscape.h"
 
 namespace sylva {
 
@@ -83,8 +83,8 @@ struct InstanceLightRecord {
 };
 static_assert(sizeof(InstanceLightRecord) == 128);
 
-// What an instance can point to. A new kind (height-field terrain, volume grid) adds an enumerator, its
-// fields in GeometryRecord and one case in traceGeometry (core/render/trace.h).
+// What an instance can point to (the surface kinds below the Instances kind, core/render/surfaces/
+// surface_list.h): traceLevel (surfaces/instances_trace.h) switches on it.
 enum class GeometryKind : uint32_t {
     Mesh = 0,                // triangles under a BVH (or kd-tree), shaded with a species' data
     Group = 1,               // instances of other geometries under their own BVH (groups nest)
@@ -201,7 +201,9 @@ struct CameraRecord {
     X(Scene, Both, TilePlant, tilePlants, Landscape)       /* the tiles' plants */                             \
     X(Scene, Both, glm::vec4, landLight, Landscape)        /* the landscape's forest grid (landLightLayout) */ \
     X(Scene, Both, float, skyMap, None)                    /* the sky's map pixels (RGB, skyModel.map's) */    \
-    X(Scene, Both, sky::VirtualLight, skyLights, None)     /* the sky's virtual directional lights */ \
+    X(Scene, Both, sky::VirtualLight, skyLights, None)     /* the sky's virtual directional lights */          \
+    X(Top, Both, LightRecord, lights, None)                /* the frame's lights (core/render/lights) */       \
+    X(Top, Both, SphereRecord, sphereRecords, None)        /* analytic spheres (camera-relative) */            \
     X(Top, Both, VolumeInstanceRecord, volumeInstances, None) /* placed volumes (camera-relative) */        \
     X(Scene, Both, VolumeGridRecord, volumeGrids, None)    /* per volume grid: dims, optics, offsets */        \
     X(Scene, Both, float, volumeDensity, None)             /* volume densities (core/render/volume_trace.h) */ \
@@ -221,31 +223,17 @@ struct RenderView {
 #undef SYLVA_X
     uint32_t instanceCount;          // of the top level
     uint32_t volumeCount;            // volumeInstances (0: no volume, every stage as before)
+    uint32_t lightCount;             // lights
 
-    // environment
-    bool groundEnabled;
-    float groundY;                   // camera-relative height of the ground plane
-    glm::vec3 groundColor;           // the ground plane's albedo, and the terrain's below the rock slope and snow line
-    bool terrainEnabled;
-    HeightFieldLayout terrain;       // of terrainHeights / terrainRanges
-    glm::vec3 terrainOrigin;         // camera-relative position of the terrain frame's origin (its first sample)
-    glm::vec3 terrainRock, terrainSnow;
-    float terrainRockCos;            // normals with a y below this are rock
-    float terrainSnowY;              // terrain-frame height above which the ground is snow (> max height: none)
-    glm::vec3 terrainBase;           // camera-relative position of sample (terrainBaseI, terrainBaseJ), placed in double: the
-    int32_t terrainBaseI, terrainBaseJ;   // height field is traced relative to it (precise near the camera anywhere)
-    bool landscapeEnabled;           // cells carrying Wang tiles of plants (landNodes ... tilePlants)
-    LandscapeLayout land;
-    glm::ivec2 landBaseCell;         // the cell under the camera (clamped to the grid)
-    glm::vec3 landBase;              // camera-relative corner of landBaseCell at the terrain frame's y = 0, placed in double
-    LandLightLayout landLightLayout; // of landLight, terrain frame: the forest grid's factor on landscape plants (dims.x 0: none)
-    glm::vec3 sunDir;                // toward the sun, normalized
-    glm::vec3 sunRadiance;           // blackbody colour (luminance 1) x intensity
+    // the scene-level surface kinds' records (core/render/surfaces)
+    GroundRecord ground;
+    TerrainRecord terrain;
+    SpheresRecord spheres;
+    LandscapeRecord landscape;
+
+    // the environment, and the unit of the LB grids
+    SkyRecord sky;
     glm::vec3 lbRadiance;            // the species' normalized grids are in units of it (render_scene.h lbRadiance)
-    glm::vec3 sky;                   // the constant sky (skyModel.kind Constant), else 0
-    sky::SkyView skyModel;           // the sky camera rays see; Map: its pixels are skyMap (skyModel.map.rgb unused)
-    uint32_t skyLightCount;          // skyLights (0: the constant sky's ambient ground light as before)
-    sky::Interleave skyInterleave;   // the K subsets of skyLights over pixels and samples
     CameraRecord camera;
 
     // settings
@@ -260,5 +248,23 @@ struct RenderView {
     float alphaDistance;             // adaptive transparency: alpha tests only within this distance of the camera
                                      // (metres, camera-relative frame); 0 = everywhere
 };
+
+// The volumes' arrays of a view (core/render/volume_trace.h).
+SYLVA_HD SYLVA_INLINE VolumeArrays volumeViewOf(const RenderView& v)
+{
+    return VolumeArrays{v.volumeGrids, v.volumeInstances, v.volumeDensity, v.volumeBricks, v.volumeLight, v.volumeTemperature,
+                        v.volumeBlackbody, v.volumeCount};
+}
+
+// The light the LB grids are solved toward (the frame's sun: the first of the list, render_scene.cpp
+// placeTopLevel); volumes scatter it singly and subtract it from their grids' light.
+SYLVA_HD SYLVA_INLINE LightRecord lbLight(const RenderView& v)
+{
+    if (v.lightCount > 0 && v.lights[0].kind == LightKind::Distant) return v.lights[0];
+    LightRecord none{};
+    none.kind = LightKind::Distant;
+    none.direction = glm::vec3(0.0f, 1.0f, 0.0f);
+    return none;
+}
 
 } // namespace sylva

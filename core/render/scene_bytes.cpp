@@ -89,6 +89,8 @@ RenderView packedFrameView(const RenderSceneHeader& h, const PackedFrame& layout
 #undef SYLVA_X
     v.instanceCount = uint32_t(h.counts[kArray_instances]);
     v.volumeCount = uint32_t(h.counts[kArray_volumeInstances]);
+    v.lightCount = uint32_t(h.counts[kArray_lights]);
+    v.spheres.count = uint32_t(h.counts[kArray_sphereRecords]);
     return v;
 }
 

@@ -12,6 +12,7 @@
 
 #include "core/accel/ray.h"
 #include "core/base/defines.h"
+#include "core/render/lights/light_list.h"
 
 namespace sylva {
 
@@ -254,14 +255,16 @@ struct VolumeSegment {
 // (optical depth per step <= kVolumeTauPerStep, at most g.step nodes, at least g.step / 8) through the
 // bricks that hold medium, density and light sampled trilinearly at each step's midpoint, integrated with
 // the exact exponential over the step (the source held constant: T (1 - e^-sigma_t dt) S / sigma_t).
-// sunDir: toward the sun (unit); sunRadiance: the renderer's sun (surfaces show albedo x it x cos, so its
-// irradiance is pi x it); lbRadiance: the unit of the normalized LB grids (RenderView::lbRadiance: the sun's
+// sun: the distant light the LB grids are solved toward (RenderView lbLight: direction toward it, unit;
+// radiance: surfaces show albedo x it x cos, so its irradiance is pi x it); lbRadiance: the unit of the normalized LB grids (RenderView::lbRadiance: the sun's
 // radiance, or 1 where the sun is dark and the sky is in the boundary); indirectScale: the LB's weight, as
 // on surfaces.
 SYLVA_HD inline VolumeSegment marchVolume(const VolumeArrays& vv, const VolumeInstanceRecord& in, const glm::vec3& org, const glm::vec3& dir,
-                                          float tmin, float tmax, const glm::vec3& sunDir, const glm::vec3& sunRadiance,
-                                          const glm::vec3& lbRadiance, float indirectScale)
+                                          float tmin, float tmax, const LightRecord& sunLight, const glm::vec3& lbRadiance,
+                                          float indirectScale)
 {
+    const glm::vec3& sunDir = sunLight.direction;
+    const glm::vec3& sunRadiance = sunLight.radiance;
     VolumeSegment s{glm::vec3(1.0f), glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
     const VolumeGridRecord g = vv.grids[in.grid];
     const glm::vec3 o = volumeToGrid(in, org), d = volumeDirToGrid(in, dir);

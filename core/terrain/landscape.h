@@ -3,7 +3,7 @@
 // tile (a square population of plant instances), a 2D kd-tree over the cells and a 2D tree per tile whose boxes
 // reach the tile's top; plants are lifted onto the height field and thinned by the density rule while tracing,
 // nothing is stored per cell beyond its tile and a bound of its ground (range and plane). Plain records here
-// (host and device); the traversal is core/render/trace_landscape.h, the build is landscape.cpp.
+// (host and device); the traversal is core/render/surfaces/landscape_trace.h, the build is landscape.cpp.
 #pragma once
 
 #include <cstdint>

@@ -117,16 +117,16 @@ struct FrameRun {
 // The share of plants the density rule keeps: every plant of every 8th cell along each axis.
 double keptFraction(const RenderView& v)
 {
-    const HeightFieldView h{v.terrain, v.terrainHeights, v.terrainRanges};
+    const HeightFieldView h{v.terrain.layout, v.terrainHeights, v.terrainRanges};
     double kept = 0.0, all = 0.0;
-    for (uint32_t cz = 0; cz < v.land.cellsZ; cz += 8)
-        for (uint32_t cx = 0; cx < v.land.cellsX; cx += 8) {
-            const LandCell& c = v.landCells[size_t(cz) * v.land.cellsX + cx];
+    for (uint32_t cz = 0; cz < v.landscape.layout.cellsZ; cz += 8)
+        for (uint32_t cx = 0; cx < v.landscape.layout.cellsX; cx += 8) {
+            const LandCell& c = v.landCells[size_t(cz) * v.landscape.layout.cellsX + cx];
             const TileRecord& t = v.tileRecords[c.tile];
             for (uint32_t q = t.plantOffset; q < t.plantOffset + t.plantCount; ++q) {
                 float y;
                 all += 1.0;
-                kept += landPlantGrows(v.land, h, v.terrainSnowY, v.terrainRockCos, cx, cz, v.tilePlants[q], y) ? 1.0 : 0.0;
+                kept += landPlantGrows(v.landscape.layout, h, v.terrain.snowY, v.terrain.rockCos, cx, cz, v.tilePlants[q], y) ? 1.0 : 0.0;
             }
         }
     return all > 0.0 ? kept / all : 0.0;
@@ -174,15 +174,15 @@ struct EmbreeLandscape {
         rtcSetSceneBuildQuality(top, RTC_BUILD_QUALITY_MEDIUM);
         // The terrain: sample (i, j) at terrainBase + ((i - baseI) dx, h, (j - baseJ) dz); triangles 2c = (p00, p11,
         // p10), 2c + 1 = (p00, p01, p11) as height_field.h splits its cells.
-        const HeightFieldLayout& H = v.terrain;
+        const HeightFieldLayout& H = v.terrain.layout;
         RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
         auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), size_t(H.nx) * H.nz));
         for (uint32_t j = 0; j < H.nz; ++j)
             for (uint32_t i = 0; i < H.nx; ++i) {
                 const size_t k = size_t(j) * H.nx + i;
-                vb[3 * k + 0] = v.terrainBase.x + float(int(i) - v.terrainBaseI) * H.dx;
-                vb[3 * k + 1] = v.terrainBase.y + v.terrainHeights[k];
-                vb[3 * k + 2] = v.terrainBase.z + float(int(j) - v.terrainBaseJ) * H.dz;
+                vb[3 * k + 0] = v.terrain.base.x + float(int(i) - v.terrain.baseI) * H.dx;
+                vb[3 * k + 1] = v.terrain.base.y + v.terrainHeights[k];
+                vb[3 * k + 2] = v.terrain.base.z + float(int(j) - v.terrain.baseJ) * H.dz;
             }
         const size_t cellsT = size_t(H.nx - 1) * (H.nz - 1);
         auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), 2 * cellsT));
@@ -197,14 +197,14 @@ struct EmbreeLandscape {
         const unsigned terrainId = rtcAttachGeometry(top, g);
         rtcReleaseGeometry(g);
         (void)terrainId;
-        const HeightFieldView h{v.terrain, v.terrainHeights, v.terrainRanges};
-        for (uint32_t cell = 0; cell < v.land.cellsX * v.land.cellsZ && complete; ++cell) {
+        const HeightFieldView h{v.terrain.layout, v.terrainHeights, v.terrainRanges};
+        for (uint32_t cell = 0; cell < v.landscape.layout.cellsX * v.landscape.layout.cellsZ && complete; ++cell) {
             const LandCell& c = v.landCells[cell];
             const TileRecord& t = v.tileRecords[c.tile];
-            const uint32_t cx = cell % v.land.cellsX, cz = cell / v.land.cellsX;
+            const uint32_t cx = cell % v.landscape.layout.cellsX, cz = cell / v.landscape.layout.cellsX;
             for (uint32_t q = t.plantOffset; q < t.plantOffset + t.plantCount; ++q) {
                 float y;
-                if (!landPlantGrows(v.land, h, v.terrainSnowY, v.terrainRockCos, cx, cz, v.tilePlants[q], y)) continue;
+                if (!landPlantGrows(v.landscape.layout, h, v.terrain.snowY, v.terrain.rockCos, cx, cz, v.tilePlants[q], y)) continue;
                 const InstanceRecord in = trace_detail::landPlantInstance(v, cell, q);
                 float xfm[12];
                 bench::embreeInstanceTransform(in, xfm);
@@ -401,7 +401,7 @@ int main(int argc, char** argv)
                 if (!got[i]) continue;
                 ++r.hits;
                 const SurfacePoint s = surfaceStage(v, cam[i], hits[i]);
-                sh.push_back(Ray{offsetPoint(s.p, s.ng, s.extent), 0.0f, v.sunDir, 1e30f});
+                sh.push_back(Ray{offsetPoint(s.p, s.ng, s.extent), 0.0f, lbLight(v).direction, 1e30f});
             }
         }
         shStart.push_back(sh.size());

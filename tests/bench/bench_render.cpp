@@ -50,6 +50,7 @@ void forTiles(int width, int height, F&& f)
 }
 
 // What a primary ray saw, for comparing tracers: instance index (kGroundPrim = ground, kNoHit = sky) and t. 8 bytes.
+constexpr uint32_t kGroundPrim = 0xfffffffeu;
 struct PrimaryResult {
     uint32_t inst;
     float t;
@@ -59,10 +60,10 @@ struct PrimaryResult {
 // Returns false where shadeRay casts none (sky, surface facing away from the sun, shadows off).
 bool shadowRayFor(const RenderView& v, const Ray& ray, const Hit& hit, Ray& out)
 {
-    if (!v.shadows || hit.prim == kNoHit) return false;
+    if (!v.shadows || hitKind(hit) == SurfaceKind::None) return false;
     const glm::vec3 p = ray.org + hit.t * ray.dir;
     glm::vec3 ng;
-    if (hit.prim == kGroundPrim) {
+    if (hitKind(hit) == SurfaceKind::Ground) {
         ng = glm::vec3(0.0f, ray.dir.y < 0.0f ? 1.0f : -1.0f, 0.0f);
     } else {
         const InstanceRecord& in = v.instances[hit.inst];
@@ -73,8 +74,8 @@ bool shadowRayFor(const RenderView& v, const Ray& ray, const Hit& hit, Ray& out)
         if (!(glm::dot(ng, ng) > 0.5f)) ng = glm::vec3(0.0f, 1.0f, 0.0f);
         if (glm::dot(ng, -ray.dir) < 0.0f) ng = -ng;
     }
-    if (!(glm::dot(ng, v.sunDir) > 0.0f)) return false;
-    out = Ray{offsetPoint(p, ng), 0.0f, v.sunDir, 1e30f};
+    if (!(glm::dot(ng, lbLight(v).direction) > 0.0f)) return false;
+    out = Ray{offsetPoint(p, ng), 0.0f, lbLight(v).direction, 1e30f};
     return true;
 }
 
@@ -185,8 +186,8 @@ SYLVA_INLINE PrimaryResult embreePrimary1(RTCScene scene, const RenderView& v, c
 {
     PrimaryResult res{kNoHit, 0.0f};
     float tmax = ray.tmax;
-    if (v.groundEnabled && ray.dir.y != 0.0f) {
-        const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+    if (v.ground.enabled && ray.dir.y != 0.0f) {
+        const float tg = (v.ground.y - ray.org.y) / ray.dir.y;
         if (tg > ray.tmin && tg < tmax) {
             tmax = tg;
             res = {kGroundPrim, tg};
@@ -205,8 +206,8 @@ SYLVA_INLINE PrimaryResult embreePrimary1(RTCScene scene, const RenderView& v, c
 
 SYLVA_INLINE bool embreeOccluded1(RTCScene scene, const RenderView& v, const Ray& ray)
 {
-    if (v.groundEnabled && ray.dir.y != 0.0f) {
-        const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+    if (v.ground.enabled && ray.dir.y != 0.0f) {
+        const float tg = (v.ground.y - ray.org.y) / ray.dir.y;
         if (tg > ray.tmin && tg < ray.tmax) return true;
     }
     RTCIntersectContext ctx;
@@ -228,8 +229,8 @@ void embreePrimary8(RTCScene scene, const RenderView& v, const Ray* rays, int co
         const Ray& ray = rays[k < count ? k : 0];
         float tmax = ray.tmax;
         ground[k] = {kNoHit, 0.0f};
-        if (v.groundEnabled && ray.dir.y != 0.0f) {
-            const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+        if (v.ground.enabled && ray.dir.y != 0.0f) {
+            const float tg = (v.ground.y - ray.org.y) / ray.dir.y;
             if (tg > ray.tmin && tg < tmax) {
                 tmax = tg;
                 ground[k] = {kGroundPrim, tg};
@@ -268,8 +269,8 @@ void embreeOccluded8(RTCScene scene, const RenderView& v, const Ray* rays, const
         if (k >= count || !active[k]) continue;
         const Ray& ray = rays[k];
         out[k] = 0;
-        if (v.groundEnabled && ray.dir.y != 0.0f) {
-            const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+        if (v.ground.enabled && ray.dir.y != 0.0f) {
+            const float tg = (v.ground.y - ray.org.y) / ray.dir.y;
             if (tg > ray.tmin && tg < ray.tmax) {
                 out[k] = 1;
                 continue;
@@ -314,8 +315,8 @@ void embreePrimaryStream(RTCScene scene, const RenderView& v, int W, int x0, int
             PrimaryResult& out = image[size_t(y) * size_t(W) + size_t(x)];
             out = {kNoHit, 0.0f};
             float tmax = ray.tmax;
-            if (v.groundEnabled && ray.dir.y != 0.0f) {
-                const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+            if (v.ground.enabled && ray.dir.y != 0.0f) {
+                const float tg = (v.ground.y - ray.org.y) / ray.dir.y;
                 if (tg > ray.tmin && tg < tmax) {
                     tmax = tg;
                     out = {kGroundPrim, tg};
@@ -347,8 +348,8 @@ void embreeOccludedStream(RTCScene scene, const RenderView& v, int W, int x0, in
             if (!active[i]) continue;
             const Ray& ray = rays[i];
             occluded[i] = 0;
-            if (v.groundEnabled && ray.dir.y != 0.0f) {
-                const float tg = (v.groundY - ray.org.y) / ray.dir.y;
+            if (v.ground.enabled && ray.dir.y != 0.0f) {
+                const float tg = (v.ground.y - ray.org.y) / ray.dir.y;
                 if (tg > ray.tmin && tg < ray.tmax) {
                     occluded[i] = 1;
                     continue;
@@ -446,7 +447,7 @@ int main(int argc, char** argv)
                     Hit h{};
                     traceScene<false>(view, pixelRay(view, x, y), h);
                     if (hitsOut) (*hitsOut)[i] = h;
-                    out[i] = {h.prim == kGroundPrim ? kGroundPrim : (h.prim == kNoHit ? kNoHit : h.inst), h.t};
+                    out[i] = {hitKind(h) == SurfaceKind::Ground ? kGroundPrim : (hitKind(h) == SurfaceKind::None ? kNoHit : h.inst), h.t};
                 }
         });
     };

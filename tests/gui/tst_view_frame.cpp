@@ -222,7 +222,7 @@ private Q_SLOTS:
         cli.render.width = size.width();
         cli.render.height = size.height();
         const RenderScene rs = buildRenderScene(cli, m_assets, sunRadiance(cli.sun));
-        QVERIFY(rs.view().skyLightCount == 16);
+        QVERIFY(rs.view().sky.lightCount == 16);
         const QImage reference = filmImage(renderFilm(rs.view()), cli.render.mode, composeSky(cli), cli.render.exposureKey);
         const int worst = maxStep(settled, reference);
         QVERIFY2(worst <= 1, qPrintable(QString("the settled viewport is %1 steps off sylva render's frame").arg(worst)));
@@ -232,7 +232,7 @@ private Q_SLOTS:
         oneSample.render.spp = 1;
         const RenderScene rs1 = buildRenderScene(oneSample, m_assets, sunRadiance(cli.sun));
         RenderView sunOnly = rs1.view();
-        sunOnly.skyLightCount = 0;
+        sunOnly.sky.lightCount = 0;
         const QImage sunPicture = filmImage(renderFilm(sunOnly), cli.render.mode, composeSky(cli), cli.render.exposureKey);
         QVERIFY2(maxStep(moving, sunPicture) <= 1, qPrintable(QString("moving frame %1 steps off the sun-only frame").arg(maxStep(moving, sunPicture))));
         QVERIFY2(maxStep(moving, settled) > 8, qPrintable(QString("moving frame only %1 steps off the settled one").arg(maxStep(moving, settled))));

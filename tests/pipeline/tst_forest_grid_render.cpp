@@ -106,7 +106,7 @@ std::map<uint32_t, double> perInstance(const RenderScene& rs, const Film& film)
     for (int y = 0; y < film.height; ++y)
         for (int x = 0; x < film.width; ++x) {
             Hit hit{};
-            if (!intersectStage(v, cameraRay(v, float(x) + 0.5f, float(y) + 0.5f), hit) || hit.prim == kGroundPrim || hit.depth != 0) continue;
+            if (!intersectStage(v, cameraRay(v, float(x) + 0.5f, float(y) + 0.5f), hit) || hitKind(hit) == SurfaceKind::Ground || hit.depth != 0) continue;
             const glm::vec3 c = film.pixels[size_t(y) * size_t(film.width) + size_t(x)].indirect;
             sum[hit.inst] += 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
             count[hit.inst] += 1.0;
@@ -176,7 +176,7 @@ private Q_SLOTS:
                 Hit hit{};
                 const Ray ray = cameraRay(v, float(x) + 0.5f, float(y) + 0.5f);
                 const size_t k = size_t(y) * size_t(fa.width) + size_t(x);
-                if (!intersectStage(v, ray, hit) || hit.prim == kGroundPrim) {
+                if (!intersectStage(v, ray, hit) || hitKind(hit) == SurfaceKind::Ground) {
                     QCOMPARE(fb.pixels[k].indirect, fa.pixels[k].indirect);   // the ground: no factor
                     continue;
                 }
@@ -215,12 +215,12 @@ private Q_SLOTS:
                 Hit hit{};
                 const Ray ray = cameraRay(v, float(x) + 0.5f, float(y) + 0.5f);
                 const size_t k = size_t(y) * size_t(fa.width) + size_t(x);
-                if (!intersectStage(v, ray, hit) || hit.inst != kLandscapeInst) {
+                if (!intersectStage(v, ray, hit) || hitKind(hit) != SurfaceKind::Landscape) {
                     QCOMPARE(fb.pixels[k].indirect, fa.pixels[k].indirect);   // the ground and the sky: no factor
                     continue;
                 }
-                const glm::vec3 p = ray.org + hit.t * ray.dir - v.terrainOrigin;
-                const glm::vec3 f = landLightFactor(v.landLightLayout, v.landLight, p);
+                const glm::vec3 p = ray.org + hit.t * ray.dir - v.terrain.origin;
+                const glm::vec3 f = landLightFactor(v.landscape.lightLayout, v.landLight, p);
                 for (int c = 0; c < 3; ++c) {
                     QVERIFY(f[c] > 0.0f && f[c] < 1.2f);
                     QVERIFY(std::fabs(fb.pixels[k].indirect[c] - fa.pixels[k].indirect[c] * f[c]) <= 1e-5f + 1e-5f * fa.pixels[k].indirect[c]);

@@ -108,7 +108,7 @@ Frame renderDirect(const TriangleMesh& mesh, const Scene& scene)
         for (int x = 0; x < v.width; ++x) {
             Hit h{};
             const bool hit = traceScene<false>(v, cameraRay(v, float(x) + 0.5f, float(y) + 0.5f), h);
-            f.what[size_t(y) * size_t(v.width) + size_t(x)] = !hit ? 0 : (h.prim == kGroundPrim ? 1 : 2);
+            f.what[size_t(y) * size_t(v.width) + size_t(x)] = !hit ? 0 : (hitKind(h) == SurfaceKind::Ground ? 1 : 2);
         }
     return f;
 }

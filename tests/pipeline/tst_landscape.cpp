@@ -78,7 +78,7 @@ Scene flattened(const Scene& land, const RenderScene& rs, Keep keep)
     Scene s = land;
     s.terrain.cells = 0;
     s.instances.clear();
-    const LandscapeLayout& L = rs.base.land;
+    const LandscapeLayout& L = rs.base.landscape.layout;
     const double C = L.cellSize, k = L.tileScale;
     for (uint32_t cz = 0; cz < L.cellsZ; ++cz)
         for (uint32_t cx = 0; cx < L.cellsX; ++cx) {
@@ -191,7 +191,7 @@ private Q_SLOTS:
         for (double tileSize : {16.0, 20.0}) {
             const Scene land = landscape(97, hills, 6, tileSize);
             const RenderScene rs = buildRenderScene(land, m_assets, glm::vec3(1.0f));
-            QVERIFY(rs.base.landscapeEnabled);
+            QVERIFY(rs.base.landscape.enabled);
             const Scene flat = flattened(land, rs, [](uint32_t, uint32_t, uint32_t, double) { return true; });
             QVERIFY(flat.instances.size() > 1000);
             const RenderScene fs = buildRenderScene(flat, m_assets, glm::vec3(1.0f));
@@ -218,12 +218,12 @@ private Q_SLOTS:
                 ray.tmax = 1e30f;
                 Hit ha{}, hb{};
                 const bool ga = traceScene<false>(a, ray, ha), gb = traceScene<false>(b, ray, hb);
-                if (ga && ha.inst == kLandscapeInst) ++plants;
-                if (ga && ha.inst == kTerrainInst) ++terrain;
+                if (ga && hitKind(ha) == SurfaceKind::Landscape) ++plants;
+                if (ga && hitKind(ha) == SurfaceKind::Terrain) ++terrain;
                 const bool same = ga == gb && (!ga || (std::fabs(ha.t - hb.t) <= 1e-4f * std::max(1.0f, ha.t) &&
-                                                       ((ha.inst == kTerrainInst) == (hb.inst == kTerrainInst))));
+                                                       ((hitKind(ha) == SurfaceKind::Terrain) == (hitKind(hb) == SurfaceKind::Terrain))));
                 if (!same) ++differ;
-                if (ga && ha.inst == kLandscapeInst && !(ha.prim == hb.prim)) ++differ;
+                if (ga && hitKind(ha) == SurfaceKind::Landscape && !(ha.prim == hb.prim)) ++differ;
                 Hit sa{}, sb{};
                 if (traceScene<true>(a, ray, sa) != traceScene<true>(b, ray, sb)) ++anyDiffer;
             }
@@ -257,7 +257,7 @@ private Q_SLOTS:
         land.render.accel = AccelKind(accel);
         const RenderScene rs = buildRenderScene(land, m_assets, glm::vec3(1.0f));
         const RenderView v = rs.view();
-        QVERIFY(v.landscapeEnabled);
+        QVERIFY(v.landscape.enabled);
         std::mt19937 rng(11);
         std::uniform_real_distribution<float> u(0.0f, 1.0f);
         int rays = 0, plantHits = 0, occluded = 0, differ = 0;
@@ -273,12 +273,12 @@ private Q_SLOTS:
                 Hit h{}, a{};
                 const bool f = traceScene<false>(v, packet[size_t(i)], h), o = traceScene<true>(v, packet[size_t(i)], a);
                 ++rays;
-                plantHits += f && h.inst == kLandscapeInst;
+                plantHits += f && hitKind(h) == SurfaceKind::Landscape;
                 occluded += o;
                 const Hit& g = hp[size_t(i)];
                 const bool same = f == fp[size_t(i)] && o == op[size_t(i)] &&
                                   (!f || (h.t == g.t && h.prim == g.prim && h.inst == g.inst &&
-                                          (h.inst != kLandscapeInst || (h.nested[0] == g.nested[0] && h.nested[1] == g.nested[1]))));
+                                          (hitKind(h) != SurfaceKind::Landscape || (h.nested[0] == g.nested[0] && h.nested[1] == g.nested[1]))));
                 if (!same && differ++ < 5)
                     qWarning("ray %d of a packet of %d: (%d %d, t %g, inst %x, prim %u, cell %u, plant %u) alone, (%d %d, t %g, inst %x, prim %u, cell %u, "
                              "plant %u) in the packet",
@@ -295,7 +295,7 @@ private Q_SLOTS:
                 check(cam);
                 for (const Ray& r : cam) {
                     Hit h{};
-                    if (traceScene<false>(v, r, h)) sun.push_back(sunShadowRay(v, surfaceStage(v, r, h)));
+                    if (traceScene<false>(v, r, h)) sun.push_back(Ray{shadowOrigin(surfaceStage(v, r, h)), 0.0f, lbLight(v).direction, 1e30f});
                 }
                 check(sun);
             }
@@ -342,7 +342,7 @@ private Q_SLOTS:
         land.render.height = 29;
         const RenderScene rs = buildRenderScene(land, m_assets, glm::vec3(1.0f));
         const RenderView v = rs.view();
-        QVERIFY(v.landscapeEnabled && v.shadows);
+        QVERIFY(v.landscape.enabled && v.shadows);
         const Film film = renderFilm(v);
         const int x0 = 3, y0 = 5, x1 = 40, y1 = 26;
         std::vector<SampleParts> rect(size_t(x1 - x0) * size_t(y1 - y0));
@@ -358,7 +358,7 @@ private Q_SLOTS:
                 differ += !same(p, film.pixels[size_t(y) * size_t(v.width) + size_t(x)]);
                 if (x >= x0 && x < x1 && y >= y0 && y < y1) differ += !same(p, rect[size_t(y - y0) * size_t(x1 - x0) + size_t(x - x0)]);
                 Hit h{};
-                plantPixels += traceScene<false>(v, sampleRay(v, x, y, 0), h) && h.inst == kLandscapeInst;
+                plantPixels += traceScene<false>(v, sampleRay(v, x, y, 0), h) && hitKind(h) == SurfaceKind::Landscape;
             }
         qInfo("%d of %d pixels show plants; %d pixels differ", plantPixels, v.width * v.height, differ);
         QVERIFY(plantPixels > v.width * v.height / 10);
@@ -502,7 +502,7 @@ private Q_SLOTS:
             if (std::fabs(pv - d) < 0.005 || std::fabs(y - 42.0) < 0.05) {   // within float rounding of a threshold: as traced
                 ++close;
                 float yy;
-                return landPlantGrows(v.land, HeightFieldView{v.terrain, v.terrainHeights, v.terrainRanges}, v.terrainSnowY, v.terrainRockCos, cx, cz, p, yy);
+                return landPlantGrows(v.landscape.layout, HeightFieldView{v.terrain.layout, v.terrainHeights, v.terrainRanges}, v.terrain.snowY, v.terrain.rockCos, cx, cz, p, yy);
             }
             const bool keep = pv <= d && y <= 42.0;
             if (y > 42.0) {
@@ -529,7 +529,7 @@ private Q_SLOTS:
             ray.tmax = 1e30f;
             Hit ha{}, hb{};
             const bool ga = traceScene<false>(v, ray, ha), gb = traceScene<false>(fv, ray, hb);
-            plants += ga && ha.inst == kLandscapeInst;
+            plants += ga && hitKind(ha) == SurfaceKind::Landscape;
             if (ga != gb || (ga && std::fabs(ha.t - hb.t) > 1e-4f * std::max(1.0f, ha.t))) ++differ;
         }
         qInfo("%d of %d rays hit plants, %d differ from the flattened scene; %d plants at a threshold", plants, n, differ, close);
@@ -574,7 +574,7 @@ private Q_SLOTS:
             Hit h{};
             traceScene<false>(v, ray, h);
             (x > 48.0f ? steep : flat) += 1;
-            if (h.inst == kLandscapeInst) (x > 48.0f ? steepHits : flatHits) += 1;
+            if (hitKind(h) == SurfaceKind::Landscape) (x > 48.0f ? steepHits : flatHits) += 1;
         }
         qInfo("flat: %d of %d rays hit plants; rock: %d of %d", flatHits, flat, steepHits, steep);
         QVERIFY(flatHits > flat / 5);

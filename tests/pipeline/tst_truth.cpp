@@ -307,7 +307,7 @@ private Q_SLOTS:
             for (int x = 0; x < v.width; ++x) {
                 const Ray ray = cameraRay(v, float(x) + 0.5f, float(y) + 0.5f);
                 Hit hit{};
-                if (!intersectStage(v, ray, hit) || hit.prim == kGroundPrim || hit.inst == kTerrainInst) continue;
+                if (!intersectStage(v, ray, hit) || hitKind(hit) == SurfaceKind::Ground || hitKind(hit) == SurfaceKind::Terrain) continue;
                 if (!v.materials[v.triMaterial[hit.prim]].isLeaf) continue;
                 const SurfacePoint sp = surfaceStage(v, ray, hit);
                 ++leaves;
@@ -318,7 +318,7 @@ private Q_SLOTS:
                 }
                 if (sp.albedo.y * w.y > cap) ++cappedGreen;
                 const SampleParts parts = lightStage(v, sp, x, y, 0);
-                const glm::vec3 expect = sp.albedo * sp.lighting * sp.indirectWeight * v.sunRadiance * v.indirectScale;
+                const glm::vec3 expect = sp.albedo * sp.lighting * sp.indirectWeight * lbLight(v).radiance * v.indirectScale;
                 for (int c = 0; c < 3; ++c) QVERIFY(std::fabs(parts.indirect[c] - expect[c]) <= 1e-5f * std::max(expect[c], 1e-3f));
             }
         QVERIFY2(leaves > 20 && cappedGreen > leaves / 2, qPrintable(QString("%1 leaf hits, %2 capped in green").arg(leaves).arg(cappedGreen)));

@@ -2,36 +2,38 @@
 // Complex Plant Populations", sections 4.1-4.3): the top-level 2D kd-tree over cells, top-down and nearest
 // first, skipping nodes the ray passes above or below; in a cell its tile's 2D tree with the tile's height
 // raised by the cell's ground range; plants lifted onto the height field and thinned by the density rule as
-// they are reached. Included by trace.h after trace_detail's mesh traversal (host and device).
+// they are reached; the landscape surface kind's query and surface (host and device). Hit: nested[0] = the
+// cell, nested[1] = the plant (tilePlants), prim = the triangle of the plant's mesh, (u, v) its barycentrics.
 #pragma once
 
+#include "core/render/surfaces/mesh_trace.h"
 #include "core/terrain/landscape.h"
 
 namespace sylva {
 
 namespace trace_detail {
 
-SYLVA_HD SYLVA_INLINE HeightFieldView landHeights(const RenderView& v) { return HeightFieldView{v.terrain, v.terrainHeights, v.terrainRanges}; }
+SYLVA_HD SYLVA_INLINE HeightFieldView landHeights(const RenderView& v) { return HeightFieldView{v.terrain.layout, v.terrainHeights, v.terrainRanges}; }
 
 // The camera-relative corner of cell (cx, cz): from the camera's base cell (placed in double on the host),
 // so a cell's frame is as precise near the camera wherever the terrain lies.
 SYLVA_HD SYLVA_INLINE glm::vec3 landCellCorner(const RenderView& v, uint32_t cx, uint32_t cz)
 {
-    return v.landBase + glm::vec3(float(int(cx) - v.landBaseCell.x) * v.land.cellSize, 0.0f, float(int(cz) - v.landBaseCell.y) * v.land.cellSize);
+    return v.landscape.base + glm::vec3(float(int(cx) - v.landscape.baseCell.x) * v.landscape.layout.cellSize, 0.0f, float(int(cz) - v.landscape.baseCell.y) * v.landscape.layout.cellSize);
 }
 
 // Plant p's root (camera-relative) in the cell whose corner is `corner`, standing at DEM-frame height y.
 SYLVA_HD SYLVA_INLINE glm::vec3 landRootAt(const RenderView& v, const glm::vec3& corner, const TilePlant& p, float y)
 {
-    return corner + glm::vec3(v.land.tileScale * p.x, y, v.land.tileScale * p.z);
+    return corner + glm::vec3(v.landscape.layout.tileScale * p.x, y, v.landscape.layout.tileScale * p.z);
 }
 
 // Plant `plant` (tilePlants) of cell `cell`: whether it grows there, and its root (camera-relative).
 SYLVA_HD inline bool landPlantRoot(const RenderView& v, uint32_t cell, const TilePlant& p, glm::vec3& root)
 {
-    const uint32_t cx = cell % v.land.cellsX, cz = cell / v.land.cellsX;
+    const uint32_t cx = cell % v.landscape.layout.cellsX, cz = cell / v.landscape.layout.cellsX;
     float y;
-    if (!landPlantGrows(v.land, landHeights(v), v.terrainSnowY, v.terrainRockCos, cx, cz, p, y)) return false;
+    if (!landPlantGrows(v.landscape.layout, landHeights(v), v.terrain.snowY, v.terrain.rockCos, cx, cz, p, y)) return false;
     root = landRootAt(v, landCellCorner(v, cx, cz), p, y);
     return true;
 }
@@ -42,12 +44,12 @@ SYLVA_HD inline InstanceRecord landPlantInstance(const RenderView& v, uint32_t c
     const TilePlant& p = v.tilePlants[plant];
     glm::vec3 root(0.0f);
     landPlantRoot(v, cell, p, root);
-    const float ik = v.land.invTileScale;
+    const float ik = v.landscape.layout.invTileScale;
     InstanceRecord outer{};
     outer.row[0] = glm::vec4(ik, 0.0f, 0.0f, -root.x * ik);
     outer.row[1] = glm::vec4(0.0f, ik, 0.0f, -root.y * ik);
     outer.row[2] = glm::vec4(0.0f, 0.0f, ik, -root.z * ik);
-    outer.scale = v.land.tileScale;
+    outer.scale = v.landscape.layout.tileScale;
     InstanceRecord inner{};
     inner.row[0] = p.row[0];
     inner.row[1] = p.row[1];
@@ -69,7 +71,7 @@ struct LandCellFrame {
     float p0, px, pz, pe;   // the ground plane y = p0 + px x + pz z within pe
 
     SYLVA_HD SYLVA_INLINE LandCellFrame(const RenderView& v, const LandCell& c, uint32_t cx, uint32_t cz)
-        : corner(landCellCorner(v, cx, cz)), ik(v.land.invTileScale), gLo(c.ground.x * ik), gHi(c.ground.y * ik), p0(c.plane.x * ik),
+        : corner(landCellCorner(v, cx, cz)), ik(v.landscape.layout.invTileScale), gLo(c.ground.x * ik), gHi(c.ground.y * ik), p0(c.plane.x * ik),
           px(c.plane.y * ik), pz(c.plane.z * ik), pe(c.plane.w * ik)
     {
     }
@@ -103,8 +105,8 @@ SYLVA_HD SYLVA_INLINE bool landCellSegment(const RenderView& v, uint32_t cx, uin
     // The border cells' columns reach out beyond the grid, where their plants overhang the terrain's edge.
     const glm::vec3 a = landCellCorner(v, cx, cz), b = landCellCorner(v, cx + 1, cz + 1);
     const float big = 3.0e38f;
-    const float x0 = cx == 0 ? -big : a.x, x1 = cx + 1 == v.land.cellsX ? big : b.x;
-    const float z0 = cz == 0 ? -big : a.z, z1 = cz + 1 == v.land.cellsZ ? big : b.z;
+    const float x0 = cx == 0 ? -big : a.x, x1 = cx + 1 == v.landscape.layout.cellsX ? big : b.x;
+    const float z0 = cz == 0 ? -big : a.z, z1 = cz + 1 == v.landscape.layout.cellsZ ? big : b.z;
     auto axis = [&](float lo, float hi, float org, float inv) {
         if (inv == 1e30f || inv == -1e30f) return lo <= org && org < hi;
         const float ta = (lo - org) * inv, tb = (hi - org) * inv;
@@ -190,11 +192,11 @@ SYLVA_HD inline bool traceLandTile(Query& q, uint32_t cell, uint32_t cx, uint32_
                 SYLVA_COUNT(g_plantRootReads);
                 float y;
                 uint32_t tri;
-                if (!landPlantHeight(v.land, heights, cx, cz, p, y, tri)) continue;
+                if (!landPlantHeight(v.landscape.layout, heights, cx, cz, p, y, tri)) continue;
                 const glm::vec3 root = landRootAt(v, f.corner, p, y);
                 const glm::vec3 op = (o - root) * ik;   // the plant-centred tile frame
                 if (!(rayBoxEntry(p.lo, p.hi, op, inv, q.tmin, tmax) <= tmax)) continue;
-                if (!landPlantKept(v.land, heights, v.terrainSnowY, v.terrainRockCos, p, y, tri)) continue;
+                if (!landPlantKept(v.landscape.layout, heights, v.terrain.snowY, v.terrain.rockCos, p, y, tri)) continue;
                 if (traceLandPlant<AnyHit, Kd>(q, cell, k, p, op, dt, tmax)) return true;
             }
         }
@@ -218,8 +220,8 @@ SYLVA_HD SYLVA_INLINE void landNodeBox(const RenderView& v, const LandRange& r, 
 {
     const LandNode& n = v.landNodes[r.node];
     const glm::vec3 a = landCellCorner(v, r.x0, r.z0), b = landCellCorner(v, r.x1, r.z1);
-    lo = glm::vec3(a.x, v.landBase.y + n.range.x, a.z);
-    hi = glm::vec3(b.x, v.landBase.y + n.range.y, b.z);
+    lo = glm::vec3(a.x, v.landscape.base.y + n.range.x, a.z);
+    hi = glm::vec3(b.x, v.landscape.base.y + n.range.y, b.z);
 }
 
 // An inner node's children (its longer side halved), the near one first along direction d.
@@ -247,11 +249,11 @@ SYLVA_HD inline bool traceLandCell(const Query& q, uint32_t cell, const glm::vec
     const LandCell c = v.landCells[cell];
     const TileRecord& tile = v.tileRecords[c.tile];
     if (tile.plantCount == 0) return false;
-    const uint32_t cx = cell % v.land.cellsX, cz = cell / v.land.cellsX;
+    const uint32_t cx = cell % v.landscape.layout.cellsX, cz = cell / v.landscape.layout.cellsX;
     float t0 = q.tmin, t1 = tmax;
     if (!landCellSegment(v, cx, cz, o, iw, t0, t1)) return false;
     SYLVA_COUNT(g_landCellVisits);
-    Query cq{v, t0, q.tAlpha, q.hit, {q.path[0], 0, 0}};
+    Query cq{v, t0, q.tAlpha, q.hit, q.kind, {q.path[0], 0, 0}};
     const float limit = landCellLimit(tmax, t1);
     float t = limit;
     const bool stopped = traceLandTile<AnyHit, Kd>(cq, cell, cx, cz, c, tile, o, d, t);
@@ -260,17 +262,15 @@ SYLVA_HD inline bool traceLandCell(const Query& q, uint32_t cell, const glm::vec
 }
 
 // The landscape's plants along the ray: its cells' 2D kd-tree top-down, near child first, a node skipped
-// where the ray passes above or below its range or beyond the closest hit so far. Hits are recorded with
-// inst = kLandscapeInst, nested[0] = the cell, nested[1] = the plant (tilePlants).
+// where the ray passes above or below its range or beyond the closest hit so far.
 template <bool AnyHit, bool Kd>
-SYLVA_HD inline bool traceLandscape(Query& q, const glm::vec3& o, const glm::vec3& d, float& tmax)
+SYLVA_HD inline bool walkLandscape(Query& q, const glm::vec3& o, const glm::vec3& d, float& tmax)
 {
     const RenderView& v = q.v;
     const glm::vec3 inv = safeReciprocal(d);
     LandRange stack[96];
     int top = 0;
-    stack[top++] = LandRange{0, 0, 0, v.land.cellsX, v.land.cellsZ};
-    q.path[0] = kLandscapeInst;
+    stack[top++] = LandRange{0, 0, 0, v.landscape.layout.cellsX, v.landscape.layout.cellsZ};
     while (top > 0) {
         const LandRange e = stack[--top];
         const LandNode& n = v.landNodes[e.node];
@@ -279,7 +279,7 @@ SYLVA_HD inline bool traceLandscape(Query& q, const glm::vec3& o, const glm::vec
         landNodeBox(v, e, lo, hi);
         if (!(rayBoxEntry(lo, hi, o, inv, q.tmin, tmax) <= tmax)) continue;
         if (n.child == 0) {
-            if (traceLandCell<AnyHit, Kd>(q, e.z0 * v.land.cellsX + e.x0, o, d, inv, tmax)) return true;
+            if (traceLandCell<AnyHit, Kd>(q, e.z0 * v.landscape.layout.cellsX + e.x0, o, d, inv, tmax)) return true;
             continue;
         }
         landChildren(n, e, d, stack[top + 1], stack[top]);   // the far one deferred
@@ -288,6 +288,25 @@ SYLVA_HD inline bool traceLandscape(Query& q, const glm::vec3& o, const glm::vec
     return false;
 }
 
+// The kind's query (Dietrich et al., sections 4.1, 4.2), below the ground's hit.
+template <bool AnyHit, bool Kd>
+SYLVA_HD inline bool traceLandscape(Query& q, const Ray& ray, float& tmax)
+{
+    if (!q.v.landscape.enabled) return false;
+    q.kind = SurfaceKind::Landscape;
+    q.path[0] = kNoHit;
+    return walkLandscape<AnyHit, Kd>(q, ray.org, ray.dir, tmax);
+}
+
 } // namespace trace_detail
+
+// The kind's surface: the plant's mesh, its LB light scaled by the landscape's forest grid at the point.
+SYLVA_HD inline void shadeLandscape(const RenderView& v, const Ray& ray, const Hit& hit, SurfacePoint& s)
+{
+    const InstanceRecord in = trace_detail::landPlantInstance(v, hit.nested[0], hit.nested[1]);
+    const glm::vec3 lp = toLocalPoint(in, ray.org) + hit.t * toLocalDir(in, ray.dir);
+    shadeMesh(v, hit, in, lp, s);
+    meshIndirect(v, in, lp, landLightFactor(v.landscape.lightLayout, v.landLight, s.p - v.terrain.origin), s);
+}
 
 } // namespace sylva

@@ -1,0 +1,33 @@
+// The distant light (the sun): parallel light from one direction, a shadow ray per point, dimmed by the
+// volumes it crosses (host and device). Its functions as light_list.h names them; included by core/render/lights.h.
+#pragma once
+
+namespace sylva {
+
+SYLVA_HD SYLVA_INLINE bool shadowRayDistant(const RenderView& v, const LightRecord& l, const SurfacePoint& s, Ray& r)
+{
+    if (!v.shadows || !(glm::dot(s.ng, l.direction) > 0.0f)) return false;
+    r = Ray{shadowOrigin(s), 0.0f, l.direction, 1e30f};
+    return true;
+}
+
+SYLVA_HD inline LightContribution directDistant(const RenderView& v, const LightRecord& l, const SurfacePoint& s, const LightQuery& q)
+{
+    LightContribution out{glm::vec3(0.0f), glm::vec3(0.0f)};
+    const float nl = glm::dot(s.ng, l.direction);
+    if (!(nl > 0.0f)) return out;
+    if (!(q.seen >= 0 ? q.seen != 0 : directionVisible(v, shadowOrigin(s), l.direction))) return out;
+    out.local = reflectedLight(s, l.direction, nl, l.radiance);
+    if (v.volumeCount > 0) out.local *= volumeTransmittance(volumeViewOf(v), s.p, l.direction);   // cloud shadows
+    return out;
+}
+
+SYLVA_HD SYLVA_INLINE LightSample sampleDistant(const RenderView&, const LightRecord& l, const glm::vec3&, glm::vec2)
+{
+    return LightSample{l.direction, l.radiance * kLightPi, 1.0f, 3.0e38f, true};
+}
+
+SYLVA_HD SYLVA_INLINE glm::vec3 evalDistant(const RenderView&, const LightRecord&, const glm::vec3&) { return glm::vec3(0.0f); }
+SYLVA_HD SYLVA_INLINE float pdfDistant(const RenderView&, const LightRecord&, const glm::vec3&) { return 0.0f; }
+
+} // namespace sylva
