@@ -30,10 +30,20 @@ std::vector<double> numbers(const Args& args, const ParamSpec& spec)
     return v;
 }
 
+// Whole numbers the member's type holds ([lo, hi]). One it cannot hold is outside the parameter's range
+// too and is refused as the core refuses one (Error, exit 1); only a parameter without such bounds gets
+// parseInteger's UsageError.
 std::vector<long long> integers(const Args& args, const ParamSpec& spec, long long lo, long long hi)
 {
     std::vector<long long> v;
-    for (const std::string& p : parts(args, spec)) v.push_back(parseInteger(optionName(spec), p, lo, hi));
+    for (const std::string& p : parts(args, spec)) {
+        const long long x = parseInteger(optionName(spec), p, std::numeric_limits<long long>::min(), std::numeric_limits<long long>::max());
+        if (x < lo || x > hi) {
+            checkParam(spec, x, "option " + optionName(spec));
+            (void)parseInteger(optionName(spec), p, lo, hi);   // throws: outside the type
+        }
+        v.push_back(x);
+    }
     return v;
 }
 
