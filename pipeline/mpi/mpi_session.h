@@ -1,4 +1,4 @@
-// What the --mpi commands share (mpi_render.cpp): MPI's start with the build check, the end of a
+// What the --mpi commands share (mpi_session.cpp): MPI's start with the build check, the end of a
 // failed job, MPI error codes as exceptions. No MPI header here.
 #pragma once
 
