@@ -58,16 +58,23 @@ inline std::vector<SpeciesAssets> oneShrub()
     return assets;
 }
 
+// A grown shrub species (the leaf preset's optics) lit on a grid of `grid` nodes: small and quick to grow.
+inline SpeciesDesc shrubSpecies(int grid, uint64_t seed = 7, uint64_t triangles = 3000, float height = 0.0f)
+{
+    SpeciesDesc sp;
+    sp.name = "shrub";
+    sp.grow = GrowSpec{"shrub", seed, triangles, height};
+    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    sp.grid = grid;
+    return sp;
+}
+
 // The GPU tests' small scene: two grown shrubs (about 4k triangles each) on the ground, leaf preset at
 // 16 nodes, 96x64 pixels: seconds to grow, light and trace on the CPU, which is the oracle.
 inline Scene twoShrubs()
 {
     Scene s;
-    s.species.resize(1);
-    s.species[0].name = "shrub";
-    s.species[0].grow = GrowSpec{"shrub", 2, 4000, 2.0f};
-    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-    s.species[0].grid = 16;
+    s.species = {shrubSpecies(16, 2, 4000, 2.0f)};
     InstanceDesc a, b;
     b.position = {1.5, 0.0, 1.0};
     b.rotationDeg = {0.0f, 70.0f, 0.0f};

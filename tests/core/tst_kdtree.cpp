@@ -555,6 +555,18 @@ bool sameTree(const KdTree& a, const KdTree& b)
            std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(KdNode)) == 0;
 }
 
+// The kd-tree of s's boxes (clipped to their triangles when `clip`); *ms: its build time.
+KdTree timedBuild(const Scene& s, bool clip, double* ms)
+{
+    KdBuildSettings settings;
+    if (clip) settings.clip = kdTriangleClipper(s.mesh);
+    QElapsedTimer timer;
+    timer.start();
+    KdTree kd = buildKdTree(s.boxes, settings);
+    *ms = double(timer.nsecsElapsed()) * 1e-6;
+    return kd;
+}
+
 // Structural checks: children in range, every leaf range inside primRefs, references valid.
 void checkStructure(const KdTree& kd, size_t prims)
 {
@@ -676,12 +688,8 @@ void TestKdTree::matchesBruteForce()
     QFETCH(int, mesh);
     QFETCH(bool, clip);
     const Scene s = makeScene(testMesh(mesh));
-    KdBuildSettings settings;
-    if (clip) settings.clip = kdTriangleClipper(s.mesh);
-    QElapsedTimer timer;
-    timer.start();
-    const KdTree kd = buildKdTree(s.boxes, settings);
-    const double ms = double(timer.nsecsElapsed()) * 1e-6;
+    double ms = 0.0;
+    const KdTree kd = timedBuild(s, clip, &ms);
     checkStructure(kd, s.boxes.size());
     const Bvh bvh = buildBvh(s.boxes);
     const std::vector<TestRay> rays = makeRays(s, 100u + uint32_t(mesh), 100000);
@@ -701,12 +709,8 @@ void TestKdTree::largeForest()
     const Bvh bvh = buildBvh(s.boxes);
     const std::vector<TestRay> rays = makeRays(s, 200, 100000);
     for (bool clip : {false, true}) {
-        KdBuildSettings settings;
-        if (clip) settings.clip = kdTriangleClipper(s.mesh);
-        QElapsedTimer timer;
-        timer.start();
-        const KdTree kd = buildKdTree(s.boxes, settings);
-        const double ms = double(timer.nsecsElapsed()) * 1e-6;
+        double ms = 0.0;
+        const KdTree kd = timedBuild(s, clip, &ms);
         checkStructure(kd, s.boxes.size());
         Counts c;
         g_spurious = 0;

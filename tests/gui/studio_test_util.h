@@ -8,6 +8,7 @@
 #include <QDir>
 #include <QFileInfo>
 #include <QImage>
+#include <QMessageBox>
 #include <QSettings>
 #include <QSignalSpy>
 #include <QStandardPaths>
@@ -71,6 +72,21 @@ inline void isolate(const QTemporaryDir& dir)
     QDir(QFileInfo(AutosaveController::recoveryFilePath()).absolutePath()).removeRecursively();
     qputenv("XDG_CACHE_HOME", dir.filePath("cache").toLocal8Bit());
     QApplication::setStyle("Fusion");
+}
+
+// A test's main window: error reports collected in *errors instead of a dialog, unsaved changes discarded on close.
+inline void quietWindow(MainWindow& win, QStringList* errors)
+{
+    win.setErrorReporter([errors](const QString&, const QString& m) { *errors << m; });
+    win.setSavePrompt([](const QString&) { return QMessageBox::Discard; });
+}
+
+// Shows the window with its viewport fixed at w x h; false when the window is not exposed.
+inline bool showWithViewport(MainWindow& win, int w, int h)
+{
+    win.show();
+    win.viewport()->setFixedSize(w, h);
+    return QTest::qWaitForWindowExposed(&win);
 }
 
 // Mean and standard deviation of the luminance (0..255) of a picture.

@@ -191,12 +191,9 @@ private Q_SLOTS:
     {
         MainWindow win;
         QStringList errors;
-        win.setErrorReporter([&](const QString&, const QString& m) { errors << m; });
-        win.setSavePrompt([](const QString&) { return QMessageBox::Discard; });
-        win.show();
+        quietWindow(win, &errors);
+        QVERIFY(showWithViewport(win, 160, 96));
         Viewport* v = win.viewport();
-        v->setFixedSize(160, 96);
-        QVERIFY(QTest::qWaitForWindowExposed(&win));
         QCOMPARE(v->backend(), QStringLiteral("cpu"));
         LightingScheduler* lighting = win.lighting();
         QSignalSpy lit(lighting, &LightingScheduler::lightingFinished);

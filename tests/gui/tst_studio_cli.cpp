@@ -7,28 +7,16 @@
 
 #include "studio/command_line.h"
 #include "studio_test_util.h"
+#include "tests/common/run_program.h"
 
 using namespace sylva;
 using namespace sylva::test;
 
 namespace {
 
-struct Run {
-    int code = -1;
-    QString out, err;
-};
-
 Run runStudio(const QStringList& args, const QProcessEnvironment& env = QProcessEnvironment::systemEnvironment())
 {
-    QProcess p;
-    p.setProcessEnvironment(env);
-    p.start(QStringLiteral(SYLVA_STUDIO_PATH), args);
-    if (!p.waitForFinished(60000)) {
-        p.kill();
-        p.waitForFinished();
-    }
-    return {p.exitStatus() == QProcess::NormalExit ? p.exitCode() : -1, QString::fromUtf8(p.readAllStandardOutput()),
-            QString::fromUtf8(p.readAllStandardError())};
+    return runProgram(QStringLiteral(SYLVA_STUDIO_PATH), args, env, 60000);
 }
 
 } // namespace

@@ -32,12 +32,9 @@ private Q_SLOTS:
     {
         MainWindow win;
         QStringList errors;
-        win.setErrorReporter([&](const QString&, const QString& m) { errors << m; });
-        win.setSavePrompt([](const QString&) { return QMessageBox::Discard; });
-        win.show();
+        quietWindow(win, &errors);
+        QVERIFY(showWithViewport(win, 640, 360));
         Viewport* v = win.viewport();
-        v->setFixedSize(640, 360);
-        QVERIFY(QTest::qWaitForWindowExposed(&win));
         QSignalSpy lit(win.lighting(), &LightingScheduler::lightingFinished);
         win.loadExampleForest();
         QCOMPARE(win.document()->scene().instances.size(), size_t(962));

@@ -34,8 +34,7 @@ private Q_SLOTS:
     {
         MainWindow win;
         QStringList errors;
-        win.setErrorReporter([&](const QString&, const QString& m) { errors << m; });
-        win.setSavePrompt([](const QString&) { return QMessageBox::Discard; });
+        quietWindow(win, &errors);
         win.lighting()->setAutoLighting(false);
         win.resize(1024, 640);
         win.show();

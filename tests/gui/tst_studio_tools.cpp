@@ -21,6 +21,7 @@
 #include "studio/volume_inspector.h"
 #include "studio/volume_view.h"
 #include "studio_test_util.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 using namespace sylva::test;
@@ -448,12 +449,7 @@ private Q_SLOTS:
     void volumeViewRendersTheGrid()
     {
         Scene one;
-        SpeciesDesc sp;
-        sp.name = "shrub";
-        sp.grow = GrowSpec{"shrub", 7, 3000, 0.0f};
-        sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-        sp.grid = 16;
-        one.species.push_back(sp);
+        one.species.push_back(test::shrubSpecies(16));
         GridCache cache(m_dir.filePath("cache-3d").toStdString());
         auto grids = std::make_shared<const SpeciesGrids>(loadSpeciesGrids(one, 0, &cache));
 

@@ -12,6 +12,7 @@
 #include "core/lb/lb_params.h"
 #include "pipeline/cache/grid_cache.h"
 #include "studio/volume_inspector.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 
@@ -21,12 +22,7 @@ namespace {
 Scene shrubScene()
 {
     Scene s;
-    SpeciesDesc sp;
-    sp.name = "shrub";
-    sp.grow = GrowSpec{"shrub", 7, 3000, 0.0f};
-    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-    sp.grid = 14;
-    s.species.push_back(sp);
+    s.species.push_back(test::shrubSpecies(14));
     s.instances.push_back(InstanceDesc{});
     return s;
 }

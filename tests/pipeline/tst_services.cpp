@@ -28,6 +28,7 @@
 #include "pipeline/services/render_stats.h"
 #include "pipeline/services/sidecars.h"
 #include "tests/common/files.h"
+#include "tests/common/scenes.h"
 
 using namespace sylva;
 
@@ -46,11 +47,8 @@ bool near(double a, double b, double tol = 1e-12) { return std::fabs(a - b) <= t
 Scene shrubScene(RenderMode mode)
 {
     Scene s;
-    s.species.resize(1);
+    s.species = {test::shrubSpecies(12, 3, 3000, 1.5f)};
     s.species[0].name = "shrub a";
-    s.species[0].grow = GrowSpec{"shrub", 3, 3000, 1.5f};
-    s.species[0].lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
-    s.species[0].grid = 12;
     s.instances.resize(1);
     s.camera.position = {0.0, 1.0, -4.0};
     s.camera.target = {0.0, 0.7, 0.0};
