@@ -56,7 +56,7 @@ float sampleWorld(const LightingGrid& g, const glm::dvec3& world, int c);
 // Relative L2 of linear luminance, image a against reference b: sqrt(sum (L_a - L_b)^2 / sum L_b^2).
 double imageError(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& b);
 
-// Pictures for the report (study_truth.cpp): the exposure of Reinhard's mapping for a reference picture (the
+// Pictures for the report (study_image.cpp): the exposure of Reinhard's mapping for a reference picture (the
 // same for every picture compared with it, so they differ as their linear pictures do), the mapping with it
 // (sRGB-encoded), and an sRGB picture as PNG (throws Error).
 float exposureOf(const std::vector<glm::vec3>& reference);
