@@ -28,7 +28,8 @@ std::array<double, 16> fromColumns(const glm::dvec3& x, const glm::dvec3& y, con
     return {x.x, y.x, z.x, o.x, x.y, y.y, z.y, o.y, x.z, y.z, z.z, o.z, 0, 0, 0, 1};
 }
 
-std::string num(double v)
+// A number as Python source text (9 significant digits: a float round-trips).
+std::string pyNumber(double v)
 {
     char b[40];
     std::snprintf(b, sizeof b, "%.9g", v);
@@ -38,11 +39,11 @@ std::string num(double v)
 std::string vec(const glm::dvec3& v)
 {
     std::string s(1, '(');
-    s += num(v.x);
+    s += pyNumber(v.x);
     s += ", ";
-    s += num(v.y);
+    s += pyNumber(v.y);
     s += ", ";
-    s += num(v.z);
+    s += pyNumber(v.z);
     return s + ")";
 }
 
@@ -51,7 +52,7 @@ std::string matrixText(const std::array<double, 16>& m)
     std::string s = "(";
     for (int r = 0; r < 4; ++r) {
         s += "(";
-        for (int c = 0; c < 4; ++c) s += num(m[size_t(r * 4 + c)]) + (c < 3 ? ", " : "");
+        for (int c = 0; c < 4; ++c) s += pyNumber(m[size_t(r * 4 + c)]) + (c < 3 ? ", " : "");
         s += r < 3 ? "), " : ")";
     }
     return s + ")";
@@ -367,7 +368,7 @@ def place(coll, name, matrix):
                     (colorPng.empty() ? "None" : pyString(colorPng)) + ", " + (maskPng.empty() ? "None" : pyString(maskPng));
             if (mt.shininess > 0.0f && (mt.specular.x > 0.0f || mt.specular.y > 0.0f || mt.specular.z > 0.0f)) {
                 const BlenderGlossy gl = blenderGlossy(mt.specular, mt.shininess);
-                mats += ", " + vec(glm::dvec3(gl.color)) + ", " + num(gl.roughness);
+                mats += ", " + vec(glm::dvec3(gl.color)) + ", " + pyNumber(gl.roughness);
             }
             mats += "), ";
         }
@@ -389,7 +390,7 @@ def place(coll, name, matrix):
 
     // Ground: Lambertian plane at the ground height (Sylva's is infinite; 80 km is beyond every view here).
     if (scene.ground.enabled) {
-        py << "gm = bpy.data.meshes.new('ground')\nH = 40000.0\nZ = " << num(scene.ground.height)
+        py << "gm = bpy.data.meshes.new('ground')\nH = 40000.0\nZ = " << pyNumber(scene.ground.height)
            << "\ngm.from_pydata([(-H, -H, Z), (H, -H, Z), (H, H, Z), (-H, H, Z)], [], [(0, 1, 2, 3)])\n"
               "gmat = material('ground', "
            << vec(glm::dvec3(scene.ground.color))
@@ -406,7 +407,7 @@ def place(coll, name, matrix):
         x = glm::normalize(x);
         const glm::dvec3 y = glm::cross(z, x);
         py << "sund = bpy.data.lights.new('sun', 'SUN')\nsund.color = " << vec(glm::dvec3(bs.color)) << "\nsund.energy = "
-           << num(bs.strength) << " * SUN_ON\nsund.angle = 0.0\n";
+           << pyNumber(bs.strength) << " * SUN_ON\nsund.angle = 0.0\n";
         py << "sund.cycles.cast_shadow = True\nsuno = bpy.data.objects.new('sun', sund)\nsuno.matrix_world = Matrix("
            << matrixText(fromColumns(x, y, z, glm::dvec3(0.0, 0.0, 100.0))) << ")\nsc.collection.objects.link(suno)\n";
         py << "try:\n    vl.lightgroups.add(name='sun')\n    vl.lightgroups.add(name='sky')\n    suno.lightgroup = 'sun'\n"
@@ -418,7 +419,7 @@ def place(coll, name, matrix):
           "bg = node(wn, 'ShaderNodeBackground')\nwo = node(wn, 'ShaderNodeOutputWorld')\nwn.links.new(bg.outputs[0], wo.inputs['Surface'])\n"
           "bg.inputs['Strength'].default_value = 1.0 * SKY_ON\n";
     if (skyExr.empty()) {
-        py << "bg.inputs['Color'].default_value = (" << num(scene.sky.x) << ", " << num(scene.sky.y) << ", " << num(scene.sky.z)
+        py << "bg.inputs['Color'].default_value = (" << pyNumber(scene.sky.x) << ", " << pyNumber(scene.sky.y) << ", " << pyNumber(scene.sky.z)
            << ", 1.0)\n";
     } else {
         // Sylva's map: u = 1/2 - atan2(x, z) / (2 pi) (Sylva frame), v = acos(y) / pi from the top row. Cycles':
@@ -439,7 +440,7 @@ def place(coll, name, matrix):
     // Camera: the same position, target, up and vertical field of view; the aspect from the resolution.
     {
         const CameraDesc& c = scene.camera;
-        py << "camd = bpy.data.cameras.new('camera')\ncamd.sensor_fit = 'VERTICAL'\ncamd.angle_y = " << num(double(c.fovY) * M_PI / 180.0)
+        py << "camd = bpy.data.cameras.new('camera')\ncamd.sensor_fit = 'VERTICAL'\ncamd.angle_y = " << pyNumber(double(c.fovY) * M_PI / 180.0)
            << "\ncamd.clip_start = 0.01\ncamd.clip_end = 1.0e6\ncamo = bpy.data.objects.new('camera', camd)\ncamo.matrix_world = Matrix("
            << matrixText(blenderCameraMatrix(c)) << ")\nsc.collection.objects.link(camo)\nsc.camera = camo\n";
     }
