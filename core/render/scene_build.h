@@ -30,7 +30,7 @@ std::vector<int> instanceLevels(const Scene& scene, const std::vector<RenderScen
 // The byte statistics of the arrays (AccelStats).
 void countBytes(RenderScene& rs);
 // The terrain-frame height above which the ground is snow (> any height: none), and the cosine below which
-// a normal is rock: the shader's colour rule and the landscape's masks (RenderView::terrainSnowY, terrainRockCos).
+// a normal is rock: the shader's colour rule and the landscape's masks (TerrainRecord::snowY, rockCos).
 inline float terrainSnowY(const TerrainDesc& t) { return t.snowLine > 0.0f ? float(double(t.snowLine) - t.origin.y) : 3.0e38f; }
 inline float terrainRockCos(const TerrainDesc& t) { return float(std::cos(double(t.rockSlope) * 3.14159265358979323846 / 180.0)); }
 

@@ -185,7 +185,7 @@ void setLandscapeDensity(LandscapeLayout& layout, const DensityDesc& density, do
 
 // Everything: tiling, populations, tile trees, cells' ground ranges and the cell kd-tree. `cells` per side of
 // the terrain's longer extent (cellsX x cellsZ cover the footprint); snowY / rockCos as the terrain's colour
-// rule (RenderView::terrainSnowY, terrainRockCos), `terrainY` the terrain origin's world y. Throws Error on
+// rule (TerrainRecord::snowY, rockCos), `terrainY` the terrain origin's world y. Throws Error on
 // bad input (cells < 1, no plants, an unknown species index, a set that cannot tile).
 LandscapeBuild buildLandscape(const HeightField& field, uint32_t cells, const TileSetDesc& tiles, const TilingDesc& tiling,
                               const DensityDesc& density, double terrainY, float snowY, float rockCos,

@@ -50,7 +50,7 @@ struct LandscapeLight {
 };
 
 // The landscape's arrays as buildLandscape made them (the host's copies), the terrain's snow height and rock
-// cosine as the traversal takes them (RenderView::terrainSnowY, terrainRockCos), `species` per scene species
+// cosine as the traversal takes them (TerrainRecord::snowY, rockCos), `species` per scene species
 // (biomass 0: it takes no part), `params` the optics and sun. Throws Error on a resolution out of range or a
 // plant's species out of range of `species`.
 LandscapeLight solveLandscapeLight(const HeightField& field, const LandscapeLayout& layout, const std::vector<LandCell>& cells,
