@@ -1,8 +1,9 @@
-# sylva_add_test(NAME <name> SOURCES <files...> LABELS <labels...> [CORE] [LIBS <targets...>] [TIMEOUT <s>])
-# CORE links only sylva_core (no Qt beyond Qt Test, no Assimp/OIIO).
+# sylva_add_test(NAME <name> SOURCES <files...> LABELS <labels...> [CORE] [CLI] [LIBS <targets...>] [TIMEOUT <s>])
+# CORE links only sylva_core (no Qt beyond Qt Test, no Assimp/OIIO). CLI: the test runs the sylva program
+# (SYLVA_CLI_PATH, tests/common/run_program.h), which is built first.
 # One Qt Test executable per unit, registered with CTest under its labels (unit, pipeline, gui, gpu, slow).
 function(sylva_add_test)
-  cmake_parse_arguments(T "CORE" "NAME;TIMEOUT" "SOURCES;LABELS;LIBS" ${ARGN})
+  cmake_parse_arguments(T "CORE;CLI" "NAME;TIMEOUT" "SOURCES;LABELS;LIBS" ${ARGN})
   add_executable(${T_NAME} ${T_SOURCES})
   set_target_properties(${T_NAME} PROPERTIES AUTOMOC ON)
   if(T_CORE)
@@ -14,6 +15,10 @@ function(sylva_add_test)
     SYLVA_RESOURCES="${CMAKE_SOURCE_DIR}/resources"
     SYLVA_TEST_DATA="${CMAKE_SOURCE_DIR}/tests/data"
     SYLVA_TEST_OUTPUT="${CMAKE_BINARY_DIR}/test-output")
+  if(T_CLI)
+    target_compile_definitions(${T_NAME} PRIVATE SYLVA_CLI_PATH="$<TARGET_FILE:sylva>")
+    add_dependencies(${T_NAME} sylva)
+  endif()
   add_test(NAME ${T_NAME} COMMAND ${T_NAME})
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 600)

@@ -69,6 +69,20 @@ inline SpeciesDesc shrubSpecies(int grid, uint64_t seed = 7, uint64_t triangles 
     return sp;
 }
 
+// Nine instances of species 0 on a 3 x 3 grid `spacing` apart (x from -spacing, z from 2), each turned 40
+// degrees further: a patch of plants to see from above.
+inline std::vector<InstanceDesc> patchOfNine(double spacing)
+{
+    std::vector<InstanceDesc> patch;
+    for (int k = 0; k < 9; ++k) {
+        InstanceDesc d;
+        d.position = {double(k % 3) * spacing - spacing, 0.0, double(k / 3) * spacing + 2.0};
+        d.rotationDeg = {0.0f, float(k) * 40.0f, 0.0f};
+        patch.push_back(d);
+    }
+    return patch;
+}
+
 // The GPU tests' small scene: two grown shrubs (about 4k triangles each) on the ground, leaf preset at
 // 16 nodes, 96x64 pixels: seconds to grow, light and trace on the CPU, which is the oracle.
 inline Scene twoShrubs()

@@ -23,6 +23,18 @@ namespace {
 
 constexpr float kNoSnow = 3.0e38f, kNoRock = -2.0f;
 
+// The density rule on (eq. 2, 3): d = atLower at the lower tree line, atUpper at the upper one.
+DensityDesc densityRule(double lower, double upper, float atLower, float atUpper)
+{
+    DensityDesc d;
+    d.enabled = true;
+    d.lower = lower;
+    d.upper = upper;
+    d.atLower = atLower;
+    d.atUpper = atUpper;
+    return d;
+}
+
 struct Land {
     HeightField field;
     LandscapeBuild build;
@@ -168,12 +180,7 @@ private Q_SLOTS:
         // a canopy shades its neighbours with the light that travels level through it (a column's canopy lies
         // in one node; light from above arrives unshaded): the stand's interior loses it, its edge facing the
         // sun and the open plateau keep it.
-        DensityDesc d;
-        d.enabled = true;
-        d.lower = 30.0;
-        d.upper = 31.0;
-        d.atLower = 1.0f;
-        d.atUpper = 0.0f;
+        DensityDesc d = densityRule(30.0, 31.0, 1.0f, 0.0f);
         d.m = 65536;   // eq. 2's value 0 (kept at d = 0) for no plant here
         const auto cliff = [](float x, float) { return 60.0f * std::clamp((x - 780.0f) / 40.0f, 0.0f, 1.0f); };
         const Land l = makeLand(161, 10.0f, cliff, 10, 7.0, d);
@@ -189,12 +196,7 @@ private Q_SLOTS:
 
     void growingPlantsAreTheTraversals()
     {
-        DensityDesc d;
-        d.enabled = true;
-        d.lower = 100.0;
-        d.upper = 300.0;
-        d.atLower = 1.0f;
-        d.atUpper = 0.2f;
+        const DensityDesc d = densityRule(100.0, 300.0, 1.0f, 0.2f);
         const Land l = makeLand(81, 10.0f, [](float x, float z) { return 0.3f * x + 40.0f * std::sin(z * 0.01f); }, 8, 6.0, d);
         const LandscapeLight r = solve(l, crown(), glm::vec3(0.8f, 0.4f, 0.3f));
         const LandscapeLayout& L = l.build.layout;

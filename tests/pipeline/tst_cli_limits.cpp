@@ -127,14 +127,11 @@ private Q_SLOTS:
             QVERIFY2(!r.err.contains("bands"), qPrintable(r.err));
             // 320x200 x 68 B = 4.4 MB of film does not fit in 80% of 2 MB; the grids come from the cache.
             // Bands: a quarter of 2 MB over 320 x (56 B of film + 24 B of pictures) per row = 20 rows, 16 in 8s.
-            QProcess p;
             QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
             if (c.extra.isEmpty()) env.insert("SYLVA_MEMORY_LIMIT_MB", "2");
-            p.setProcessEnvironment(env);
-            p.start(SYLVA_CLI_PATH, common + c.extra + QStringList{"-o", banded});
-            QVERIFY(p.waitForFinished(600000));
-            const QString err = QString::fromUtf8(p.readAllStandardError());
-            QVERIFY2(p.exitCode() == 0, qPrintable(err));
+            const Run bandedRun = test::runProgram(SYLVA_CLI_PATH, common + c.extra + QStringList{"-o", banded}, env);
+            const QString& err = bandedRun.err;
+            QVERIFY2(bandedRun.code == 0, qPrintable(err));
             QVERIFY2(err.contains(c.extra.isEmpty() ? "in 13 bands of 16 rows (the whole frame does not fit" : "in 29 bands of 7 rows"),
                      qPrintable(err));
             const ImageRgba a = readImage(whole.toStdString()), b = readImage(banded.toStdString());

@@ -56,13 +56,7 @@ Scene openGround()
 Scene shrubPatch()
 {
     Scene s = openGround();
-    s.instances.clear();
-    for (int k = 0; k < 9; ++k) {
-        InstanceDesc d;
-        d.position = {double(k % 3) * 1.6 - 1.6, 0.0, double(k / 3) * 1.6 + 2.0};
-        d.rotationDeg = {0.0f, float(k) * 40.0f, 0.0f};
-        s.instances.push_back(d);
-    }
+    s.instances = test::patchOfNine(1.6);
     s.camera.position = {0.0, 5.0, -3.0};
     s.camera.target = {0.0, 0.0, 3.6};
     s.render.width = 40;

@@ -31,12 +31,7 @@ Scene shrubPatch()
     Scene s;
     s.species.resize(1);
     s.species[0].name = "shrub";
-    for (int k = 0; k < 9; ++k) {
-        InstanceDesc d;
-        d.position = {double(k % 3) * 3.0 - 3.0, 0.0, double(k / 3) * 3.0 + 2.0};
-        d.rotationDeg = {0.0f, float(k) * 40.0f, 0.0f};
-        s.instances.push_back(d);
-    }
+    s.instances = test::patchOfNine(3.0);
     s.camera.position = {0.0, 6.0, -6.0};
     s.camera.target = {0.0, 0.0, 6.0};
     s.sun.direction = glm::vec3(0.5f, 0.7f, 0.2f);
