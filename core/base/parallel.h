@@ -88,7 +88,7 @@ struct HostExec {
 // the chunks beside it (a trapezoid: stage s stops s slabs short of each inner edge), then each inner edge
 // finishes stages 1 .. over the 2s slabs around it. Every value is computed from the same inputs as in
 // stage-by-stage passes, so the bits do not depend on the chunks or the thread count (tst_parallel checks
-// both against those passes). Used by the smoke simulation's V-cycle (core/volume/smoke.cpp).
+// both against those passes). Used by the smoke simulation's V-cycle (core/volume/smoke_multigrid.cpp).
 template <class Stage>
 void pipelineSlabs(int n, int stages, const Stage& stage)
 {

@@ -16,6 +16,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -28,6 +29,8 @@ class Progress;
 }
 
 namespace sylva::volume {
+
+class PressureSolver;   // smoke_multigrid.h
 
 // The parameters `sylva simulate` and the studio's smoke form set, each declared once
 // (core/base/param_spec.h): the members' defaults, validateSmoke, the options and --help, the form's
@@ -161,14 +164,25 @@ public:
     DensityGrid temperatureGrid() const;   // temperature in .density (not bounded to [0, 1])
 
 private:
-    struct Solver;
+    // The phases of step() after the copy of the velocity into m_u1, m_v1, m_w1 (smoke_step.cpp; the
+    // self-advection in smoke_advect.cpp): the forces on the copy, the CFL number of the copy (throws
+    // over the limit), the copy advected into m_u, m_v, m_w, then (after project and advectScalars) the
+    // scalars' decay and the sources' emission.
+    void addBuoyancy(float dt);
+    void addVorticityConfinement(float dt);
+    void setSourceVelocities();
+    double checkedCfl() const;
+    void advectVelocity(float dt);
+    void decayScalars(float dt);
+    void emitSources();
+
     SmokeSettings m_s;
     int m_steps = 0;
     SmokeStepStats m_stats;
     std::vector<float> m_density, m_temperature, m_u, m_v, m_w;
     std::vector<uint8_t> m_solid;
     std::vector<double> m_pressure;
-    Solver* m_solver = nullptr;
+    std::unique_ptr<PressureSolver> m_solver;
     // Scratch kept from step to step: a step allocating these afresh spent over a third of its time
     // in the kernel clearing new pages (perf, 128^3). Their values never carry over.
     std::vector<float> m_u1, m_v1, m_w1, m_oldDensity, m_oldTemperature, m_vorticityMag;
