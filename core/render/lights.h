@@ -10,8 +10,8 @@ namespace sylva {
 
 inline constexpr float kLightPi = 3.14159265358979f;
 
-// What a light adds to a surface point's parts: `local` direct light, `indirect` ambient (the constant sky's
-// uniform light on the Lambertian ground).
+// What the lights add to a surface point's parts, each adding its share in the list's order: `local` direct
+// light, `indirect` ambient (the constant sky's uniform light on the Lambertian ground).
 struct LightContribution {
     glm::vec3 local;
     glm::vec3 indirect;
@@ -66,14 +66,13 @@ namespace sylva {
 #define SYLVA_LIGHT_CASE(Kind, call) \
     case LightKind::Kind: return call;
 
-SYLVA_HD inline LightContribution lightDirect(const RenderView& v, const LightRecord& l, const SurfacePoint& s, const LightQuery& q)
+SYLVA_HD inline void lightDirect(const RenderView& v, const LightRecord& l, const SurfacePoint& s, const LightQuery& q, LightContribution& out)
 {
     switch (l.kind) {
-#define SYLVA_X(Kind) SYLVA_LIGHT_CASE(Kind, direct##Kind(v, l, s, q))
+#define SYLVA_X(Kind) SYLVA_LIGHT_CASE(Kind, direct##Kind(v, l, s, q, out))
         SYLVA_LIGHT_KINDS(SYLVA_X)
 #undef SYLVA_X
     }
-    return LightContribution{glm::vec3(0.0f), glm::vec3(0.0f)};
 }
 
 SYLVA_HD inline bool lightShadowRay(const RenderView& v, const LightRecord& l, const SurfacePoint& s, Ray& r)

@@ -114,14 +114,12 @@ SYLVA_HD SYLVA_INLINE SampleParts backgroundStage(const RenderView& v, const Ray
 SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& s, int px = 0, int py = 0, int sample = 0,
                                        const int* seen = nullptr)
 {
-    SampleParts out{glm::vec3(0.0f), s.indirect, s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
+    LightContribution light{glm::vec3(0.0f), s.indirect};
     for (uint32_t i = 0; i < v.lightCount; ++i) {
         const LightQuery q{px, py, sample, seen && i < uint32_t(kPacketLights) ? seen[i] : -1};
-        const LightContribution c = lightDirect(v, v.lights[i], s, q);
-        out.local += c.local;
-        out.indirect += c.indirect;
+        lightDirect(v, v.lights[i], s, q, light);
     }
-    return out;
+    return SampleParts{light.local, light.indirect, s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
 }
 
 // The stages after intersect for a camera ray whose first hit is known (found; hit and its surface sp where

@@ -11,15 +11,14 @@ SYLVA_HD SYLVA_INLINE bool shadowRayDistant(const RenderView& v, const LightReco
     return true;
 }
 
-SYLVA_HD inline LightContribution directDistant(const RenderView& v, const LightRecord& l, const SurfacePoint& s, const LightQuery& q)
+SYLVA_HD inline void directDistant(const RenderView& v, const LightRecord& l, const SurfacePoint& s, const LightQuery& q, LightContribution& out)
 {
-    LightContribution out{glm::vec3(0.0f), glm::vec3(0.0f)};
     const float nl = glm::dot(s.ng, l.direction);
-    if (!(nl > 0.0f)) return out;
-    if (!(q.seen >= 0 ? q.seen != 0 : directionVisible(v, shadowOrigin(s), l.direction))) return out;
-    out.local = reflectedLight(s, l.direction, nl, l.radiance);
-    if (v.volumeCount > 0) out.local *= volumeTransmittance(volumeViewOf(v), s.p, l.direction);   // cloud shadows
-    return out;
+    if (!(nl > 0.0f)) return;
+    if (!(q.seen >= 0 ? q.seen != 0 : directionVisible(v, shadowOrigin(s), l.direction))) return;
+    glm::vec3 c = reflectedLight(s, l.direction, nl, l.radiance);
+    if (v.volumeCount > 0) c *= volumeTransmittance(volumeViewOf(v), s.p, l.direction);   // cloud shadows
+    out.local += c;
 }
 
 SYLVA_HD SYLVA_INLINE LightSample sampleDistant(const RenderView&, const LightRecord& l, const glm::vec3&, glm::vec2)

@@ -2,7 +2,7 @@
 // light is a header <kind>_light.h (included by core/render/lights.h) with its functions, its line here and
 // the record fields it needs; docs/ARCHITECTURE.md walks through it with the point light. Each kind K
 // provides, for the shading code on every backend:
-//   SYLVA_HD LightContribution directK(const RenderView&, const LightRecord&, const SurfacePoint&, const LightQuery&)
+//   SYLVA_HD void directK(const RenderView&, const LightRecord&, const SurfacePoint&, const LightQuery&, LightContribution&)
 //       what it adds to a surface point's parts (`local`: direct light; `indirect`: the uniform sky's ambient on
 //       the ground), with its shadow rays (or the answer the packet path traced, LightQuery::seen);
 //   SYLVA_HD bool shadowRayK(const RenderView&, const LightRecord&, const SurfacePoint&, Ray&)

@@ -12,20 +12,19 @@ SYLVA_HD SYLVA_INLINE bool shadowRayPoint(const RenderView& v, const LightRecord
     return true;
 }
 
-SYLVA_HD inline LightContribution directPoint(const RenderView& v, const LightRecord& l, const SurfacePoint& s, const LightQuery& q)
+SYLVA_HD inline void directPoint(const RenderView& v, const LightRecord& l, const SurfacePoint& s, const LightQuery& q, LightContribution& out)
 {
-    LightContribution out{glm::vec3(0.0f), glm::vec3(0.0f)};
     const glm::vec3 d = l.position - s.p;
     const float r2 = glm::dot(d, d);
-    if (!(r2 > 0.0f)) return out;
+    if (!(r2 > 0.0f)) return;
     const float r = sqrtf(r2);
     const glm::vec3 wi = d / r;
     const float nl = glm::dot(s.ng, wi);
-    if (!(nl > 0.0f)) return out;
-    if (!(q.seen >= 0 ? q.seen != 0 : segmentVisible(v, shadowOrigin(s), l.position))) return out;
-    out.local = reflectedLight(s, wi, nl, l.radiance / r2);
-    if (v.volumeCount > 0) out.local *= volumeTransmittance(volumeViewOf(v), s.p, wi, r);
-    return out;
+    if (!(nl > 0.0f)) return;
+    if (!(q.seen >= 0 ? q.seen != 0 : segmentVisible(v, shadowOrigin(s), l.position))) return;
+    glm::vec3 c = reflectedLight(s, wi, nl, l.radiance / r2);
+    if (v.volumeCount > 0) c *= volumeTransmittance(volumeViewOf(v), s.p, wi, r);
+    out.local += c;
 }
 
 SYLVA_HD SYLVA_INLINE LightSample samplePoint(const RenderView&, const LightRecord& l, const glm::vec3& p, glm::vec2)

@@ -41,12 +41,10 @@ SYLVA_HD inline glm::vec3 skyLightIrradiance(const RenderView& v, const glm::vec
 
 SYLVA_HD SYLVA_INLINE bool shadowRaySky(const RenderView&, const LightRecord&, const SurfacePoint&, Ray&) { return false; }
 
-SYLVA_HD inline LightContribution directSky(const RenderView& v, const LightRecord&, const SurfacePoint& s, const LightQuery& q)
+SYLVA_HD inline void directSky(const RenderView& v, const LightRecord&, const SurfacePoint& s, const LightQuery& q, LightContribution& out)
 {
-    LightContribution out{glm::vec3(0.0f), glm::vec3(0.0f)};
-    if (v.sky.lightCount > 0) out.local = s.albedo * skyLightIrradiance(v, shadowOrigin(s), s.ng, q.px, q.py, q.sample);
-    if (s.ground) out.indirect = s.albedo * v.sky.constant;
-    return out;
+    if (v.sky.lightCount > 0) out.local += s.albedo * skyLightIrradiance(v, shadowOrigin(s), s.ng, q.px, q.py, q.sample);
+    if (s.ground) out.indirect += s.albedo * v.sky.constant;
 }
 
 // The sky's radiance toward unit dir: the constant sky's colour, else the Preetham or map sky's.
