@@ -325,10 +325,10 @@ bool Viewport::paintGpu()
     const size_t pass = m_gpuPass;
     const bool last = pass + 1 == spps.size();
     placeViewFrame(m_gpuFrame->frame, m_scene, sunRadiance(m_scene.sun), w, h, spps[pass]);
-    const uint32_t skyLights = rs.base.sky.lightCount;
-    if (refine.frames > 0 && !last) rs.base.sky.lightCount = 0;   // moving: the sun alone
+    const uint32_t skyLights = rs.frame.sky.lightCount;
+    if (refine.frames > 0 && !last) rs.frame.sky.lightCount = 0;   // moving: the sun alone
     m_gpuFrame->device->place(rs);
-    rs.base.sky.lightCount = skyLights;
+    rs.frame.sky.lightCount = skyLights;
     // The last pass is also kept on the host (lastImage(), tests, export of what is shown).
     QImage picture;
     if (last) picture = QImage(w, h, QImage::Format_RGBX8888);

@@ -92,7 +92,7 @@ void countBytes(RenderScene& rs)
 #define SYLVA_X(part, where, T, name, stat) bytes[size_t(ArrayStat::stat)] += rs.name.size() * sizeof(T);
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
-    AccelStats& st = rs.m_stats;
+    AccelStats& st = rs.buildStats;
     const bool kd = rs.accel == AccelKind::KdTree;
     st.tlasBytes = bytes[size_t(ArrayStat::Tlas)];
     st.wideTlasBytes = bytes[size_t(ArrayStat::WideTlas)];
@@ -136,7 +136,7 @@ InstanceRecord makeInstance(const InstanceDesc& inst, const glm::dvec3& frameOri
 
 RenderView RenderScene::view() const
 {
-    RenderView v = base;
+    RenderView v = frame;
 #define SYLVA_X(part, where, T, name, stat) v.name = name.empty() ? nullptr : name.data();
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
@@ -190,9 +190,9 @@ void placeLights(RenderScene& rs, const FrameSun& sun)
 
 void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
 {
-    rs.base.sky.model = sky::SkyView{};
-    rs.base.sky.lightCount = 0;
-    rs.base.sky.interleave = sky::Interleave{};
+    rs.frame.sky.model = sky::SkyView{};
+    rs.frame.sky.lightCount = 0;
+    rs.frame.sky.interleave = sky::Interleave{};
     rs.skyMap.clear();
     rs.skyLights.clear();
     if (!d.analytic()) return;
@@ -204,10 +204,10 @@ void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
     sky::SkyView v = built.view();
     if (built.kind == sky::SkyKind::Map && built.map) rs.skyMap = built.map->rgb;
     v.map.rgb = nullptr;   // the frame's skyMap array (host or device) is read instead
-    rs.base.sky.model = v;
+    rs.frame.sky.model = v;
     rs.skyLights = sky::skyLights(built, d.lights, 512, groundPlane);
-    rs.base.sky.lightCount = uint32_t(rs.skyLights.size());
-    rs.base.sky.interleave = sky::makeInterleave(d.interleave, int(rs.skyLights.size()));
+    rs.frame.sky.lightCount = uint32_t(rs.skyLights.size());
+    rs.frame.sky.interleave = sky::makeInterleave(d.interleave, int(rs.skyLights.size()));
 }
 
 namespace {
@@ -291,7 +291,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     const glm::dvec3 origin = scene.camera.position;
     const std::vector<int> level = instanceLevels(scene, rs.meshLevels);
 
-    AccelStats& st = rs.m_stats;
+    AccelStats& st = rs.buildStats;
     st.instancedTriangles = 0.0;
     std::fill(std::begin(st.instancesPerLevel), std::end(st.instancesPerLevel), size_t(0));
     rs.instances.clear();
@@ -326,7 +326,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     st.instances = ni;
 
     // Environment, camera, settings.
-    RenderView& b = rs.base;
+    RenderView& b = rs.frame;
     const TerrainDesc& t = scene.terrain;
     b.ground.enabled = groundPlaneShown(scene);   // a terrain is the ground
     b.ground.y = float(scene.ground.height - origin.y);
@@ -340,7 +340,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
         b.terrain.snowY = terrainSnowY(t);
         // The height field's and the landscape's frames are rebased under the camera, in double (Dietrich et
         // al. 2006 at UTM coordinates: millions of metres from the world origin, centimetres near the camera).
-        const HeightFieldLayout& L = rs.base.terrain.layout;
+        const HeightFieldLayout& L = rs.frame.terrain.layout;
         const glm::dvec3 camLocal = origin - t.origin;   // the camera in the DEM's frame
         const auto nearest = [](double x, double step, uint32_t n) { return int32_t(std::clamp(std::floor(x / step), 0.0, double(n))); };
         b.terrain.baseI = nearest(camLocal.x, double(L.dx), L.nx - 1);

@@ -88,12 +88,12 @@ enum class LodLevels { Used, All };
 class RenderScene {
 public:
     RenderView view() const;
-    const AccelStats& stats() const { return m_stats; }
+    const AccelStats& stats() const { return buildStats; }
 
 #define SYLVA_X(part, where, T, name, stat) std::vector<T> name;
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
-    RenderView base{};                  // environment, camera and settings (pointers filled by view())
+    RenderView frame{};                 // the frame's records (surface kinds, sky), camera and settings; view() fills its pointers
 
     // What placeTopLevel needs of the camera-independent part (host only, never traced).
     struct MeshLevels {
@@ -109,7 +109,7 @@ public:
                                                // landscape's lattice is solved again after a landscape edit)
     AccelKind accel = AccelKind::Bvh;          // the mesh structures built
     LodLevels lodLevels = LodLevels::Used;
-    AccelStats m_stats;
+    AccelStats buildStats;                     // what the builders record (read through stats())
 };
 
 // Step 1: the camera-independent part. One BVH (or, for accel kdtree, one kd-tree) per species and per

@@ -22,7 +22,7 @@ RenderSceneHeader renderSceneHeader(const RenderScene& rs)
 #define SYLVA_X(part, where, T, name, stat) h.counts[i++] = rs.name.size();
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
-    h.base = rs.base;
+    h.frame = rs.frame;
     return h;
 }
 
@@ -41,7 +41,7 @@ RenderScene allocateRenderScene(const RenderSceneHeader& h)
 #define SYLVA_X(part, where, T, name, stat) rs.name.resize(size_t(h.counts[i++]));
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
-    rs.base = h.base;
+    rs.frame = h.frame;
     return rs;
 }
 
@@ -81,7 +81,7 @@ void packRenderScene(const RenderScene& rs, const RenderSceneHeader& h, const Pa
 
 RenderView packedFrameView(const RenderSceneHeader& h, const PackedFrame& layout, const void* block)
 {
-    RenderView v = h.base;
+    RenderView v = h.frame;
     const char* b = static_cast<const char*>(block);
     size_t i = 0;
 #define SYLVA_X(part, where, T, name, stat) v.name = h.counts[i] ? reinterpret_cast<const T*>(b + layout.offset[i]) : nullptr, ++i;

@@ -28,7 +28,7 @@ static_assert(std::is_trivially_copyable_v<RenderView>, "the view's settings tra
 
 struct RenderSceneHeader {
     uint64_t counts[kRenderSceneArrays];
-    RenderView base;
+    RenderView frame;
 };
 
 RenderSceneHeader renderSceneHeader(const RenderScene& rs);

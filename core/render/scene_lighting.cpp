@@ -34,10 +34,10 @@ lb::LbParams forestGridParams(const Scene& scene, int optics)
 // plants grow now, applied unless off or (auto) exposure is uniform over the cells with plants.
 void buildLandscapeLight(RenderScene& rs, const Scene& scene)
 {
-    LandscapeLightStats& st = rs.m_stats.landscapeLight;
+    LandscapeLightStats& st = rs.buildStats.landscapeLight;
     st = LandscapeLightStats{};
     rs.landLight.clear();
-    rs.base.landscape.lightLayout = LandLightLayout{};
+    rs.frame.landscape.lightLayout = LandLightLayout{};
     const ForestGridMode mode = scene.lighting.forestGrid;
     if (mode == ForestGridMode::Off || rs.landCells.empty()) return;
     const int optics = forestOptics(rs.forestSpecies);
@@ -48,7 +48,7 @@ void buildLandscapeLight(RenderScene& rs, const Scene& scene)
     const TerrainDesc& t = scene.terrain;
     LandscapeLightSettings settings;
     settings.resolution = scene.lighting.forestGridResolution;
-    LandscapeLight l = solveLandscapeLight(*t.field, rs.base.landscape.layout, rs.landCells, rs.tileRecords, rs.tilePlants, terrainSnowY(t), terrainRockCos(t),
+    LandscapeLight l = solveLandscapeLight(*t.field, rs.frame.landscape.layout, rs.landCells, rs.tileRecords, rs.tilePlants, terrainSnowY(t), terrainRockCos(t),
                                            rs.forestSpecies, forestGridParams(scene, optics), settings);
     st.solved = l.cellsWithPlants > 0;
     st.resolution = l.resolution;
@@ -67,7 +67,7 @@ void buildLandscapeLight(RenderScene& rs, const Scene& scene)
     st.applied = st.solved && !st.skipped;
     if (!st.applied) return;
     rs.landLight = std::move(l.nodes);
-    rs.base.landscape.lightLayout = l.layout;
+    rs.frame.landscape.lightLayout = l.layout;
 }
 
 // The forest-level LB grid (core/lb/forest_grid.h) over the scene's top-level instances of species with a
@@ -76,7 +76,7 @@ void buildLandscapeLight(RenderScene& rs, const Scene& scene)
 // differs: factors and face factors spread by at least uniformSpread (2%).
 void buildForestGrid(RenderScene& rs, const Scene& scene)
 {
-    ForestGridStats& st = rs.m_stats.forestGrid;
+    ForestGridStats& st = rs.buildStats.forestGrid;
     const ForestGridMode mode = scene.lighting.forestGrid;
     st = ForestGridStats{};
     st.mode = forestGridModeName(mode);

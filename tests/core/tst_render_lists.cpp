@@ -25,15 +25,15 @@ RenderScene makeFrame(const std::vector<SphereRecord>& spheres, const std::vecto
     cam.position = glm::dvec3(0.0);
     cam.target = glm::dvec3(0.0, 0.0, -1.0);
     cam.fovY = 40.0f;
-    rs.base.camera = makeCamera(cam, kW, kH);
-    rs.base.width = kW;
-    rs.base.height = kH;
-    rs.base.spp = 1;
-    rs.base.shadows = true;
-    rs.base.indirectScale = 1.0f;
-    rs.base.ground.enabled = ground;
-    rs.base.ground.y = groundY;
-    rs.base.ground.color = glm::vec3(0.5f, 0.4f, 0.3f);
+    rs.frame.camera = makeCamera(cam, kW, kH);
+    rs.frame.width = kW;
+    rs.frame.height = kH;
+    rs.frame.spp = 1;
+    rs.frame.shadows = true;
+    rs.frame.indirectScale = 1.0f;
+    rs.frame.ground.enabled = ground;
+    rs.frame.ground.y = groundY;
+    rs.frame.ground.color = glm::vec3(0.5f, 0.4f, 0.3f);
     rs.sphereRecords = spheres;
     rs.lights = lights;
     return rs;
@@ -176,7 +176,7 @@ private Q_SLOTS:
     void sampleEvalPdfAgree()
     {
         RenderScene rs = makeFrame({}, {}, false);
-        rs.base.sky.constant = glm::vec3(0.25f, 0.5f, 1.0f);
+        rs.frame.sky.constant = glm::vec3(0.25f, 0.5f, 1.0f);
         LightRecord skyLight{};
         skyLight.kind = LightKind::Sky;
         const LightRecord sun = distant(glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(2.0f));
@@ -196,7 +196,7 @@ private Q_SLOTS:
             e += glm::dvec3(s.value) * double(std::max(0.0f, s.wi.y));
         }
         e /= double(n);
-        for (int k = 0; k < 3; ++k) QVERIFY(std::fabs(e[k] - kLightPi * rs.base.sky.constant[k]) < 0.01 * kLightPi * rs.base.sky.constant[k]);
+        for (int k = 0; k < 3; ++k) QVERIFY(std::fabs(e[k] - kLightPi * rs.frame.sky.constant[k]) < 0.01 * kLightPi * rs.frame.sky.constant[k]);
         const LightSample ss = lightSample(v, v.lights[0], glm::vec3(0.0f), glm::vec2(0.5f));
         QVERIFY(ss.delta && ss.wi == sun.direction && near(ss.value.x, kLightPi * 2.0f, 1e-6f));
         QCOMPARE(lightPdf(v, v.lights[0], sun.direction), 0.0f);

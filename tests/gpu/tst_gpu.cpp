@@ -555,7 +555,7 @@ private Q_SLOTS:
         });
         QCOMPARE(arrays, kRenderSceneArrays);
         QVERIFY(bytes > 100000);
-        QVERIFY(std::memcmp(&back.base, &rs.base, sizeof(RenderView)) == 0);
+        QVERIFY(std::memcmp(&back.frame, &rs.frame, sizeof(RenderView)) == 0);
         const Film again = renderFilm(back.view());
         QVERIFY(std::memcmp(again.pixels.data(), film.pixels.data(), film.pixels.size() * sizeof(SampleParts)) == 0);
 

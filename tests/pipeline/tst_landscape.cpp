@@ -78,7 +78,7 @@ Scene flattened(const Scene& land, const RenderScene& rs, Keep keep)
     Scene s = land;
     s.terrain.cells = 0;
     s.instances.clear();
-    const LandscapeLayout& L = rs.base.landscape.layout;
+    const LandscapeLayout& L = rs.frame.landscape.layout;
     const double C = L.cellSize, k = L.tileScale;
     for (uint32_t cz = 0; cz < L.cellsZ; ++cz)
         for (uint32_t cx = 0; cx < L.cellsX; ++cx) {
@@ -191,7 +191,7 @@ private Q_SLOTS:
         for (double tileSize : {16.0, 20.0}) {
             const Scene land = landscape(97, hills, 6, tileSize);
             const RenderScene rs = buildRenderScene(land, m_assets, glm::vec3(1.0f));
-            QVERIFY(rs.base.landscape.enabled);
+            QVERIFY(rs.frame.landscape.enabled);
             const Scene flat = flattened(land, rs, [](uint32_t, uint32_t, uint32_t, double) { return true; });
             QVERIFY(flat.instances.size() > 1000);
             const RenderScene fs = buildRenderScene(flat, m_assets, glm::vec3(1.0f));

@@ -64,8 +64,8 @@ void buildGroupGeometry(RenderScene& rs, const Scene& scene, const std::vector<u
         rs.geometryBounds[record] = bvh.bounds;
         rs.geometryTriangles[record] = triangles;
     }
-    rs.m_stats.groups = scene.groups.size();
-    rs.m_stats.groupInstances = rs.groupInstances.size();
+    rs.buildStats.groups = scene.groups.size();
+    rs.buildStats.groupInstances = rs.groupInstances.size();
 }
 
 } // namespace sylva::scene_build

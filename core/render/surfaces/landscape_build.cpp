@@ -17,8 +17,8 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
     rs.tileRecords.clear();
     rs.tileNodes.clear();
     rs.tilePlants.clear();
-    rs.base.landscape.layout = LandscapeLayout{};
-    rs.m_stats.landscape = LandscapeStats{};
+    rs.frame.landscape.layout = LandscapeLayout{};
+    rs.buildStats.landscape = LandscapeStats{};
     // The landscape (Dietrich, Marmitt & Slusallek, "Terrain Guided Multi-Level Instancing of Highly Complex
     // Plant Populations"): Wang tiles of the species' full meshes on the terrain's cells.
     if (scene.terrain.enabled() && scene.terrain.cells > 0) {
@@ -35,8 +35,8 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
         rs.tileRecords = std::move(lb.tiles);
         rs.tileNodes = std::move(lb.tileNodes);
         rs.tilePlants = std::move(lb.plants);
-        rs.base.landscape.layout = lb.layout;
-        rs.m_stats.landscape = lb.stats;
+        rs.frame.landscape.layout = lb.layout;
+        rs.buildStats.landscape = lb.stats;
     }
     buildLandscapeLight(rs, scene);
     countBytes(rs);
@@ -45,7 +45,7 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
 void setLandscapeDensity(RenderScene& rs, const Scene& scene)
 {
     if (rs.landCells.empty()) return;
-    setLandscapeDensity(rs.base.landscape.layout, scene.terrain.density, scene.terrain.origin.y);
+    setLandscapeDensity(rs.frame.landscape.layout, scene.terrain.density, scene.terrain.origin.y);
     buildLandscapeLight(rs, scene);
     countBytes(rs);
 }

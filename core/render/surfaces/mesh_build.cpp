@@ -310,9 +310,9 @@ void buildMeshGeometry(RenderScene& rs, const Scene& scene, const std::vector<Sp
             }
         }
         rs.species.push_back(sr);
-        rs.m_stats.speciesTriangles += m.triangles.size();
-        rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, meshes[s].bvh.depth);
-        rs.m_stats.maxWideBlasDepth = std::max(rs.m_stats.maxWideBlasDepth, meshes[s].bvh.wideDepth);
+        rs.buildStats.speciesTriangles += m.triangles.size();
+        rs.buildStats.maxBlasDepth = std::max(rs.buildStats.maxBlasDepth, meshes[s].bvh.depth);
+        rs.buildStats.maxWideBlasDepth = std::max(rs.buildStats.maxWideBlasDepth, meshes[s].bvh.wideDepth);
     }
 
     // Pruned levels: own triangles and BVH, the species' shading data and lighting grid.
@@ -328,11 +328,11 @@ void buildMeshGeometry(RenderScene& rs, const Scene& scene, const std::vector<Sp
             gr, geo.bvh, triBase[geo.species], [&p](uint32_t prim, int c) { return p.corners[3 * size_t(prim) + size_t(c)]; },
             [&p](uint32_t prim) { return p.tris[prim]; });
         rs.geometries.push_back(gr);
-        rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, geo.bvh.depth);
-        rs.m_stats.maxWideBlasDepth = std::max(rs.m_stats.maxWideBlasDepth, geo.bvh.wideDepth);
+        rs.buildStats.maxBlasDepth = std::max(rs.buildStats.maxBlasDepth, geo.bvh.depth);
+        rs.buildStats.maxWideBlasDepth = std::max(rs.buildStats.maxWideBlasDepth, geo.bvh.wideDepth);
     }
-    rs.m_stats.prunedLevels = meshes.size() - ns;
-    rs.m_stats.pruneBytes = (rs.blasNodes.size() - nodesBefore) * sizeof(BvhNode) + (rs.tris.size() - trisBefore) * sizeof(TriAccel) +
+    rs.buildStats.prunedLevels = meshes.size() - ns;
+    rs.buildStats.pruneBytes = (rs.blasNodes.size() - nodesBefore) * sizeof(BvhNode) + (rs.tris.size() - trisBefore) * sizeof(TriAccel) +
                             (rs.blocks.size() - blocksBefore) * sizeof(TriBlock) +
                             (rs.blasWideNodes.size() - wideBefore) * sizeof(BvhNode8);
 
@@ -351,7 +351,7 @@ void buildMeshGeometry(RenderScene& rs, const Scene& scene, const std::vector<Sp
         gr.hi = meshes[g].bvh.bounds.hi;
     }
     if (scene.render.accel == AccelKind::KdTree) {
-        rs.m_stats.maxBlasDepth = 0;
+        rs.buildStats.maxBlasDepth = 0;
         std::vector<KdTree> kd(nm);
         tbb::parallel_for(size_t(0), nm, [&](size_t g) {
             const TriAccel* tris = rs.tris.data() + rs.geometries[g].triOffset;
@@ -377,7 +377,7 @@ void buildMeshGeometry(RenderScene& rs, const Scene& scene, const std::vector<Sp
             gr.kdRefOffset = uint32_t(rs.kdRefs.size());
             rs.kdNodes.insert(rs.kdNodes.end(), kd[g].nodes.begin(), kd[g].nodes.end());
             rs.kdRefs.insert(rs.kdRefs.end(), kd[g].primRefs.begin(), kd[g].primRefs.end());
-            rs.m_stats.maxBlasDepth = std::max(rs.m_stats.maxBlasDepth, kd[g].stats.depth);
+            rs.buildStats.maxBlasDepth = std::max(rs.buildStats.maxBlasDepth, kd[g].stats.depth);
         }
     }
 }

@@ -11,9 +11,9 @@ void buildTerrainArrays(RenderScene& rs, const Scene& scene)
     const HeightField& hf = *scene.terrain.field;
     rs.terrainHeights = hf.heights;
     rs.terrainRanges = hf.ranges;
-    rs.base.terrain.layout = hf.layout;
-    rs.m_stats.terrainSamplesX = hf.layout.nx;
-    rs.m_stats.terrainSamplesZ = hf.layout.nz;
+    rs.frame.terrain.layout = hf.layout;
+    rs.buildStats.terrainSamplesX = hf.layout.nx;
+    rs.buildStats.terrainSamplesZ = hf.layout.nz;
 }
 
 } // namespace sylva::scene_build
