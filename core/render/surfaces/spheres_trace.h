@@ -12,6 +12,7 @@ template <bool AnyHit, bool Kd>
 SYLVA_HD inline bool traceSpheres(Query& q, const Ray& ray, float& tmax)
 {
     const RenderView& v = q.v;
+    if (v.spheres.count == 0) return false;
     const float a = glm::dot(ray.dir, ray.dir);
     if (!(a > 0.0f)) return false;
     for (uint32_t i = 0; i < v.spheres.count; ++i) {
