@@ -8,8 +8,6 @@
 
 namespace sylva {
 
-inline constexpr float kLightPi = 3.14159265358979f;
-
 // What the lights add to a surface point's parts, each adding its share in the list's order: `local` direct
 // light, `indirect` ambient (the constant sky's uniform light on the Lambertian ground).
 struct LightContribution {

@@ -196,13 +196,13 @@ private Q_SLOTS:
             e += glm::dvec3(s.value) * double(std::max(0.0f, s.wi.y));
         }
         e /= double(n);
-        for (int k = 0; k < 3; ++k) QVERIFY(std::fabs(e[k] - kLightPi * rs.frame.sky.constant[k]) < 0.01 * kLightPi * rs.frame.sky.constant[k]);
+        for (int k = 0; k < 3; ++k) QVERIFY(std::fabs(e[k] - sky::kPi * rs.frame.sky.constant[k]) < 0.01 * sky::kPi * rs.frame.sky.constant[k]);
         const LightSample ss = lightSample(v, v.lights[0], glm::vec3(0.0f), glm::vec2(0.5f));
-        QVERIFY(ss.delta && ss.wi == sun.direction && near(ss.value.x, kLightPi * 2.0f, 1e-6f));
+        QVERIFY(ss.delta && ss.wi == sun.direction && near(ss.value.x, sky::kPi * 2.0f, 1e-6f));
         QCOMPARE(lightPdf(v, v.lights[0], sun.direction), 0.0f);
         QCOMPARE(lightEval(v, v.lights[0], sun.direction), glm::vec3(0.0f));
         const LightSample ls = lightSample(v, v.lights[2], glm::vec3(0.0f, 0.0f, 0.0f), glm::vec2(0.5f));
-        QVERIFY(ls.delta && near(ls.distance, 2.0f, 1e-6f) && near(ls.value.x, kLightPi * 8.0f / 4.0f, 1e-6f));
+        QVERIFY(ls.delta && near(ls.distance, 2.0f, 1e-6f) && near(ls.value.x, sky::kPi * 8.0f / 4.0f, 1e-6f));
         QCOMPARE(ls.wi, glm::vec3(0.0f, 1.0f, 0.0f));
     }
 };

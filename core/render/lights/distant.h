@@ -23,7 +23,7 @@ SYLVA_HD inline void directDistant(const RenderView& v, const LightRecord& l, co
 
 SYLVA_HD SYLVA_INLINE LightSample sampleDistant(const RenderView&, const LightRecord& l, const glm::vec3&, glm::vec2)
 {
-    return LightSample{l.direction, l.radiance * kLightPi, 1.0f, 3.0e38f, true};
+    return LightSample{l.direction, l.radiance * sky::kPi, 1.0f, 3.0e38f, true};
 }
 
 SYLVA_HD SYLVA_INLINE glm::vec3 evalDistant(const RenderView&, const LightRecord&, const glm::vec3&) { return glm::vec3(0.0f); }

@@ -33,7 +33,7 @@ SYLVA_HD SYLVA_INLINE LightSample samplePoint(const RenderView&, const LightReco
     const float r2 = glm::dot(d, d);
     if (!(r2 > 0.0f)) return LightSample{glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f), 1.0f, 0.0f, true};
     const float r = sqrtf(r2);
-    return LightSample{d / r, l.radiance * (kLightPi / r2), 1.0f, r, true};
+    return LightSample{d / r, l.radiance * (sky::kPi / r2), 1.0f, r, true};
 }
 
 SYLVA_HD SYLVA_INLINE glm::vec3 evalPoint(const RenderView&, const LightRecord&, const glm::vec3&) { return glm::vec3(0.0f); }

@@ -54,13 +54,13 @@ SYLVA_HD SYLVA_INLINE glm::vec3 evalSky(const RenderView& v, const LightRecord&,
 }
 
 // Uniform over the sphere (y up).
-SYLVA_HD SYLVA_INLINE float pdfSky(const RenderView&, const LightRecord&, const glm::vec3&) { return 1.0f / (4.0f * kLightPi); }
+SYLVA_HD SYLVA_INLINE float pdfSky(const RenderView&, const LightRecord&, const glm::vec3&) { return 1.0f / (4.0f * sky::kPi); }
 
 SYLVA_HD inline LightSample sampleSky(const RenderView& v, const LightRecord& l, const glm::vec3&, glm::vec2 u)
 {
     const float y = 1.0f - 2.0f * u.x;
     const float r = sqrtf(fmaxf(0.0f, 1.0f - y * y));
-    const float phi = 2.0f * kLightPi * u.y;
+    const float phi = 2.0f * sky::kPi * u.y;
     const glm::vec3 wi(r * cosf(phi), y, r * sinf(phi));
     return LightSample{wi, evalSky(v, l, wi) / pdfSky(v, l, wi), pdfSky(v, l, wi), 3.0e38f, false};
 }
