@@ -16,6 +16,8 @@
 #include <QVBoxLayout>
 
 #include "pipeline/grow/tree_grower.h"
+#include "pipeline/scene/scene_fields.h"
+#include "studio/param_widgets.h"
 
 namespace sylva {
 
@@ -25,15 +27,14 @@ GrowDialog::GrowDialog(QWidget* parent) : QDialog(parent)
     auto* form = new QFormLayout(this);
     m_species = new QComboBox;
     for (const std::string& n : speciesNames()) m_species->addItem(QString::fromStdString(n));
-    m_seed = new QSpinBox;
-    m_seed->setRange(0, 1 << 30);
+    m_seed = sceneIntSpin("species[i].grow.seed", "grow.seed");   // the scene file's range, clamped to an int
     m_seed->setValue(1);
     m_triangles = new QSpinBox;
     m_triangles->setRange(int(kMinGrowTriangles), int(kMaxGrowTriangles));
     m_triangles->setSingleStep(10000);
     m_triangles->setValue(50000);
-    m_height = new QDoubleSpinBox;
-    m_height->setRange(0.0, 150.0);
+    m_height = sceneSpin("species[i].grow.height", "grow.height", 2, 1.0);   // 0: the species' default
+    m_height->setKeyboardTracking(true);
     m_height->setSpecialValueText(tr("species default"));
     m_height->setSuffix(tr(" m"));
     form->addRow(tr("Grower species"), m_species);
@@ -52,7 +53,8 @@ GrowSpec GrowDialog::spec() const
     g.species = m_species->currentText().toStdString();
     g.seed = uint64_t(m_seed->value());
     g.triangles = uint64_t(m_triangles->value());
-    g.height = m_height->value() < 0.1 ? 0.0f : float(m_height->value());
+    const double shortest = sceneFieldRange("species[i].grow.height").lo;   // below it: 0, the species' default
+    g.height = m_height->value() < shortest ? 0.0f : float(m_height->value());
     return g;
 }
 

@@ -10,6 +10,9 @@
 #include <QRegularExpressionValidator>
 #include <QSpinBox>
 
+#include "pipeline/scene/scene_fields.h"
+#include "studio/form_widgets.h"
+
 namespace sylva {
 
 QString paramToolTip(const ParamSpec& spec)
@@ -55,5 +58,28 @@ QLineEdit* paramSeedEdit(const ParamSpec& spec, const QString& name, uint64_t va
 uint64_t paramSeed(const QLineEdit* edit) { return edit->text().toULongLong(); }
 
 void setParamSeed(QLineEdit* edit, uint64_t value) { edit->setText(QString::number(value)); }
+
+QDoubleSpinBox* sceneSpin(const char* key, const QString& name, int decimals, double step)
+{
+    const json::Bounds b = sceneFieldRange(key);
+    const double unit = std::pow(10.0, -decimals);
+    double lo = std::max(b.lo, -kWidgetLimit) + (b.loOpen ? unit : 0.0);
+    const double hi = std::min(b.hi, kWidgetLimit) - (b.hiOpen ? unit : 0.0);
+    if (b.orZero) lo = std::min(lo, 0.0);
+    QDoubleSpinBox* s = widgets::spin(name, lo, hi, decimals, step);
+    s->setRange(lo, hi);   // again: setDecimals may have rounded it
+    return s;
+}
+
+QSpinBox* sceneIntSpin(const char* key, const QString& name)
+{
+    constexpr double intLo = std::numeric_limits<int>::min(), intHi = std::numeric_limits<int>::max();
+    const json::Bounds b = sceneFieldRange(key);
+    auto* s = new QSpinBox;
+    s->setObjectName(name);
+    s->setRange(int(std::max(b.lo, intLo)), int(std::min(b.hi, intHi)));
+    s->setKeyboardTracking(false);
+    return s;
+}
 
 } // namespace sylva

@@ -1,5 +1,6 @@
 // Form widgets made from a ParamSpec (core/base/param_spec.h): the range, the tooltip (the help line with
 // range and default) and the object name come from the one declaration the CLI and the core read too.
+// Widgets over a scene file's field take their range from the scene's field table the same way.
 #pragma once
 
 #include <cstdint>
@@ -27,5 +28,13 @@ QSpinBox* paramIntSpin(const ParamSpec& spec, const QString& name, int value);
 QLineEdit* paramSeedEdit(const ParamSpec& spec, const QString& name, uint64_t value);
 uint64_t paramSeed(const QLineEdit* edit);
 void setParamSeed(QLineEdit* edit, uint64_t value);
+
+// Spin boxes over a scene file's numbers (pipeline/scene/scene_fields.h, sceneFieldRange): the range is the
+// one the file checks, looked up by the field's full key ("sun.temperature"); an open bound moves in by
+// one step of the last decimal, an unbounded side stops at +-kWidgetLimit (a bound "0 or ..." admits 0).
+// Built as widgets::spin (named `name`, committing on Enter or focus loss).
+QDoubleSpinBox* sceneSpin(const char* key, const QString& name, int decimals, double step);
+// An integer field's range, clamped to an int's.
+QSpinBox* sceneIntSpin(const char* key, const QString& name);
 
 } // namespace sylva

@@ -98,7 +98,7 @@ QWidget* PropertyPanel::buildInstancePage()
     }
     form->addRow(tr("Position (m)"), row({m_instPos[0], m_instPos[1], m_instPos[2]}));
     form->addRow(tr("Rotation (deg)"), row({m_instRot[0], m_instRot[1], m_instRot[2]}));
-    m_instScale = spin("instance.scale", 0.001, 1000.0, 3, 0.05);
+    m_instScale = sceneSpin("instances[i].scale", "instance.scale", 3, 0.05);
     connect(m_instScale, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         const int i = m_item.row;
         apply(m_instScale, tr("Scale instance"), [&](Scene& s) { s.instances.at(size_t(i)).scale = float(v); });
@@ -166,7 +166,7 @@ QWidget* PropertyPanel::buildSunPage()
 {
     auto* page = new QWidget;
     auto* form = new QFormLayout(page);
-    m_sunElevation = spin("sun.elevation", -90.0, 90.0, 1, 1.0);
+    m_sunElevation = sceneSpin("sun.elevation", "sun.elevation", 1, 1.0);
     m_sunAzimuth = spin("sun.azimuth", 0.0, 360.0, 1, 1.0);
     m_sunAzimuth->setWrapping(true);
     m_sunDial = new QDial;
@@ -176,8 +176,8 @@ QWidget* PropertyPanel::buildSunPage()
     m_sunDial->setNotchesVisible(true);
     m_sunDial->setNotchTarget(15.0);
     m_sunDial->setFixedSize(72, 72);
-    m_sunTemperature = spin("sun.temperature", 1000.0, 40000.0, 0, 100.0);
-    m_sunIntensity = spin("sun.intensity", 0.0, 100.0, 3, 0.1);
+    m_sunTemperature = sceneSpin("sun.temperature", "sun.temperature", 0, 100.0);
+    m_sunIntensity = sceneSpin("sun.intensity", "sun.intensity", 3, 0.1);
     auto setAngles = [this](QObject* editor, double elevation, double azimuth) {
         apply(editor, tr("Move sun"), [&](Scene& s) {
             s.sun.place.reset();   // by direction now (the sky panel sets the sun by date and place)
@@ -218,7 +218,7 @@ QWidget* PropertyPanel::buildCameraPage()
             apply(m_camTarget[size_t(a)], tr("Aim camera"), [&](Scene& s) { s.camera.target[a] = v; });
         });
     }
-    m_camFov = spin("camera.fov", 1.0, 170.0, 1, 1.0);
+    m_camFov = sceneSpin("camera.fov", "camera.fov", 1, 1.0);
     connect(m_camFov, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         apply(m_camFov, tr("Change field of view"), [&](Scene& s) { s.camera.fovY = float(v); });
     });

@@ -16,6 +16,7 @@
 #include "core/terrain/height_field.h"
 
 #include "studio/form_widgets.h"
+#include "studio/param_widgets.h"
 
 namespace sylva {
 using namespace widgets;
@@ -53,11 +54,11 @@ QWidget* SceneItemPages::buildTerrainPage()
     m_terrainInfo = new QLabel;
     m_terrainInfo->setWordWrap(true);
     m_terrainInfo->setTextInteractionFlags(Qt::TextSelectableByMouse);
-    m_snowLine = spin("terrain.snowLine", 0.0, 1e5, 1, 50.0);
+    m_snowLine = sceneSpin("terrain.snow_line", "terrain.snowLine", 1, 50.0);
     m_snowLine->setToolTip(tr("World height above which the ground is snow (0: no snow)"));
     connect(m_snowLine, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { m_apply(m_snowLine, tr("Change snow line"), [&](Scene& s) { s.terrain.snowLine = float(v); }); });
-    m_rockSlope = spin("terrain.rockSlope", 0.0, 90.0, 1, 1.0);
+    m_rockSlope = sceneSpin("terrain.rock_slope", "terrain.rockSlope", 1, 1.0);
     m_rockSlope->setToolTip(tr("Slopes steeper than this (degrees) are rock"));
     connect(m_rockSlope, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { m_apply(m_rockSlope, tr("Change rock slope"), [&](Scene& s) { s.terrain.rockSlope = float(v); }); });
@@ -71,11 +72,11 @@ QWidget* SceneItemPages::buildTilesPage()
 {
     auto* page = new QWidget;
     m_plantForm = new QFormLayout(page);
-    m_tileSize = spin("tiles.size", 1.0, 10000.0, 1, 10.0);
+    m_tileSize = sceneSpin("terrain.tiles.size", "tiles.size", 1, 10.0);
     m_tileSize->setToolTip(tr("The side of a square tile of plants, metres (the cells stretch it over themselves)"));
     connect(m_tileSize, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { m_apply(m_tileSize, tr("Change tile size"), [&](Scene& s) { s.terrain.tiles.size = v; }); });
-    m_tileSeed = intSpin("tiles.seed", 0, 1 << 30);
+    m_tileSeed = sceneIntSpin("terrain.tiles.seed", "tiles.seed");   // the file's range, clamped to an int
     connect(m_tileSeed, &QSpinBox::valueChanged, this,
             [this](int v) { m_apply(m_tileSeed, tr("Change tile seed"), [&](Scene& s) { s.terrain.tiles.seed = uint64_t(v); }); });
     m_plantForm->addRow(tr("Tile size (m)"), m_tileSize);
@@ -91,7 +92,7 @@ void SceneItemPages::rebuildPlantRows(const Scene& scene)
         while (m_plantForm->rowCount() > 3) m_plantForm->removeRow(3);
         m_plantSpacing.clear();
         for (size_t i = 0; i < plants.size(); ++i) {
-            QDoubleSpinBox* box = spin(QStringLiteral("tiles.spacing.%1").arg(i), 0.5, 1000.0, 2, 0.5);
+            QDoubleSpinBox* box = sceneSpin("terrain.tiles.plants[i].spacing", QStringLiteral("tiles.spacing.%1").arg(i), 2, 0.5);
             connect(box, &QDoubleSpinBox::valueChanged, this, [this, box, i](double v) {
                 m_apply(box, tr("Change plant spacing"), [&](Scene& s) { s.terrain.tiles.plants.at(i).spacing = v; });
             });
@@ -112,7 +113,7 @@ QWidget* SceneItemPages::buildTilingPage()
     auto* form = new QFormLayout(page);
     m_tilingH = intSpin("tiling.horizontal", 1, 8);
     m_tilingV = intSpin("tiling.vertical", 1, 8);
-    m_tilingSeed = intSpin("tiling.seed", 0, 1 << 30);
+    m_tilingSeed = sceneIntSpin("terrain.tiling.seed", "tiling.seed");
     m_tilingInfo = new QLabel;
     m_tilingInfo->setWordWrap(true);
     // A colour count edit makes the set every combination of colours (a given set would no longer match).
@@ -150,8 +151,8 @@ QWidget* SceneItemPages::buildDensityPage()
     });
     m_densityLower = spin("density.lower", -1e5, 1e5, 1, 50.0);
     m_densityUpper = spin("density.upper", -1e5, 1e5, 1, 50.0);
-    m_densityAtLower = spin("density.atLower", 0.0, 1.0, 3, 0.05);
-    m_densityAtUpper = spin("density.atUpper", 0.0, 1.0, 3, 0.05);
+    m_densityAtLower = sceneSpin("terrain.density.at_lower", "density.atLower", 3, 0.05);
+    m_densityAtUpper = sceneSpin("terrain.density.at_upper", "density.atUpper", 3, 0.05);
     connect(m_densityLower, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { m_apply(m_densityLower, tr("Move lower tree line"), [&](Scene& s) { s.terrain.density.lower = v; }); });
     connect(m_densityUpper, &QDoubleSpinBox::valueChanged, this,
@@ -203,7 +204,7 @@ QWidget* SceneItemPages::buildVolumePage()
         if (i < 0 || idx < 0) return;
         m_apply(m_volumeTracer, tr("Change volume tracer"), [&](Scene& s) { s.volumes.at(size_t(i)).tracer = VolumeTracer(idx); });
     });
-    m_volumeDensityScale = spin("volume.densityScale", 0.0, 1.0, 3, 0.05);
+    m_volumeDensityScale = sceneSpin("volumes[i].density_scale", "volume.densityScale", 3, 0.05);   // the top set per grid
     connect(m_volumeDensityScale, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         const int i = m_item.row;
         m_apply(m_volumeDensityScale, tr("Change volume density"), [&](Scene& s) { s.volumes.at(size_t(i)).densityScale = float(v); });
@@ -224,7 +225,7 @@ QWidget* SceneItemPages::buildVolumePage()
         });
         pl->addWidget(box);
     }
-    m_volumeScale = spin("volume.scale", 0.001, 1e5, 3, 0.1);
+    m_volumeScale = sceneSpin("volumes[i].instances[i].scale", "volume.scale", 3, 0.1);
     connect(m_volumeScale, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         const int i = m_item.row;
         m_apply(m_volumeScale, tr("Scale volume"), [&](Scene& s) {
@@ -274,7 +275,7 @@ bool SceneItemPages::showItem(const OutlinerItem& item, const Scene& s)
     case K::Tiles:
         if (!t.enabled()) return false;
         setValue(m_tileSize, t.tiles.size);
-        setValue(m_tileSeed, int(std::min<uint64_t>(t.tiles.seed, uint64_t(1) << 30)));
+        setValue(m_tileSeed, int(std::min<uint64_t>(t.tiles.seed, uint64_t(m_tileSeed->maximum()))));
         rebuildPlantRows(s);
         setCurrentWidget(m_tilesPage);
         return true;
@@ -286,7 +287,7 @@ bool SceneItemPages::showItem(const OutlinerItem& item, const Scene& s)
                                           : tr("Every combination of edge colours: %1 Wang tiles").arg(tiles));
         setValue(m_tilingH, tl.horizontal);
         setValue(m_tilingV, tl.vertical);
-        setValue(m_tilingSeed, int(std::min<uint64_t>(tl.seed, uint64_t(1) << 30)));
+        setValue(m_tilingSeed, int(std::min<uint64_t>(tl.seed, uint64_t(m_tilingSeed->maximum()))));
         setCurrentWidget(m_tilingPage);
         return true;
     }

@@ -26,10 +26,10 @@
 
 #include "core/base/error.h"
 #include "core/sky/sun_position.h"
-#include "core/sky/virtual_lights.h"
 #include "studio/camera_nav.h"
 
 #include "studio/form_widgets.h"
+#include "studio/param_widgets.h"
 
 namespace sylva {
 using namespace widgets;
@@ -76,7 +76,7 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     });
 
     m_preethamRows = new QWidget;
-    m_turbidity = spin("sky.turbidity", 2.0, 10.0, 2, 0.25);
+    m_turbidity = sceneSpin("sky.turbidity", "sky.turbidity", 2, 0.25);
     m_turbidity->setToolTip(tr("Haze of the atmosphere: 2 a very clear sky, 10 a hazy one"));
     connect(m_turbidity, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         apply(m_turbidity, tr("Change turbidity"), [&](Scene& s) { s.skyModel.turbidity = v; });
@@ -100,7 +100,7 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
         apply(m_rotation, tr("Rotate sky map"), [&](Scene& s) { s.skyModel.rotationDeg = float(v); });
     });
     mapForm->addRow(tr("Rotation (deg)"), m_rotation);
-    m_intensity = spin("sky.intensity", 0.0, 1000.0, 3, 0.1);
+    m_intensity = sceneSpin("sky.intensity", "sky.intensity", 3, 0.1);
     connect(m_intensity, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         apply(m_intensity, tr("Change sky map intensity"), [&](Scene& s) { s.skyModel.intensity = float(v); });
     });
@@ -109,19 +109,13 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
 
     m_lightRows = new QWidget;
     QFormLayout* lightForm = form(m_lightRows);
-    m_lights = new QSpinBox;
-    m_lights->setObjectName("sky.lights");
-    m_lights->setRange(sky::kMinVirtualLights, 4096);
-    m_lights->setKeyboardTracking(false);
+    m_lights = sceneIntSpin("sky.lights", "sky.lights");
     m_lights->setToolTip(tr("Virtual directional lights the sky is split into (the sun is its own light)"));
     connect(m_lights, &QSpinBox::valueChanged, this, [this](int v) {
         apply(m_lights, tr("Change sky lights"), [&](Scene& s) { s.skyModel.lights = v; });
     });
     lightForm->addRow(tr("Lights"), m_lights);
-    m_interleave = new QSpinBox;
-    m_interleave->setObjectName("sky.interleave");
-    m_interleave->setRange(1, 256);
-    m_interleave->setKeyboardTracking(false);
+    m_interleave = sceneIntSpin("sky.interleave", "sky.interleave");
     m_interleave->setToolTip(tr("Subsets of the lights over neighbouring pixels and samples (interleaved sampling)"));
     connect(m_interleave, &QSpinBox::valueChanged, this, [this](int v) {
         apply(m_interleave, tr("Change sky interleave"), [&](Scene& s) { s.skyModel.interleave = v; });
@@ -159,7 +153,7 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
 
     auto* dialPage = new QWidget;
     QFormLayout* dialForm = form(dialPage);
-    m_elevation = spin("sun.elevation", -90.0, 90.0, 1, 1.0);
+    m_elevation = sceneSpin("sun.elevation", "sun.elevation", 1, 1.0);
     m_azimuth = spin("sun.azimuth", 0.0, 360.0, 1, 1.0);
     m_azimuth->setWrapping(true);
     m_dial = new QDial;
@@ -216,14 +210,14 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     connect(m_timeSlider, &QSlider::valueChanged, this, [this](int minutes) {
         applyPlace(m_timeSlider, [minutes](sky::SunPlace& p) { p.hour = minutes / 60.0; });
     });
-    m_zone = spin("sun.timezone", -14.0, 14.0, 2, 0.5);
+    m_zone = sceneSpin("sun.timezone", "sun.timezone", 2, 0.5);
     m_zone->setToolTip(tr("Hours of local time ahead of UTC (east +: 1 for CET, 2 for CEST)"));
     connect(m_zone, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { applyPlace(m_zone, [v](sky::SunPlace& p) { p.timeZoneHours = v; }); });
-    m_latitude = spin("sun.latitude", -90.0, 90.0, 4, 0.5);
+    m_latitude = sceneSpin("sun.latitude", "sun.latitude", 4, 0.5);
     connect(m_latitude, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { applyPlace(m_latitude, [v](sky::SunPlace& p) { p.latitudeDeg = v; }); });
-    m_longitude = spin("sun.longitude", -180.0, 180.0, 4, 0.5);
+    m_longitude = sceneSpin("sun.longitude", "sun.longitude", 4, 0.5);
     connect(m_longitude, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { applyPlace(m_longitude, [v](sky::SunPlace& p) { p.longitudeDeg = v; }); });
     placeForm->addRow(tr("Date"), m_date);

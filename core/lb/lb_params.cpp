@@ -105,8 +105,9 @@ void validate(const LbParams& params)
             if (!std::isfinite(v) || v < 0.0f) throw Error("invalid LB boundary distribution: values must be finite and >= 0");
     }
     if (params.steps < 0) throw Error("invalid step count " + std::to_string(params.steps) + ": must be >= 1");
-    if (params.stepsPerEdge < 1 || params.stepsPerEdge > 64)
-        throw Error("invalid steps per edge " + std::to_string(params.stepsPerEdge) + ": must be in [1, 64]");
+    if (!paramHolds(kStepsPerEdge, (long long)params.stepsPerEdge))
+        throw Error("invalid steps per edge " + std::to_string(params.stepsPerEdge) + ": must be in [" + paramNumber(kStepsPerEdge.lo) + ", " +
+                    paramNumber(kStepsPerEdge.hi) + "]");
     if (!std::isfinite(params.tolerance) || params.tolerance < 0.0)
         throw Error("invalid tolerance: must be a finite number > 0");
     if (params.checkEvery < 0) throw Error("invalid tolerance check period: must be >= 1 step (or 0 for automatic)");

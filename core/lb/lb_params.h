@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/base/param_spec.h"
 #include "core/lb/omega.h"
 
 namespace sylva {
@@ -22,13 +23,18 @@ enum class Storage { Fp32, Fp16 };
 // Bump whenever a change alters the numbers a solve returns (cache keys include it).
 inline constexpr int kAlgorithmVersion = 2;
 
+// Steps per node of the longest edge of a fixed-step solve: its range is declared here once; validate(),
+// the scene file (species and volume lighting) and docs/SCENE.md read it. The default is LbParams's.
+inline constexpr ParamSpec kStepsPerEdge{.key = "steps_per_edge", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 1, .hi = 64,
+                                         .def = {2, 0, 0}, .help = "LB steps per node of the longest edge"};
+
 struct LbParams {
     std::array<ChannelParams, 3> channels{};   // R, G, B
     bool zeroF0 = true;                        // plants: true; clouds and plastics keep f_0
     glm::vec3 sun{0.0f, 1.0f, 0.0f};           // direction toward the sun, any length
     glm::vec3 intensity{1.0f};                 // sun intensity per channel
     int steps = 0;                             // fixed step count; 0 = stepsPerEdge x the longest edge
-    int stepsPerEdge = 2;                      // with steps = 0: steps per node of the longest edge (the papers' 2)
+    int stepsPerEdge = int(kStepsPerEdge.def[0]);   // with steps = 0: steps per node of the longest edge (the papers' 2)
     double tolerance = 0.0;                    // > 0: stop when the relative L2 change per step < tolerance
     int checkEvery = 0;                        // tolerance check period in steps; 0 = about every 16 steps
     int maxSteps = 0;                          // tolerance mode cap; 0 = 4 x the longest edge

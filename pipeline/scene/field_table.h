@@ -51,6 +51,14 @@ struct Bounds {
     bool any() const { return !std::isinf(lo) || !std::isinf(hi); }
 };
 
+// A row as the table declares it: the doc and the bounds its read checks (numbers, integers; none: unbounded).
+struct FieldRow : FieldDoc {
+    std::optional<Bounds> range;
+};
+
+// A closed range as docs/SCENE.md's rules write it: "1 .. 64".
+inline std::string spanText(const ParamSpec& s) { return paramNumber(s.lo) + " .. " + paramNumber(s.hi); }
+
 inline Bounds atLeast(double lo, const char* note = "") { return Bounds{.lo = lo, .note = note}; }
 inline Bounds above(double lo) { return Bounds{.lo = lo, .loOpen = true}; }
 
@@ -76,9 +84,10 @@ struct Field {
     std::function<bool(const T&)> writeIf;   // null: always written
     std::function<std::string(const T&)> summary;   // words for people; empty: nothing to say
     bool glue = false;                  // the summary joins the previous one without ", "
-    std::function<void(std::vector<FieldDoc>&, const std::string& path)> children;
+    std::function<void(std::vector<FieldRow>&, const std::string& path)> children;
     // A check across fields, run once this field is read (or found absent): object path, its JSON.
     std::function<void(JsonReader&, const QJsonObject&, const KeyPath&, T&)> then;
+    std::optional<Bounds> range;        // the bounds the read checks (numbers, integers); the studio's widgets take theirs
 
     Field& doc(const char* t, std::string r)
     {
@@ -110,6 +119,12 @@ struct Field {
     Field& thenCheck(std::function<void(JsonReader&, const QJsonObject&, const KeyPath&, T&)> f)
     {
         then = std::move(f);
+        return *this;
+    }
+    // The bounds of a field whose read checks them itself (custom reads).
+    Field& ranged(Bounds b)
+    {
+        range = b;
         return *this;
     }
 };
@@ -186,16 +201,18 @@ std::string summarize(const T& t, const Table<T>& table)
     return s;
 }
 
-// The rows documenting the table; path: the object's own path ("species[i]"), empty at the top.
+// The rows documenting the table, each with its bounds; path: the object's own path ("species[i]"), empty at
+// the top.
 template <class T>
-void documentFields(const Table<T>& table, const std::string& path, std::vector<FieldDoc>& out)
+void documentFields(const Table<T>& table, const std::string& path, std::vector<FieldRow>& out)
 {
     for (const Field<T>& f : table.fields) {
-        FieldDoc d;
+        FieldRow d;
         d.key = (path.empty() ? std::string(f.key) : path + "." + f.key) + (f.list ? "[i]" : "");
         d.type = f.type;
         d.rule = f.rule;
         d.section = path.empty() && f.nested;
+        d.range = f.range;
         if (f.shownDefault) {
             d.defaultValue = f.shownDefault;
         } else if (!f.nested && f.write) {
@@ -246,7 +263,7 @@ public:
     template <class Get>
     Field<T>& integer(const char* key, Get get, long long lo, long long hi)
     {
-        return custom(
+        Field<T>& f = custom(
             key,
             [get, lo, hi](JsonReader& r, const QJsonValue& v, const KeyPath& p, T& t) {
                 using V = std::remove_cvref_t<decltype(ref(get, t))>;
@@ -257,6 +274,7 @@ public:
                 if constexpr (std::is_same_v<V, uint64_t>) w.integer(uint64_t(ref(get, t)));
                 else w.integer((long long)ref(get, t));
             });
+        return f.ranged(Bounds{.lo = double(lo), .hi = double(hi)});
     }
 
     // A parameter declared by a ParamSpec (core/base/param_spec.h): key, bounds and doc line from it.
@@ -277,7 +295,7 @@ public:
     template <class Get>
     Field<T>& number(const char* key, Get get, Bounds bounds = {})
     {
-        return custom(
+        Field<T>& f = custom(
             key,
             [get, bounds](JsonReader& r, const QJsonValue& v, const KeyPath& p, T& t) {
                 using V = std::remove_cvref_t<decltype(ref(get, t))>;
@@ -288,6 +306,8 @@ public:
                 ref(get, t) = x;
             },
             [get](JsonWriter& w, const T& t, const KeyPath& p, int) { w.number(ref(get, t), p); });
+        if (bounds.any()) f.range = bounds;
+        return f;
     }
 
     // [x, y, z] of floats (glm::vec3) or doubles (glm::dvec3); nonZero: refuses a zero vector.
@@ -343,7 +363,7 @@ public:
             [get, &sub](JsonWriter& w, const T& t, const KeyPath& p, int indent) { writeObject(w, ref(get, t), p, sub, indent); });
         f.readWhenAbsent = true;
         f.nested = true;
-        f.children = [&sub](std::vector<FieldDoc>& out, const std::string& path) { documentFields(sub, path, out); };
+        f.children = [&sub](std::vector<FieldRow>& out, const std::string& path) { documentFields(sub, path, out); };
         return f;
     }
 
@@ -361,7 +381,7 @@ public:
             [get, &sub](JsonWriter& w, const T& t, const KeyPath& p, int indent) { writeObject(w, *ref(get, t), p, sub, indent); });
         f.writeIf = [get](const T& t) { return ref(get, t).has_value(); };
         f.nested = true;
-        f.children = [&sub](std::vector<FieldDoc>& out, const std::string& path) { documentFields(sub, path, out); };
+        f.children = [&sub](std::vector<FieldRow>& out, const std::string& path) { documentFields(sub, path, out); };
         return f;
     }
 
@@ -400,7 +420,7 @@ public:
         f.nested = true;
         f.list = true;
         f.required("missing (required)");
-        f.children = [&sub](std::vector<FieldDoc>& out, const std::string& path) { documentFields(sub, path, out); };
+        f.children = [&sub](std::vector<FieldRow>& out, const std::string& path) { documentFields(sub, path, out); };
         return f;
     }
 

@@ -99,9 +99,10 @@ const Table<SpeciesDesc>& lightingTable()
              },
              [](JsonWriter& w, const SpeciesDesc& d, const KeyPath&, int) { w.integer((long long)d.lighting.steps); })
             .doc("integer", "fixed step count, 0 .. 1000000; 0 = `steps_per_edge` x the longest grid edge");
-        b.integer("steps_per_edge", [](auto& d) -> auto& { return d.lighting.stepsPerEdge; }, 1, 64)
+        b.integer("steps_per_edge", [](auto& d) -> auto& { return d.lighting.stepsPerEdge; }, (long long)lb::kStepsPerEdge.lo,
+                  (long long)lb::kStepsPerEdge.hi)
             .doc("integer",
-                 "1 .. 64: with `steps` 0, steps per node of the longest edge (2 = the seed's count). The default 1 is the cheapest "
+                 json::spanText(lb::kStepsPerEdge) + ": with `steps` 0, steps per node of the longest edge (2 = the seed's count). The default 1 is the cheapest "
                  "solve at its error on the measured fronts ([ACCURACY.md](ACCURACY.md)): the LB's transport error against Monte "
                  "Carlo (5-11%) dwarfs the under-0.7% the seed's 2 x or a tolerance would change");
         b.number("tolerance", [](auto& d) -> auto& { return d.lighting.tolerance; }, atLeast(0.0, " (0: fixed step count)"))
@@ -343,7 +344,7 @@ void terrainObject(TableBuilder<TerrainDesc>& b, const char* key, Get get, const
         [get, &sub](JsonWriter& w, const TerrainDesc& t, const KeyPath& p, int indent) { writeObject(w, get(const_cast<TerrainDesc&>(t)), p, sub, indent); });
     f.writeIf = when;
     f.nested = true;
-    f.children = [&sub](std::vector<json::FieldDoc>& o, const std::string& path) { documentFields(sub, path, o); };
+    f.children = [&sub](std::vector<json::FieldRow>& o, const std::string& path) { documentFields(sub, path, o); };
     f.doc("object", rule).shown("");
 }
 
@@ -413,7 +414,10 @@ const Table<SunDesc>& sunTable()
                 return "toward " + human3(s.direction) + buf;
             });
         // Another form of the direction: read together once both are known, never written.
-        b.custom("elevation", nullptr, nullptr).doc("number", "degrees above the horizon, -90 .. 90; needs `azimuth`").shown("-");
+        b.custom("elevation", nullptr, nullptr)
+            .doc("number", "degrees above the horizon, -90 .. 90; needs `azimuth`")
+            .shown("-")
+            .ranged(elevationBounds);
         b.custom("azimuth", nullptr, nullptr)
             .doc("number", "degrees, 0 = +Z, 90 = +X; needs `elevation`")
             .shown("-")
@@ -470,7 +474,8 @@ const Table<SunDesc>& sunTable()
                     pl.*member = x;
                 },
                 [member](JsonWriter& w, const sky::SunPlace& pl, const KeyPath& p) { w.number(pl.*member, p); })
-                .doc("number", rule);
+                .doc("number", rule)
+                .ranged(Bounds{.lo = -limit, .hi = limit});
         };
         placeNumber("timezone", &sky::SunPlace::timeZoneHours, 14.0, "hours of local time ahead of UTC (east +: 1 for CET, 2 for CEST), -14 .. 14; with `date`");
         placeNumber("latitude", &sky::SunPlace::latitudeDeg, 90.0, "degrees north (south negative), -90 .. 90; with `date`");
@@ -789,7 +794,7 @@ const Table<Scene>& sceneTable()
                 [](JsonWriter& w, const Scene& sc, const KeyPath& p, int indent) { writeObject(w, sc.terrain, p, terrainTable(), indent); });
             f.writeIf = [](const Scene& sc) { return sc.terrain.enabled(); };
             f.nested = true;
-            f.children = [](std::vector<json::FieldDoc>& o, const std::string& path) { documentFields(terrainTable(), path, o); };
+            f.children = [](std::vector<json::FieldRow>& o, const std::string& path) { documentFields(terrainTable(), path, o); };
             f.doc("object", "a terrain from a DEM (replaces the ground plane); optional")
                 .shown("")
                 .summarized(sectionLine("terrain", [](const Scene& sc) -> const TerrainDesc& { return sc.terrain; }, terrainTable()));
@@ -827,11 +832,32 @@ const Table<Scene>& sceneTable()
     return table;
 }
 
+namespace {
+
+std::vector<json::FieldRow> sceneFieldRows()
+{
+    std::vector<json::FieldRow> rows;
+    json::documentFields(sceneTable(), "", rows);
+    return rows;
+}
+
+} // namespace
+
 std::vector<json::FieldDoc> sceneFieldDocs()
 {
-    std::vector<json::FieldDoc> docs;
-    json::documentFields(sceneTable(), "", docs);
-    return docs;
+    const std::vector<json::FieldRow> rows = sceneFieldRows();
+    return std::vector<json::FieldDoc>(rows.begin(), rows.end());
+}
+
+json::Bounds sceneFieldRange(const std::string& key)
+{
+    static const std::vector<json::FieldRow> rows = sceneFieldRows();
+    for (const json::FieldRow& d : rows) {
+        if (d.key != key) continue;
+        if (!d.range) throw Error("scene field " + key + " has no bounds");
+        return *d.range;
+    }
+    throw Error("no scene field " + key);
 }
 
 } // namespace sylva

@@ -41,4 +41,9 @@ const json::Table<Scene>& sceneTable();
 // The rows of docs/SCENE.md's field table, in order, as the table declares them.
 std::vector<json::FieldDoc> sceneFieldDocs();
 
+// The bounds the scene file checks on the number at KEY, a full key as sceneFieldDocs() names it
+// ("sun.temperature", "terrain.rock_slope", "species[i].lighting.steps_per_edge"): the studio's widgets take
+// their ranges from it. Throws sylva::Error for an unknown key or a field without bounds.
+json::Bounds sceneFieldRange(const std::string& key);
+
 } // namespace sylva

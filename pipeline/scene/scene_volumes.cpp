@@ -116,8 +116,9 @@ const Table<VolumeDesc>& volumeTable()
             .doc("number", "shadow-march step in nodes, 0.05 .. 16 (cloud shadows, single scattering)");
         b.number("emission_exposure", &VolumeDesc::emissionExposure, Bounds{.lo = -64.0, .hi = 64.0, .unit = " stops"})
             .doc("number", "stops: emission = 2^this x sigma_a x density x Planck(T) / luminance(Planck(6500 K)), -64 .. 64");
-        b.integer("steps_per_edge", [](auto& d) -> auto& { return d.lighting.stepsPerEdge; }, 1, 64)
-            .doc("integer", "LB steps per node of the longest edge, 1 .. 64 (2 = the seed's count)");
+        b.integer("steps_per_edge", [](auto& d) -> auto& { return d.lighting.stepsPerEdge; }, (long long)lb::kStepsPerEdge.lo,
+                  (long long)lb::kStepsPerEdge.hi)
+            .doc("integer", "LB steps per node of the longest edge, " + json::spanText(lb::kStepsPerEdge) + " (2 = the seed's count)");
         b.array("instances", &VolumeDesc::instances, placementTable(), "a volume needs at least one placement")
             .doc("object", "placements of the grid, at least one");
         b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& p, VolumeDesc& d) {
