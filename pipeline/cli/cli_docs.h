@@ -1,5 +1,5 @@
-// The man page and the bash completion of `sylva`, generated from its command table (main.cpp's
-// commands() and each Command's options), so they never drift from what the program accepts.
+// The man page and the bash completion of `sylva`, generated from its command table (commandTable
+// in command_line.cpp, and each Command's options), so they never drift from what the program accepts.
 // `sylva --man` and `sylva --completion` print them; the build installs their output.
 #pragma once
 

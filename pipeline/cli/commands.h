@@ -1,6 +1,9 @@
 // The `sylva` commands, one file each (cmd_NAME.cpp): each returns its description and function.
-// main.cpp lists them in the order `sylva --help` shows.
+// commandTable (command_line.cpp) lists them in the order `sylva --help` shows; main.cpp runs it.
 #pragma once
+
+#include <string>
+#include <vector>
 
 #include "pipeline/cli/args.h"
 
@@ -18,5 +21,14 @@ Command cacheCommand();       // cmd_cache.cpp
 Command exportCommand();      // cmd_export.cpp
 Command volumeCommand();      // cmd_volume.cpp
 Command simulateCommand();    // cmd_simulate.cpp
+
+// The commands in the order `sylva --help` lists them.
+std::vector<Command> commandTable();
+
+// `sylva ARGS...` over a table of commands (args without the program's name): `--help`, `--version`,
+// `--man`, `--completion`, `COMMAND --help`, or the command run; what it throws is printed on stderr and
+// mapped to the exit code returned: UsageError 2, Cancelled 1 (or 128 + the signal that asked for it),
+// any other exception 1. Installs the SIGINT / SIGTERM handlers (cancelOnSignals) before a command runs.
+int runCommandLine(const std::vector<Command>& commands, const std::vector<std::string>& args);
 
 } // namespace sylva::cli

@@ -27,6 +27,7 @@
 #include "pipeline/study/study_image.h"
 #include "pipeline/study/study_parts.h"
 #include "pipeline/study/study_plot.h"
+#include "pipeline/study/study_truth.h"
 
 namespace sylva::study {
 namespace fs = std::filesystem;
@@ -39,13 +40,6 @@ std::string f(const char* fmt, double v)
     std::snprintf(b, sizeof b, fmt, v);
     return b;
 }
-
-struct TruthScene {
-    std::string key, title;
-    Scene scene;
-    int refSamples = 1024;
-    std::vector<int> sweep;
-};
 
 Scene baseScene(int w, int h)
 {
@@ -300,11 +294,15 @@ struct Totals {
     std::vector<std::vector<CurvePoint>> sylvaOncePoints;
 };
 
-// The scenes compared: the tree, the tree under a Preetham sky, the stand, the forest's crop; SYLVA_TRUTH_SCENES
-// picks a subset, SYLVA_TRUTH_SAMPLE_DIVISOR divides every sample count.
-std::vector<TruthScene> truthScenes(const Options& o)
+} // namespace
+
+std::vector<TruthScene> truthSceneList(const Options& o)
 {
-    std::vector<TruthScene> scenes = {treeScene(o), treeSkyScene(o), standScene(), forestScene()};
+    return {treeScene(o), treeSkyScene(o), standScene(), forestScene()};
+}
+
+std::vector<TruthScene> pickTruthScenes(std::vector<TruthScene> scenes)
+{
     if (const char* only = std::getenv("SYLVA_TRUTH_SCENES")) {   // e.g. "tree,stand": a subset
         std::vector<TruthScene> kept;
         for (TruthScene& t : scenes)
@@ -324,6 +322,8 @@ std::vector<TruthScene> truthScenes(const Options& o)
     }
     return scenes;
 }
+
+namespace {
 
 // The section's head: what is compared and how, the optics mapping, the leaf preset and what cannot match.
 void writeIntro(std::ostringstream& md)
