@@ -1,7 +1,6 @@
 // Flattens species, pruned levels, instance groups, textures and lighting grids into the RenderView arrays;
 // builds every level's acceleration structure. The one builder of the levels, for every front end.
 #include "core/render/render_scene.h"
-#include "core/render/render_volumes.h"
 #include "core/render/scene_build.h"
 
 #include <array>
@@ -83,10 +82,8 @@ std::vector<uint32_t> groupBuildOrder(const Scene& scene)
 
 } // namespace
 
-namespace scene_build {
-
 // The byte figures of AccelStats from the array table: each array counts towards its stat column.
-void countBytes(RenderScene& rs)
+void countFrameBytes(RenderScene& rs)
 {
     size_t bytes[size_t(ArrayStat::None) + 1] = {};
 #define SYLVA_X(part, where, T, name, stat) bytes[size_t(ArrayStat::stat)] += rs.name.size() * sizeof(T);
@@ -103,8 +100,6 @@ void countBytes(RenderScene& rs)
     st.terrainBytes = bytes[size_t(ArrayStat::Terrain)];
     st.landscapeBytes = bytes[size_t(ArrayStat::Landscape)];
 }
-
-} // namespace scene_build
 
 CameraRecord makeCamera(const CameraDesc& c, int width, int height)
 {
@@ -141,7 +136,7 @@ RenderView RenderScene::view() const
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
     v.instanceCount = uint32_t(instances.size());
-    v.volumeCount = uint32_t(volumeInstances.size());
+    v.volumes.count = uint32_t(volumeInstances.size());
     v.lightCount = uint32_t(lights.size());
     v.spheres.count = uint32_t(sphereRecords.size());
     return v;
@@ -227,8 +222,8 @@ std::vector<uint32_t> checkSceneInput(const Scene& scene, const std::vector<Spec
 
 } // namespace
 
-// The table of contents: each surface kind's builder (core/render/surfaces/*_build.cpp), the volumes, the sky,
-// then the LB solve the instances trigger (core/render/scene_lighting.cpp).
+// The table of contents: each kind's builder (core/render/surfaces/*_build.cpp), then the sky. The LB solves
+// the frame triggers are the pipeline's (pipeline/render/frame_build.h lightFrame).
 RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAssets>& assets, LodLevels lod, Progress* progress)
 {
     Scene lifted;
@@ -244,11 +239,9 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
     buildMeshGeometry(rs, scene, assets, lod, progress);
     buildGroupGeometry(rs, scene, groupOrder);
     buildLandscapeArrays(rs, scene);   // and its share of the forest grid
-    buildVolumeGrids(rs, scene);       // core/render/render_volumes.h
+    buildVolumeGrids(rs, scene);
     setFrameSky(rs, scene.skyModel, groundPlaneShown(scene));
-
-    buildForestGrid(rs, scene);
-    countBytes(rs);
+    countFrameBytes(rs);
     return rs;
 }
 
@@ -257,7 +250,7 @@ RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAs
 void rebuildVolumeGrids(RenderScene& rs, const Scene& scene)
 {
     buildVolumeGrids(rs, scene);
-    countBytes(rs);
+    countFrameBytes(rs);
 }
 
 bool hasLevelsFor(const RenderScene& rs, const Scene& sceneIn)
@@ -366,7 +359,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     b.indirectScale = scene.render.indirectScale;
     b.alphaDistance = scene.render.alphaDistance;
     placeVolumes(rs, scene, scene.camera.position);
-    countBytes(rs);
+    countFrameBytes(rs);
 }
 
 FrameSun frameSun(const Scene& scene, const glm::vec3& sunRadiance)
@@ -400,15 +393,6 @@ glm::vec3 lbRadiance(const Scene& scene, const FrameSun& sun)
     for (int c = 0; c < 3; ++c)
         if (!(u[c] > 0.0f)) u[c] = 1.0f;
     return u;
-}
-
-RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
-                             Progress* progress)
-{
-    RenderScene rs = buildSceneGeometry(scene, assets, LodLevels::Used, progress);
-    placeTopLevel(rs, scene, sunRadiance, scene.render.width, scene.render.height, scene.render.spp);
-    if (progress) progress->report(1.0, "acceleration structures built");
-    return rs;
 }
 
 } // namespace sylva

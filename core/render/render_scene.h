@@ -1,6 +1,7 @@
 // Host side of a frame: species geometry, textures and lighting grids flattened into the arrays a RenderView points at.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -115,9 +116,10 @@ public:
 // Step 1: the camera-independent part. One BVH (or, for accel kdtree, one kd-tree) per species and per
 // pruned level (in parallel; with render.pruneDistance > 0 the levels `lod` asks for, core/render/prune.h),
 // one BVH per instance group of scene.groups over its instances in the group's frame (groups nest at most
-// kMaxLevels - 1 deep), textures, cut-outs and lighting grids, and with lighting.forest_grid on (or auto
-// where exposure differs) the forest-level grid's factors per top-level instance (instanceLights; placeTopLevel
-// points each instance at its record). assets[i] belongs to scene.species[i].
+// kMaxLevels - 1 deep), textures, cut-outs, lighting grids, the terrain, the landscape, the volumes and the sky.
+// No LB solve: the forest-level grid the scene's instances and landscape trigger is the pipeline's
+// (pipeline/render/frame_build.h lightFrame, which fills instanceLights and landLight). assets[i] belongs to
+// scene.species[i].
 // Throws Error on inconsistent input (missing species or group, a cycle or too deep nesting of groups).
 RenderScene buildSceneGeometry(const Scene& scene, const std::vector<SpeciesAssets>& assets, LodLevels lod = LodLevels::Used,
                                Progress* progress = nullptr);
@@ -135,20 +137,18 @@ void placeTopLevel(RenderScene& rs, const Scene& scene, const glm::vec3& sunRadi
 // viewport keeps the species' structures across such edits; the same species list is assumed):
 // buildLandscapeArrays: the landscape's tiling, tile populations and trees, cells and kd-tree (a tile, tiling
 // or cell edit); setLandscapeDensity: only the density rule's layout fields (core/terrain/landscape.h:
-// nothing is built, the rule thins plants while tracing); both solve the landscape's forest grid again (it
-// depends on which plants grow) when lighting.forest_grid is not off; rebuildVolumeGrids: the volumes' arrays
-// (buildVolumeGrids). Each throws Error as buildSceneGeometry does for its part.
+// nothing is built, the rule thins plants while tracing); both drop the landscape's share of the forest grid
+// (clearLandscapeLight: it depends on which plants grow; pipeline/render/frame_build.h lightLandscape solves
+// it again); rebuildVolumeGrids: the volumes' arrays (buildVolumeGrids). Each throws Error as
+// buildSceneGeometry does for its part.
 void buildLandscapeArrays(RenderScene& rs, const Scene& scene);
 void setLandscapeDensity(RenderScene& rs, const Scene& scene);
+void clearLandscapeLight(RenderScene& rs);
 void rebuildVolumeGrids(RenderScene& rs, const Scene& scene);
 
 // Whether `rs` holds every level of detail placeTopLevel needs for `scene` (a LodLevels::All build always
 // does; a LodLevels::Used build for the camera it was built with).
 bool hasLevelsFor(const RenderScene& rs, const Scene& scene);
-
-// Both steps at the scene's own size and samples: what sylva render, the banded renders and the exports trace.
-RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
-                             Progress* progress = nullptr);
 
 // Whether the frame has the ground plane (a terrain replaces it): then every direction below the horizon
 // ends on the ground, for every point above it.
@@ -157,13 +157,13 @@ inline bool groundPlaneShown(const Scene& scene) { return scene.ground.enabled &
 // The sky's part of a built frame: a Preetham or map sky's per-ray parameters, its map pixels and its
 // virtual lights (d.lights of them, d.interleave subsets; with groundPlane, groundPlaneShown(scene), all of
 // them above the horizon, since the ground hides the rest); the constant sky: none (the frame as before).
-// buildRenderScene calls it; changing only the lights or subsets of the same sky needs nothing else (the
+// buildSceneGeometry calls it; changing only the lights or subsets of the same sky needs nothing else (the
 // sun and the LB grids stay). Throws Error when the sky is not built or its counts are out of range.
 void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane);
 
 // The sun the frame lights with: the scene's direction and `sunRadiance`, or a built Preetham sky's (or a
 // map sky's, with sun_from_map) own sun, radiance() x sun.intensity / pi (a surface shows albedo x radiance
-// x cos). What buildRenderScene and the Blender export use. Throws Error on a zero direction.
+// x cos). What placeTopLevel and the Blender export use. Throws Error on a zero direction.
 struct FrameSun {
     glm::vec3 direction;   // toward the sun, unit
     glm::vec3 radiance;
@@ -181,6 +181,15 @@ glm::vec3 lbSunDirection(const Scene& scene);
 // so a sky without a sun (a map with none, a Preetham sky at night, sun.intensity 0) still lights the grid.
 glm::vec3 lbRadiance(const Scene& scene, const FrameSun& sun);
 
+// The byte statistics of the frame's arrays (AccelStats): every builder recounts after it changes them.
+void countFrameBytes(RenderScene& rs);
+
+// The terrain-frame height above which the ground is snow (> any height: none), and the cosine below which
+// a normal is rock: the shader's colour rule and the landscape's masks (TerrainRecord::snowY, rockCos).
+inline float terrainSnowY(const TerrainDesc& t) { return t.snowLine > 0.0f ? float(double(t.snowLine) - t.origin.y) : 3.0e38f; }
+inline float terrainRockCos(const TerrainDesc& t) { return float(std::cos(double(t.rockSlope) * 3.14159265358979323846 / 180.0)); }
+
+
 // Camera basis and image extents for a camera and image size (throws Error on a degenerate camera).
 // The rotation of an instance from its degrees about x, y, z: R = Rz Ry Rx (column-major glm).
 glm::dmat3 rotationDeg(const glm::vec3& deg);
@@ -188,7 +197,7 @@ glm::dmat3 rotationDeg(const glm::vec3& deg);
 CameraRecord makeCamera(const CameraDesc& camera, int width, int height);
 
 // The instance's parent -> geometry map in the frame whose origin is `frameOrigin` (parent-frame metres).
-// geometry = the species (buildRenderScene picks a pruned level or the group's record).
+// geometry = the species (placeTopLevel picks a pruned level or the group's record).
 InstanceRecord makeInstance(const InstanceDesc& inst, const glm::dvec3& frameOrigin);
 
 } // namespace sylva

@@ -13,7 +13,6 @@
 #include "core/sky/virtual_lights.h"
 #include "core/render/lights/light_list.h"
 #include "core/render/surfaces/surface_list.h"
-#include "core/render/volume_trace.h"
 
 namespace sylva {
 
@@ -206,7 +205,7 @@ struct CameraRecord {
     X(Top, Both, SphereRecord, sphereRecords, None)        /* analytic spheres (camera-relative) */            \
     X(Top, Both, VolumeInstanceRecord, volumeInstances, None) /* placed volumes (camera-relative) */        \
     X(Scene, Both, VolumeGridRecord, volumeGrids, None)    /* per volume grid: dims, optics, offsets */        \
-    X(Scene, Both, float, volumeDensity, None)             /* volume densities (core/render/volume_trace.h) */ \
+    X(Scene, Both, float, volumeDensity, None)             /* volume densities (surfaces/volumes_trace.h) */  \
     X(Scene, Both, float, volumeBricks, None)              /* their bricks' max density (empty-space skip) */ \
     X(Scene, Both, float, volumeLight, None)               /* their LB photon density, 3 per node, normalized */ \
     X(Scene, Both, float, volumeTemperature, None)         /* their temperatures (kelvin; emission) */         \
@@ -222,7 +221,6 @@ struct RenderView {
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
     uint32_t instanceCount;          // of the top level
-    uint32_t volumeCount;            // volumeInstances (0: no volume, every stage as before)
     uint32_t lightCount;             // lights
 
     // the scene-level surface kinds' records (core/render/surfaces)
@@ -230,6 +228,7 @@ struct RenderView {
     TerrainRecord terrain;
     SpheresRecord spheres;
     LandscapeRecord landscape;
+    VolumesRecord volumes;
 
     // the environment, and the unit of the LB grids
     SkyRecord sky;
@@ -248,13 +247,6 @@ struct RenderView {
     float alphaDistance;             // adaptive transparency: alpha tests only within this distance of the camera
                                      // (metres, camera-relative frame); 0 = everywhere
 };
-
-// The volumes' arrays of a view (core/render/volume_trace.h).
-SYLVA_HD SYLVA_INLINE VolumeArrays volumeViewOf(const RenderView& v)
-{
-    return VolumeArrays{v.volumeGrids, v.volumeInstances, v.volumeDensity, v.volumeBricks, v.volumeLight, v.volumeTemperature,
-                        v.volumeBlackbody, v.volumeCount};
-}
 
 // The light the LB grids are solved toward (the frame's sun: the first of the list, render_scene.cpp
 // placeTopLevel); volumes scatter it singly and subtract it from their grids' light.

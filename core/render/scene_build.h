@@ -1,9 +1,8 @@
-// The scene build's parts (render_scene.cpp's buildSceneGeometry is their table of contents): each surface
-// kind's builder and the frame's LB solves. Internal to core/render.
+// The scene build's parts (render_scene.cpp's buildSceneGeometry is their table of contents): each kind's
+// builder. Internal to core/render.
 #pragma once
 
 #include <cstdint>
-#include <cmath>
 #include <vector>
 
 #include "core/render/render_scene.h"
@@ -18,20 +17,19 @@ void buildMeshGeometry(RenderScene& rs, const Scene& scene, const std::vector<Sp
 // Instance groups in `order` (each after the groups it places): their instances in their own frames under a
 // BVH each (core/render/surfaces/group_build.cpp).
 void buildGroupGeometry(RenderScene& rs, const Scene& scene, const std::vector<uint32_t>& order);
-// The LB solves a frame triggers (core/render/scene_lighting.cpp): the forest-level grid over the top level's
-// instances, and its share over the landscape's plants.
-void buildForestGrid(RenderScene& rs, const Scene& scene);
-void buildLandscapeLight(RenderScene& rs, const Scene& scene);
+// The volumes' grids, bricks, lighting and temperatures (core/render/surfaces/volumes_build.cpp) from
+// scene.volumes (each with its data loaded: pipeline/scene loadSceneVolumes). Throws Error naming the volume
+// when its data is missing or inconsistent (lighting or temperature of other dims).
+void buildVolumeGrids(RenderScene& rs, const Scene& scene);
+// rs.volumeInstances for the camera at `eye` (world metres, double): each volume's placements mapped from the
+// camera-relative frame to its grid's node coordinates.
+void placeVolumes(RenderScene& rs, const Scene& scene, const glm::dvec3& eye);
+// Brick maxima of a density grid (what buildVolumeGrids stores): per brick of kVolumeBrick nodes, the largest
+// density over the nodes a trilinear lookup inside it reads.
+std::vector<float> volumeBrickMaxima(const std::vector<float>& density, const glm::ivec3& dims, glm::ivec3* bricks);
 
 // An instance's box in the frame whose origin is frameOrigin, from its geometry's bounds b.
 Bounds3 instanceBox(const InstanceDesc& d, const Bounds3& b, const glm::dvec3& frameOrigin);
 // The level of detail each top-level instance gets from the scene's camera.
 std::vector<int> instanceLevels(const Scene& scene, const std::vector<RenderScene::MeshLevels>& ml);
-// The byte statistics of the arrays (AccelStats).
-void countBytes(RenderScene& rs);
-// The terrain-frame height above which the ground is snow (> any height: none), and the cosine below which
-// a normal is rock: the shader's colour rule and the landscape's masks (TerrainRecord::snowY, rockCos).
-inline float terrainSnowY(const TerrainDesc& t) { return t.snowLine > 0.0f ? float(double(t.snowLine) - t.origin.y) : 3.0e38f; }
-inline float terrainRockCos(const TerrainDesc& t) { return float(std::cos(double(t.rockSlope) * 3.14159265358979323846 / 180.0)); }
-
 } // namespace sylva::scene_build

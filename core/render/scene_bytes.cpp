@@ -88,7 +88,7 @@ RenderView packedFrameView(const RenderSceneHeader& h, const PackedFrame& layout
     SYLVA_RENDER_ARRAYS(SYLVA_X)
 #undef SYLVA_X
     v.instanceCount = uint32_t(h.counts[kArray_instances]);
-    v.volumeCount = uint32_t(h.counts[kArray_volumeInstances]);
+    v.volumes.count = uint32_t(h.counts[kArray_volumeInstances]);
     v.lightCount = uint32_t(h.counts[kArray_lights]);
     v.spheres.count = uint32_t(h.counts[kArray_sphereRecords]);
     return v;

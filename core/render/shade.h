@@ -7,29 +7,6 @@
 
 namespace sylva {
 
-// The three parts a render mode combines (linear RGB): local = sun light only, indirect = LB
-// indirect light (ground: sky light), albedo = the surface colour the indirect light multiplies
-// (for the constant-ambient comparison), skyCover = share of samples that saw the sky. Beside them,
-// for the render passes only (no mode reads them): normal = the unit surface normal facing the
-// viewer (world orientation; 0 for the sky), averaged over a pixel's samples like the parts, and
-// depth = the distance along the camera's forward axis to the surface, the nearest over the samples
-// (kSkyDepth for the sky). background = the radiance of a Preetham or map sky where samples saw it
-// (averaged like the parts; 0 for the constant sky, which composes as skyCover x its colour). A
-// Preetham or map sky's light on surfaces (its virtual lights) is direct light: it is in `local`.
-// 68 bytes.
-struct SampleParts {
-    glm::vec3 local;
-    glm::vec3 indirect;
-    glm::vec3 albedo;
-    float skyCover;
-    glm::vec3 normal;
-    float depth;
-    glm::vec3 background;
-};
-
-// The depth of a sample that saw the sky (Cycles' value for the background of its Z pass).
-inline constexpr float kSkyDepth = 1e10f;
-
 // Linear RGB of a render mode from a pixel's parts: full = local + indirect, local = sun light only,
 // ambient = local + a constant ambient x albedo, lb = indirect only; plus the sky where samples saw it
 // (skyCover x the constant sky `sky`, composeSky(scene), plus the other skies' background).
@@ -56,46 +33,14 @@ SYLVA_HD SYLVA_INLINE bool intersectStage(const RenderView& v, const Ray& ray, H
 // Stage 2, surface: geometry and material at the hit, from the kind that recorded it (trace.h surfaceAt).
 SYLVA_HD SYLVA_INLINE SurfacePoint surfaceStage(const RenderView& v, const Ray& ray, const Hit& hit) { return surfaceAt(v, ray, hit); }
 
-// Stage 3, volume: what participating media along the camera ray's segment [ray.tmin, tEnd] add to
-// and take from the parts behind them.
-// The volumes the segment crosses are composed back to front (each one's entry point orders them):
-// what lies behind is multiplied by the volume's transmittance (the constant sky through skyCover x its
-// mean, the colour difference into background) and the volume's own light is added (core/render/
-// volume_trace.h marchVolume: sun single scattering and emission into local, LB into indirect, the
-// scattered share of a uniform ambient into albedo, so every render mode keeps its meaning). Without
-// volumes the parts pass unchanged.
+// Stage 3, volume: what the media kinds (core/render/surfaces/surface_list.h) along the camera ray's segment
+// [ray.tmin, tEnd] add to and take from the parts behind them, each kind's cross<Kind> in the list's order
+// (the volumes: surfaces/volumes_trace.h crossVolumes). Without media the parts pass unchanged.
 SYLVA_HD inline void volumeStage(const RenderView& v, const Ray& ray, float tEnd, SampleParts& parts)
 {
-    if (v.volumeCount == 0) return;
-    const VolumeArrays vv = volumeViewOf(v);
-    uint32_t order[kMaxRayVolumes];
-    float entry[kMaxRayVolumes];
-    int n = 0;
-    for (uint32_t i = 0; i < v.volumeCount; ++i) {
-        const VolumeInstanceRecord& in = v.volumeInstances[i];
-        float t0 = ray.tmin, t1 = tEnd;
-        if (!volumeClip(v.volumeGrids[in.grid].dims, volumeToGrid(in, ray.org), volumeDirToGrid(in, ray.dir), t0, t1)) continue;
-        if (n == kMaxRayVolumes && !(t0 < entry[n - 1])) continue;   // full: keep the nearest
-        int k = n < kMaxRayVolumes ? n++ : n - 1;
-        while (k > 0 && entry[k - 1] > t0) {        // nearest entry first
-            order[k] = order[k - 1];
-            entry[k] = entry[k - 1];
-            --k;
-        }
-        order[k] = i;
-        entry[k] = t0;
-    }
-    for (int k = n - 1; k >= 0; --k) {
-        const VolumeSegment s = marchVolume(vv, v.volumeInstances[order[k]], ray.org, ray.dir, ray.tmin, tEnd, lbLight(v), v.lbRadiance,
-                                            v.indirectScale);
-        const glm::vec3& T = s.transmittance;
-        const float mean = (T.x + T.y + T.z) * (1.0f / 3.0f);
-        parts.local = parts.local * T + s.local;
-        parts.indirect = parts.indirect * T + s.indirect;
-        parts.albedo = parts.albedo * T + s.albedo;
-        parts.background = parts.background * T + parts.skyCover * (T - mean) * v.sky.constant;
-        parts.skyCover *= mean;
-    }
+#define SYLVA_X(Kind) cross##Kind(v, ray, tEnd, parts);
+    SYLVA_SURFACE_KINDS(SYLVA_KIND_SKIP, SYLVA_X)
+#undef SYLVA_X
 }
 
 // Stage 4, background and lights: a ray that hit nothing sees the environment (the constant sky through

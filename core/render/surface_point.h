@@ -25,6 +25,29 @@ struct SurfacePoint {
     bool ground;             // Lambertian ground (plane, terrain, spheres): lit by the uniform sky's ambient
 };
 
+// The three parts a render mode combines (linear RGB): local = sun light only, indirect = LB
+// indirect light (ground: sky light), albedo = the surface colour the indirect light multiplies
+// (for the constant-ambient comparison), skyCover = share of samples that saw the sky. Beside them,
+// for the render passes only (no mode reads them): normal = the unit surface normal facing the
+// viewer (world orientation; 0 for the sky), averaged over a pixel's samples like the parts, and
+// depth = the distance along the camera's forward axis to the surface, the nearest over the samples
+// (kSkyDepth for the sky). background = the radiance of a Preetham or map sky where samples saw it
+// (averaged like the parts; 0 for the constant sky, which composes as skyCover x its colour). A
+// Preetham or map sky's light on surfaces (its virtual lights) is direct light: it is in `local`.
+// 68 bytes.
+struct SampleParts {
+    glm::vec3 local;
+    glm::vec3 indirect;
+    glm::vec3 albedo;
+    float skyCover;
+    glm::vec3 normal;
+    float depth;
+    glm::vec3 background;
+};
+
+// The depth of a sample that saw the sky (Cycles' value for the background of its Z pass).
+inline constexpr float kSkyDepth = 1e10f;
+
 // Offset along the geometric normal, scaled to the magnitude of the coordinates the hit was computed
 // from (no self-shadowing acne): camera-relative p and, for a mesh hit, `extent` = its species-frame
 // point's largest coordinate in world units. No floor in metres: a 1 m floor lifted the shadow rays of

@@ -1,5 +1,5 @@
-// Ray queries over the surface kinds (core/render/surfaces/surface_list.h): each kind asked in the list's
-// order below the closest hit so far (host and device).
+// Ray queries over the kinds (core/render/surfaces/surface_list.h): each surface kind asked in the list's
+// order below the closest hit so far, and what the media let through (host and device).
 #pragma once
 
 #include "core/render/surfaces/ground_trace.h"
@@ -7,6 +7,7 @@
 #include "core/render/surfaces/landscape_trace.h"
 #include "core/render/surfaces/spheres_trace.h"
 #include "core/render/surfaces/terrain_trace.h"
+#include "core/render/surfaces/volumes_trace.h"
 
 namespace sylva {
 
@@ -45,7 +46,7 @@ SYLVA_HD inline bool traceSurfaces(const RenderView& v, const Ray& ray, Hit& hit
     trace_detail::Query q{v, ray.tmin, alphaTestLimit(v, ray), hit, SurfaceKind::None, {}};
 #define SYLVA_X(Kind) \
     if (trace_detail::trace##Kind<AnyHit, Kd>(q, ray, tmax) && AnyHit) return true;
-    SYLVA_SURFACE_KINDS(SYLVA_X)
+    SYLVA_SURFACE_KINDS(SYLVA_X, SYLVA_KIND_SKIP)
 #undef SYLVA_X
     return AnyHit ? false : hit.kind != uint16_t(SurfaceKind::None);
 }
@@ -67,11 +68,21 @@ SYLVA_HD inline SurfacePoint surfaceAt(const RenderView& v, const Ray& ray, cons
     switch (hitKind(hit)) {
 #define SYLVA_X(Kind) \
     case SurfaceKind::Kind: shade##Kind(v, ray, hit, s); break;
-        SYLVA_SURFACE_KINDS(SYLVA_X)
+        SYLVA_SURFACE_KINDS(SYLVA_X, SYLVA_KIND_SKIP)
 #undef SYLVA_X
     case SurfaceKind::None: break;
     }
     return s;
+}
+
+// What gets through every medium kind along the shadow ray org + t dir, t in [0, tmax], per channel.
+SYLVA_HD inline glm::vec3 mediaTransmittance(const RenderView& v, const glm::vec3& org, const glm::vec3& dir, float tmax = 1e30f)
+{
+    glm::vec3 t(1.0f);
+#define SYLVA_X(Kind) t *= transmittance##Kind(v, org, dir, tmax);
+    SYLVA_SURFACE_KINDS(SYLVA_KIND_SKIP, SYLVA_X)
+#undef SYLVA_X
+    return t;
 }
 
 } // namespace sylva

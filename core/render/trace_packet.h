@@ -157,7 +157,7 @@ inline void tracePacket(const RenderView& v, const Ray* rays, int n, Hit* hits, 
         PacketWalk<SurfaceKind::Kind>::template run<AnyHit, Kd>(Q);                                                      \
     else                                                                                                                 \
         Q.perRay<AnyHit>([](Query& q, const Ray& r, float& t) { return trace##Kind<AnyHit, Kd>(q, r, t); });
-    SYLVA_SURFACE_KINDS(SYLVA_X)
+    SYLVA_SURFACE_KINDS(SYLVA_X, SYLVA_KIND_SKIP)
 #undef SYLVA_X
     for (int i = 0; i < n; ++i) found[i] = (Q.done >> i & 1u) || (!AnyHit && hits[i].kind != uint16_t(SurfaceKind::None));
 }

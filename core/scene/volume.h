@@ -1,5 +1,5 @@
 // Volumes of a scene (participating media: clouds, smoke, glowing plastics): a density grid with its
-// optics, LB lighting, emission and placements. The renderer's side is core/render/volume_trace.h.
+// optics, LB lighting, emission and placements. The renderer's side is the volumes kind (core/render/surfaces/volume*).
 #pragma once
 
 #include <cstdint>
@@ -11,7 +11,7 @@
 
 #include "core/grid/grid.h"
 #include "core/lb/lb_params.h"
-#include "core/render/volume_trace.h"
+#include "core/render/surfaces/volume.h"
 
 namespace sylva {
 

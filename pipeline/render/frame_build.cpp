@@ -1,14 +1,15 @@
-// The LB solves a frame triggers: the forest-level grid over the top level's instances (core/lb/forest_grid.h)
-// and its share over the landscape's plants (core/terrain/landscape_light.h), each applied unless off or
-// (auto) exposure is uniform.
-#include "core/render/scene_build.h"
+// A frame from a scene: the renderer's build (core/render/render_scene.h), the LB solves the frame triggers
+// (the forest-level grid over the top level's instances, core/lb/forest_grid.h, and its share over the
+// landscape's plants, core/terrain/landscape_light.h: each applied unless off or, auto, exposure is uniform),
+// then the top level.
+#include "pipeline/render/frame_build.h"
 
 #include <algorithm>
 
 #include "core/base/error.h"
 #include "core/terrain/landscape_light.h"
 
-namespace sylva::scene_build {
+namespace sylva {
 
 namespace {
 
@@ -28,16 +29,10 @@ lb::LbParams forestGridParams(const Scene& scene, int optics)
     return p;
 }
 
-} // namespace
-
-// The forest grid's share over the landscape's plants (core/terrain/landscape_light.h): the lattice of which
-// plants grow now, applied unless off or (auto) exposure is uniform over the cells with plants.
-void buildLandscapeLight(RenderScene& rs, const Scene& scene)
+// The landscape's share, into rs (cleared first by lightLandscape).
+void solveLandscapeShare(RenderScene& rs, const Scene& scene)
 {
     LandscapeLightStats& st = rs.buildStats.landscapeLight;
-    st = LandscapeLightStats{};
-    rs.landLight.clear();
-    rs.frame.landscape.lightLayout = LandLightLayout{};
     const ForestGridMode mode = scene.lighting.forestGrid;
     if (mode == ForestGridMode::Off || rs.landCells.empty()) return;
     const int optics = forestOptics(rs.forestSpecies);
@@ -70,11 +65,16 @@ void buildLandscapeLight(RenderScene& rs, const Scene& scene)
     rs.frame.landscape.lightLayout = l.layout;
 }
 
-// The forest-level LB grid (core/lb/forest_grid.h) over the scene's top-level instances of species with a
-// density grid, with the scene's sun and the first such species' optics; its factors become instanceLights
-// (one record per scene instance, factor 1 for those outside it). Auto applies them only where exposure
-// differs: factors and face factors spread by at least uniformSpread (2%).
-void buildForestGrid(RenderScene& rs, const Scene& scene)
+} // namespace
+
+void lightLandscape(RenderScene& rs, const Scene& scene)
+{
+    clearLandscapeLight(rs);
+    solveLandscapeShare(rs, scene);
+    countFrameBytes(rs);
+}
+
+void lightForestGrid(RenderScene& rs, const Scene& scene)
 {
     ForestGridStats& st = rs.buildStats.forestGrid;
     const ForestGridMode mode = scene.lighting.forestGrid;
@@ -133,4 +133,20 @@ void buildForestGrid(RenderScene& rs, const Scene& scene)
     }
 }
 
-} // namespace sylva::scene_build
+void lightFrame(RenderScene& rs, const Scene& scene)
+{
+    lightLandscape(rs, scene);
+    lightForestGrid(rs, scene);
+}
+
+RenderScene buildRenderScene(const Scene& scene, const std::vector<SpeciesAssets>& assets, const glm::vec3& sunRadiance,
+                             Progress* progress)
+{
+    RenderScene rs = buildSceneGeometry(scene, assets, LodLevels::Used, progress);
+    lightFrame(rs, scene);
+    placeTopLevel(rs, scene, sunRadiance, scene.render.width, scene.render.height, scene.render.spp);
+    if (progress) progress->report(1.0, "acceleration structures built");
+    return rs;
+}
+
+} // namespace sylva

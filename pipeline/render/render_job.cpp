@@ -22,6 +22,7 @@
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/image_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/render/volume_job.h"
 

@@ -1,10 +1,12 @@
-// The studio's frame through the renderer's one builder (buildSceneGeometry + placeTopLevel).
+// The studio's frame through the renderer's one builder (buildSceneGeometry, the LB solves it triggers:
+// frame_build.h lightFrame, then placeTopLevel).
 #include "pipeline/render/view_frame.h"
 
 #include <algorithm>
 #include <cstdio>
 
 #include "pipeline/lighting_job.h"
+#include "pipeline/render/frame_build.h"
 
 namespace sylva {
 
@@ -14,6 +16,7 @@ ViewFrame buildViewFrame(const Scene& scene, const std::vector<SpeciesAssets>& a
     s.render.accel = AccelKind::Bvh;   // the viewport traces BVHs
     ViewFrame f;
     f.rs = buildSceneGeometry(s, assets, LodLevels::All);
+    lightFrame(f.rs, s);
     placeTopLevel(f.rs, s, sunRadiance, s.render.width, s.render.height, s.render.spp);
     return f;
 }
@@ -99,6 +102,7 @@ void updateViewFrame(ViewFrame& frame, const Scene& next, const ViewFrameUpdate&
 {
     if (update.landscape) buildLandscapeArrays(frame.rs, next);
     else if (update.density) setLandscapeDensity(frame.rs, next);
+    if (update.landscape || update.density) lightLandscape(frame.rs, next);   // which plants grow changed
     if (update.volumes) rebuildVolumeGrids(frame.rs, next);
 }
 

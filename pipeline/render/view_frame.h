@@ -44,8 +44,8 @@ struct ViewFrameUpdate {
 };
 ViewFrameUpdate viewFrameUpdate(const Scene& built, const Scene& next);
 
-// Applies an update short of a rebuild to `frame` for `next` (setLandscapeDensity, buildLandscapeArrays,
-// rebuildVolumeGrids); placeViewFrame follows. Throws Error as those do.
+// Applies an update short of a rebuild to `frame` for `next` (setLandscapeDensity or buildLandscapeArrays, then
+// lightLandscape; rebuildVolumeGrids); placeViewFrame follows. Throws Error as those do.
 void updateViewFrame(ViewFrame& frame, const Scene& next, const ViewFrameUpdate& update);
 
 } // namespace sylva

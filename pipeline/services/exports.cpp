@@ -8,6 +8,7 @@
 #include "core/render/render_cpu.h"
 #include "pipeline/io/file_extension.h"
 #include "pipeline/io/grid_file.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/render_passes.h"
 

@@ -6,6 +6,7 @@
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/render/tonemap.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/study/study_parts.h"
 

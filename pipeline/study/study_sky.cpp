@@ -18,6 +18,7 @@
 #include "pipeline/io/atomic_file.h"
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/lighting_job.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/study/study_parts.h"
 

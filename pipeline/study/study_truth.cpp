@@ -21,6 +21,7 @@
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/lighting_job.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/study/blender_scene.h"
 #include "pipeline/study/study_blender.h"

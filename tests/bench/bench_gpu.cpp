@@ -13,6 +13,7 @@
 #include "core/render/tonemap.h"
 #include "cuda/device_query.h"
 #include "pipeline/cache/grid_cache.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/view_frame.h"
 #include "tests/bench/bench_timing.h"

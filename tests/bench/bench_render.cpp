@@ -19,6 +19,7 @@
 #include "core/render/shade.h"
 #include "core/render/trace.h"
 #include "pipeline/cache/grid_cache.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "tests/bench/bench_timing.h"
 

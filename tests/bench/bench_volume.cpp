@@ -17,6 +17,7 @@
 #include "core/lb/lb_solver.h"
 #include "core/reference/mc_reference.h"
 #include "core/render/render_cpu.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/volume_job.h"
 #include "pipeline/scene/scene_file.h"

@@ -21,6 +21,7 @@
 #include "pipeline/backend_select.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/io/env_map_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/view_frame.h"
 #include "pipeline/render/volume_job.h"

@@ -12,6 +12,7 @@
 
 #include "core/render/render_cpu.h"
 #include "core/scene/scene.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "studio/asset_store.h"
 #include "studio/render_worker.h"

@@ -21,6 +21,7 @@
 #include "core/sky/sun_position.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/io/env_map_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/camera_nav.h"

@@ -31,6 +31,7 @@
 #include "pipeline/io/grid_file.h"
 #include "pipeline/io/image_io.h"
 #include "pipeline/io/npy.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_passes.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/job_panel.h"

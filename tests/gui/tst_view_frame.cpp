@@ -12,6 +12,7 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/io/env_map_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "studio/asset_store.h"
 #include "studio/render_worker.h"

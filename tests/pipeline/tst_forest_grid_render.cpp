@@ -14,6 +14,7 @@
 #include "core/render/render_scene.h"
 #include "core/render/shade.h"
 #include "core/terrain/landscape_light.h"
+#include "pipeline/render/frame_build.h"
 #include "tests/common/scenes.h"
 
 using namespace sylva;

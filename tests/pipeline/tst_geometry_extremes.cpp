@@ -21,6 +21,7 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/grow/obj_writer.h"
 #include "pipeline/lighting_job.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "tests/common/files.h"
 

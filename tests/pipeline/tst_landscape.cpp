@@ -26,6 +26,7 @@
 #include "core/terrain/landscape.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/io/dem_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "tests/common/golden.h"

@@ -18,6 +18,7 @@
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/image_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "tests/common/files.h"
 #include "tests/common/golden.h"

@@ -14,6 +14,7 @@
 #include "core/render/tonemap.h"
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/grow/tree_grower.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "tests/common/scenes.h"
 

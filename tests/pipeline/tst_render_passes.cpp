@@ -20,6 +20,7 @@
 #include "core/voxel/voxelize.h"
 #include "pipeline/grow/obj_writer.h"
 #include "pipeline/lighting_job.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/render_passes.h"
 #include "pipeline/scene/scene_file.h"

@@ -11,6 +11,7 @@
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/render/shade.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/grow/tree_grower.h"
 
 using namespace sylva;

@@ -20,6 +20,7 @@
 #include "core/sky/sky_light.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/io/env_map_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "tests/common/scenes.h"

@@ -16,6 +16,7 @@
 #include "core/render/render_scene.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/io/dem_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/scene/scene_file.h"
 #include "tests/common/scenes.h"
 

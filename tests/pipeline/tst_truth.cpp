@@ -15,6 +15,7 @@
 #include "core/render/render_scene.h"
 #include "core/render/shade.h"
 #include "pipeline/io/image_io.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/study/blender_scene.h"

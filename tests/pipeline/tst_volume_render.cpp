@@ -22,6 +22,7 @@
 #include "core/render/render_scene.h"
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/io/npy.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/volume_job.h"
 #include "pipeline/scene/scene_file.h"

@@ -18,6 +18,7 @@
 #include "core/voxel/voxelize.h"
 #include "pipeline/import/mesh_import.h"
 #include "pipeline/io/grid_file.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/grid_stats.h"

@@ -1,5 +1,5 @@
 // The distant light (the sun): parallel light from one direction, a shadow ray per point, dimmed by the
-// volumes it crosses (host and device). Its functions as light_list.h names them; included by core/render/lights.h.
+// media it crosses (host and device). Its functions as light_list.h names them; included by core/render/lights.h.
 #pragma once
 
 namespace sylva {
@@ -17,7 +17,7 @@ SYLVA_HD inline void directDistant(const RenderView& v, const LightRecord& l, co
     if (!(nl > 0.0f)) return;
     if (!(q.seen >= 0 ? q.seen != 0 : directionVisible(v, shadowOrigin(s), l.direction))) return;
     glm::vec3 c = reflectedLight(s, l.direction, nl, l.radiance);
-    if (v.volumeCount > 0) c *= volumeTransmittance(volumeViewOf(v), s.p, l.direction);   // cloud shadows
+    c *= mediaTransmittance(v, s.p, l.direction);   // cloud shadows
     out.local += c;
 }
 

@@ -1,6 +1,6 @@
 // The light kinds, one line each, and the record a frame's light list (RenderView::lights) holds. Adding a
-// light is a header <kind>_light.h (included by core/render/lights.h) with its functions, its line here and
-// the record fields it needs; docs/ARCHITECTURE.md walks through it with the point light. Each kind K
+// light is a header <kind>.h in this folder (included by core/render/lights.h) with its functions, its line
+// here and the record fields it needs; docs/ARCHITECTURE.md walks through it with the point light. Each kind K
 // provides, for the shading code on every backend:
 //   SYLVA_HD void directK(const RenderView&, const LightRecord&, const SurfacePoint&, const LightQuery&, LightContribution&)
 //       what it adds to a surface point's parts (`local`: direct light; `indirect`: the uniform sky's ambient on

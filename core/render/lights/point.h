@@ -23,7 +23,7 @@ SYLVA_HD inline void directPoint(const RenderView& v, const LightRecord& l, cons
     if (!(nl > 0.0f)) return;
     if (!(q.seen >= 0 ? q.seen != 0 : segmentVisible(v, shadowOrigin(s), l.position))) return;
     glm::vec3 c = reflectedLight(s, wi, nl, l.radiance / r2);
-    if (v.volumeCount > 0) c *= volumeTransmittance(volumeViewOf(v), s.p, wi, r);
+    c *= mediaTransmittance(v, s.p, wi, r);
     out.local += c;
 }
 

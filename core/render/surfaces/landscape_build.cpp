@@ -7,8 +7,13 @@
 
 namespace sylva {
 
-using scene_build::buildLandscapeLight;
-using scene_build::countBytes;
+void clearLandscapeLight(RenderScene& rs)
+{
+    rs.landLight.clear();
+    rs.frame.landscape.lightLayout = LandLightLayout{};
+    rs.buildStats.landscapeLight = LandscapeLightStats{};
+}
+
 
 void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
 {
@@ -38,16 +43,16 @@ void buildLandscapeArrays(RenderScene& rs, const Scene& scene)
         rs.frame.landscape.layout = lb.layout;
         rs.buildStats.landscape = lb.stats;
     }
-    buildLandscapeLight(rs, scene);
-    countBytes(rs);
+    clearLandscapeLight(rs);
+    countFrameBytes(rs);
 }
 
 void setLandscapeDensity(RenderScene& rs, const Scene& scene)
 {
     if (rs.landCells.empty()) return;
     setLandscapeDensity(rs.frame.landscape.layout, scene.terrain.density, scene.terrain.origin.y);
-    buildLandscapeLight(rs, scene);
-    countBytes(rs);
+    clearLandscapeLight(rs);
+    countFrameBytes(rs);
 }
 
 } // namespace sylva

@@ -1,11 +1,12 @@
-// Volumes into the renderer's flat arrays.
-#include "core/render/render_volumes.h"
+// The volumes kind's builder: grids, bricks, lighting and temperatures into the flat arrays (once per set of
+// assets), the placed instances camera-relative (per camera).
+#include "core/render/scene_build.h"
 
 #include <algorithm>
 
 #include "core/base/error.h"
 
-namespace sylva {
+namespace sylva::scene_build {
 
 std::vector<float> volumeBrickMaxima(const std::vector<float>& density, const glm::ivec3& dims, glm::ivec3* bricksOut)
 {
@@ -87,20 +88,6 @@ void buildVolumeGrids(RenderScene& rs, const Scene& scene)
     }
 }
 
-namespace {
-
-glm::dmat3 rotationOf(const glm::vec3& deg)
-{
-    const glm::dvec3 r = glm::radians(glm::dvec3(deg));
-    const double cx = std::cos(r.x), sx = std::sin(r.x), cy = std::cos(r.y), sy = std::sin(r.y), cz = std::cos(r.z), sz = std::sin(r.z);
-    const glm::dmat3 rx(1, 0, 0, 0, cx, sx, 0, -sx, cx);
-    const glm::dmat3 ry(cy, 0, -sy, 0, 1, 0, sy, 0, cy);
-    const glm::dmat3 rz(cz, sz, 0, -sz, cz, 0, 0, 0, 1);
-    return rz * ry * rx;
-}
-
-} // namespace
-
 void placeVolumes(RenderScene& rs, const Scene& scene, const glm::dvec3& eye)
 {
     rs.volumeInstances.clear();
@@ -111,7 +98,7 @@ void placeVolumes(RenderScene& rs, const Scene& scene, const glm::dvec3& eye)
         for (const VolumePlacement& p : vd.instances) {
             // world = R (s x_grid) + p, x_grid = origin + spacing n  =>  n = (R^T (world - p) / s - origin) / spacing
             const double k = 1.0 / (double(p.scale) * gg.spacing);
-            const glm::dmat3 m = glm::transpose(rotationOf(p.rotationDeg)) * k;
+            const glm::dmat3 m = glm::transpose(rotationDeg(p.rotationDeg)) * k;
             const glm::dvec3 t = -(m * (p.position - eye)) - gg.origin / gg.spacing;
             VolumeInstanceRecord r{};
             for (int i = 0; i < 3; ++i) r.row[i] = glm::vec4(float(m[0][i]), float(m[1][i]), float(m[2][i]), float(t[i]));
@@ -122,4 +109,4 @@ void placeVolumes(RenderScene& rs, const Scene& scene, const glm::dvec3& eye)
     }
 }
 
-} // namespace sylva
+} // namespace sylva::scene_build

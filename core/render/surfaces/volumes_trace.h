@@ -1,4 +1,4 @@
-// Participating media in the renderer (host and device): density grids with LB lighting, marched along
+// The volumes kind, the list's medium (host and device): density grids with LB lighting, marched along
 // camera rays (Geist & Westall, "Lattice-Boltzmann Lighting Models", section 3.2.1: "a standard, path
 // integrating volume tracer that samples the medium density and the LB lighting solution along each ray"),
 // beside single scattering (as in the graphics-blog posts "Faster Fog" and "In-Scattering Demo"), with
@@ -12,68 +12,10 @@
 
 #include "core/accel/ray.h"
 #include "core/base/defines.h"
-#include "core/render/lights/light_list.h"
+#include "core/render/render_view.h"
+#include "core/render/surface_point.h"
 
 namespace sylva {
-
-// How a volume's in-scattered light is computed (docs/RENDERING.md "Volumes").
-//   Lb:       sigma_s x the LB photon density (isotropic), Geist & Westall: no shadow rays, all of it indirect;
-//   Single:   as in those posts: sun single scattering with the Henyey-Greenstein phase and a shadow march
-//             toward the sun at every step (direct, `local`), no multiple scattering;
-//   Combined: Single's sun term plus the LB solution less its uncollided part (multiple scattering,
-//             indirect).
-enum class VolumeTracer : uint32_t { Lb = 0, Single = 1, Combined = 2 };
-
-// Nodes per side of a brick of the empty-space grid.
-inline constexpr int kVolumeBrick = 8;
-// Blackbody table: kVolumeBlackbodySize entries from kVolumeBlackbodyLo to kVolumeBlackbodyHi kelvin.
-inline constexpr int kVolumeBlackbodySize = 256;
-inline constexpr float kVolumeBlackbodyLo = 1000.0f, kVolumeBlackbodyHi = 40000.0f;
-// A ray's march stops where every channel's transmittance is below this (the rest adds < 1e-4).
-inline constexpr float kVolumeMinTransmittance = 1e-4f;
-// The adaptive step keeps the optical depth of one step below this (down to step / 8).
-inline constexpr float kVolumeTauPerStep = 0.25f;
-// Volumes one camera ray composes (the nearest entries beyond are dropped; shadows take them all).
-inline constexpr int kMaxRayVolumes = 8;
-
-// One volume grid (asset), its optics per node spacing at density 1. 96 bytes.
-struct VolumeGridRecord {
-    glm::ivec3 dims;            // density nodes per axis (z fastest)
-    uint32_t densityOffset;     // into RenderView::volumeDensity
-    glm::ivec3 bricks;          // brick grid dims (ceil(dims / kVolumeBrick))
-    uint32_t brickOffset;       // into volumeBricks: max density over a brick's trilinear support
-    glm::vec3 sigmaT;           // extinction per node spacing at density 1, per channel
-    uint32_t lightOffset;       // into volumeLight (3 floats per node, normalized: 1 = unobstructed); kNoHit = none
-    glm::vec3 sigmaS;           // scattering per node spacing at density 1
-    uint32_t temperatureOffset; // into volumeTemperature (kelvin per node); kNoHit = no emission
-    glm::vec3 g;                // Henyey-Greenstein asymmetry per channel
-    uint32_t tracer;            // VolumeTracer
-    float step;                 // largest camera-ray step, nodes
-    float shadowStep;           // shadow-march step, nodes
-    float emission;             // 2^exposure: multiplies sigma_a rho B(T) / Y(B(6500 K))
-    float maxSigmaT;            // max over channels of sigmaT
-};
-
-// A placed volume: camera-relative world -> grid node coordinates (node (i,j,k) at (i,j,k); the medium
-// fills the node-centred cells, [-0.5, N - 0.5] per axis). 64 bytes.
-struct VolumeInstanceRecord {
-    glm::vec4 row[3];
-    uint32_t grid;              // into RenderView::volumeGrids
-    float nodesPerMetre;        // 1 / (spacing x instance scale)
-    uint32_t pad[2];
-};
-
-// What a volume view needs of RenderView (filled from it by volumeViewOf in shade.h).
-struct VolumeArrays {
-    const VolumeGridRecord* grids;
-    const VolumeInstanceRecord* instances;
-    const float* density;
-    const float* bricks;
-    const float* light;
-    const float* temperature;
-    const glm::vec3* blackbody;
-    uint32_t count;             // instances
-};
 
 SYLVA_HD SYLVA_INLINE glm::vec3 volumeToGrid(const VolumeInstanceRecord& in, const glm::vec3& p)
 {
@@ -336,6 +278,60 @@ SYLVA_HD inline VolumeSegment marchVolume(const VolumeArrays& vv, const VolumeIn
         return true;
     });
     return s;
+}
+
+// The volumes' arrays of a view.
+SYLVA_HD SYLVA_INLINE VolumeArrays volumeViewOf(const RenderView& v)
+{
+    return VolumeArrays{v.volumeGrids, v.volumeInstances, v.volumeDensity, v.volumeBricks, v.volumeLight, v.volumeTemperature,
+                        v.volumeBlackbody, v.volumes.count};
+}
+
+// The volumes kind's segment of a camera ray, [ray.tmin, tEnd]: the volumes it crosses composed back to
+// front (each one's entry point orders them; the nearest kMaxRayVolumes kept): what lies behind is multiplied
+// by a volume's transmittance (the constant sky through skyCover x its mean, the colour difference into
+// background) and the volume's own light is added (marchVolume: sun single scattering and emission into
+// local, LB into indirect, the scattered share of a uniform ambient into albedo, so every render mode keeps
+// its meaning).
+SYLVA_HD inline void crossVolumes(const RenderView& v, const Ray& ray, float tEnd, SampleParts& parts)
+{
+    if (v.volumes.count == 0) return;
+    const VolumeArrays vv = volumeViewOf(v);
+    uint32_t order[kMaxRayVolumes];
+    float entry[kMaxRayVolumes];
+    int n = 0;
+    for (uint32_t i = 0; i < v.volumes.count; ++i) {
+        const VolumeInstanceRecord& in = v.volumeInstances[i];
+        float t0 = ray.tmin, t1 = tEnd;
+        if (!volumeClip(v.volumeGrids[in.grid].dims, volumeToGrid(in, ray.org), volumeDirToGrid(in, ray.dir), t0, t1)) continue;
+        if (n == kMaxRayVolumes && !(t0 < entry[n - 1])) continue;   // full: keep the nearest
+        int k = n < kMaxRayVolumes ? n++ : n - 1;
+        while (k > 0 && entry[k - 1] > t0) {        // nearest entry first
+            order[k] = order[k - 1];
+            entry[k] = entry[k - 1];
+            --k;
+        }
+        order[k] = i;
+        entry[k] = t0;
+    }
+    for (int k = n - 1; k >= 0; --k) {
+        const VolumeSegment s = marchVolume(vv, v.volumeInstances[order[k]], ray.org, ray.dir, ray.tmin, tEnd, lbLight(v), v.lbRadiance,
+                                            v.indirectScale);
+        const glm::vec3& T = s.transmittance;
+        const float mean = (T.x + T.y + T.z) * (1.0f / 3.0f);
+        parts.local = parts.local * T + s.local;
+        parts.indirect = parts.indirect * T + s.indirect;
+        parts.albedo = parts.albedo * T + s.albedo;
+        parts.background = parts.background * T + parts.skyCover * (T - mean) * v.sky.constant;
+        parts.skyCover *= mean;
+    }
+}
+
+// The volumes kind's transmittance along a shadow ray (cloud shadows).
+SYLVA_HD SYLVA_INLINE glm::vec3 transmittanceVolumes(const RenderView& v, const glm::vec3& org, const glm::vec3& dir, float tmax)
+{
+    if (v.volumes.count == 0) return glm::vec3(1.0f);
+    return volumeTransmittance(volumeViewOf(v), org, dir, tmax);
 }
 
 } // namespace sylva
