@@ -66,7 +66,10 @@ std::string paramRange(const ParamSpec& s)
 std::string paramDefault(const ParamSpec& s)
 {
     std::string t;
-    for (int i = 0; i < s.count; ++i) t += (i ? "," : "") + paramNumber(s.def[i]);
+    for (int i = 0; i < s.count; ++i) {
+        if (i) t += ',';
+        t += paramNumber(s.def[i]);
+    }
     return t;
 }
 

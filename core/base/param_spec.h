@@ -12,6 +12,11 @@ namespace sylva {
 
 inline constexpr double kUnbounded = std::numeric_limits<double>::infinity();
 
+// The largest seed any generator takes: 2^62, exact in a double (a JSON number, a ParamSpec bound) and
+// below 2^63 (a signed parse). The scene file's seeds, the CLI's --seed options and the cloud's and smoke's
+// seeds all read it here; the docs write it "2^62" (paramNumber).
+inline constexpr uint64_t kMaxSeed = uint64_t(1) << 62;
+
 struct ParamSpec {
     enum class Kind { Real, Integer };
     const char* key = "";          // the field's name; the CLI option is --key

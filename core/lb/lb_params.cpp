@@ -5,10 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <sstream>
 
 #include "core/base/error.h"
+#include "core/base/number_text.h"
 #include "core/grid/grid.h"
 
 namespace sylva::lb {
@@ -57,18 +57,6 @@ int fixedSteps(const LbParams& params, const glm::ivec3& dims)
     return std::max(1, params.stepsPerEdge * glm::max(dims.x, glm::max(dims.y, dims.z)));
 }
 
-namespace {
-
-// A parameter value as the message shows it: enough digits that a value just past a bound reads past it.
-std::string num(float v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.9g", double(v));
-    return buf;
-}
-
-} // namespace
-
 void validate(const LbParams& params)
 {
     static const char* names[3] = {"R", "G", "B"};
@@ -78,19 +66,19 @@ void validate(const LbParams& params)
             throw Error(std::string("invalid LB parameter for channel ") + names[c] + ": " + what);
         };
         if (!std::isfinite(ch.sigmaA) || ch.sigmaA < 0.0f)
-            fail("sigma_a = " + num(ch.sigmaA) + " must be finite and >= 0");
+            fail("sigma_a = " + numberText(ch.sigmaA, kFloatDigits) + " must be finite and >= 0");
         if (!std::isfinite(ch.sigmaS) || ch.sigmaS < 0.0f)
-            fail("sigma_s = " + num(ch.sigmaS) + " must be finite and >= 0");
+            fail("sigma_s = " + numberText(ch.sigmaS, kFloatDigits) + " must be finite and >= 0");
         // Stability (docs/LB_MODEL.md): every coefficient of I + rho*Omega is >= 0 iff sigma_t * max(rho) <= 1.
         // Checked on the float sum the kernels use (compactOmega): any excess over 1 makes the coefficient
         // 1 - rho * sigma_t negative and f with it. Decimal inputs that sum to 1 (0.118 + 0.882) round to
         // exactly 1 there.
         const float sigmaT = ch.sigmaA + ch.sigmaS;
         if (sigmaT > 1.0f)
-            fail("sigma_t = sigma_a + sigma_s = " + num(sigmaT) +
+            fail("sigma_t = sigma_a + sigma_s = " + numberText(sigmaT, kFloatDigits) +
                  " exceeds the stability bound 1 (sigma_t * max density must be <= 1)");
         if (!std::isfinite(ch.g) || std::fabs(ch.g) > 1.0f)
-            fail("g = " + num(ch.g) + " must lie in [-1, 1]");
+            fail("g = " + numberText(ch.g, kFloatDigits) + " must lie in [-1, 1]");
     }
     const glm::vec3 s = params.sun;
     if (!std::isfinite(s.x) || !std::isfinite(s.y) || !std::isfinite(s.z) || glm::length(s) < 1e-12f)

@@ -31,7 +31,7 @@ inline constexpr ParamSpec kCloudResolution{.key = "resolution", .kind = ParamSp
                                             .def = {128}, .help = "nodes per axis of the cubic grid"};
 inline constexpr ParamSpec kCloudDensity{.key = "density", .metavar = "D", .lo = 0.0, .hi = 1.0, .loOpen = true, .def = {1.0},
                                          .help = "density inside the cloud"};
-inline constexpr ParamSpec kCloudSeed{.key = "seed", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 0, .hi = 0x1p62,
+inline constexpr ParamSpec kCloudSeed{.key = "seed", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 0, .hi = double(kMaxSeed),
                                       .def = {1}, .help = "noise seed", .note = "; the same seed gives the same grid"};
 inline constexpr ParamSpec kCloudCentre{.key = "centre", .metavar = "X,Y,Z", .count = 3, .def = {0.0, 0.0, 0.0},
                                         .help = "world position of the sphere's centre, metres"};

@@ -14,7 +14,6 @@
 
 namespace sylva::volume {
 
-using smoke_detail::num;
 
 namespace {
 
@@ -62,16 +61,16 @@ void validateSmoke(const SmokeSettings& s)
     const double need = smokeBytes(s.cells), have = availableMemoryBytes();
     if (have > 0.0 && need > have)
         fail("a " + std::to_string(s.cells.x) + "x" + std::to_string(s.cells.y) + "x" + std::to_string(s.cells.z) + " grid needs " +
-             num(need / 1048576.0) + " MiB but only " + num(have / 1048576.0) + " MiB are available");
-    if (!(std::isfinite(s.cellSize) && s.cellSize > 0.0f)) fail("cell size " + num(s.cellSize) + " must be finite and > 0");
+             numberText(need / 1048576.0) + " MiB but only " + numberText(have / 1048576.0) + " MiB are available");
+    if (!(std::isfinite(s.cellSize) && s.cellSize > 0.0f)) fail("cell size " + numberText(s.cellSize) + " must be finite and > 0");
     checkParam(kSmokeDt, s.dt, "simulate", "time step");
     if (!finite3(s.origin)) fail("origin must be finite");
     if (!std::isfinite(s.buoyancyDensity) || !std::isfinite(s.buoyancyTemperature)) fail("buoyancy must be finite");
     checkParam(kSmokeVorticity, s.vorticity, "simulate");
     if (!(s.densityDecay >= 0.0f && s.densityDecay * s.dt <= 1.0f))
-        fail("density decay " + num(s.densityDecay) + " must be >= 0 and at most 1 / dt");
+        fail("density decay " + numberText(s.densityDecay) + " must be >= 0 and at most 1 / dt");
     if (!(s.temperatureDecay >= 0.0f && s.temperatureDecay * s.dt <= 1.0f))
-        fail("temperature decay " + num(s.temperatureDecay) + " must be >= 0 and at most 1 / dt");
+        fail("temperature decay " + numberText(s.temperatureDecay) + " must be >= 0 and at most 1 / dt");
     checkParam(kSmokeJitter, s.jitter, "simulate");
     checkParam(kSmokeTolerance, s.pressureTolerance, "simulate");
     checkParam(kSmokeSeed, s.seed, "simulate");
@@ -80,7 +79,7 @@ void validateSmoke(const SmokeSettings& s)
     auto checkShape = [&](const SmokeShape& sh, const std::string& what) {
         if (!finite3(sh.centre)) fail(what + ": centre must be finite");
         if (sh.kind == SmokeShape::Kind::Sphere && !(std::isfinite(sh.radius) && sh.radius > 0.0f))
-            fail(what + ": radius " + num(sh.radius) + " must be finite and > 0");
+            fail(what + ": radius " + numberText(sh.radius) + " must be finite and > 0");
         if (sh.kind == SmokeShape::Kind::Box && !(finite3(sh.halfSize) && glm::all(glm::greaterThan(sh.halfSize, glm::vec3(0.0f)))))
             fail(what + ": box half sizes must be finite and > 0");
     };
@@ -93,7 +92,7 @@ void validateSmoke(const SmokeSettings& s)
         if (!finite3(src.velocity)) fail(what + ": velocity must be finite");
         const float cfl = glm::length(src.velocity) * s.dt / s.cellSize;
         if (cfl > s.cflLimit)
-            fail(what + ": its velocity moves " + num(cfl) + " cells per step, over the CFL limit " + num(s.cflLimit) +
+            fail(what + ": its velocity moves " + numberText(cfl) + " cells per step, over the CFL limit " + numberText(s.cflLimit) +
                  " (lower the time step or the speed)");
     }
     for (size_t i = 0; i < s.obstacles.size(); ++i) checkShape(s.obstacles[i], "obstacle " + std::to_string(i + 1));

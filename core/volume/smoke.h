@@ -51,7 +51,7 @@ inline constexpr ParamSpec kSmokeJitter{.key = "jitter", .metavar = "J", .lo = 0
                                         .help = "source density noise"};
 inline constexpr ParamSpec kSmokeTolerance{.key = "tol", .metavar = "T", .lo = 0.0, .hi = 1.0, .loOpen = true, .hiOpen = true,
                                            .def = {1e-6}, .help = "relative residual of the pressure solve"};
-inline constexpr ParamSpec kSmokeSeed{.key = "seed", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 0, .hi = 0x1p62,
+inline constexpr ParamSpec kSmokeSeed{.key = "seed", .kind = ParamSpec::Kind::Integer, .metavar = "N", .lo = 0, .hi = double(kMaxSeed),
                                       .def = {1}, .help = "seed of the source noise", .note = "; the same seed gives the same bits"};
 inline constexpr ParamSpec kSmokeSourceDensity{.key = "source-density", .metavar = "D", .lo = 0.0, .hi = 1.0, .def = {1.0},
                                                .help = "density the sources set"};

@@ -8,23 +8,15 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "core/base/number_text.h"
 #include "core/base/parallel.h"
 
 namespace sylva::volume::smoke_detail {
-
-// A number in a message.
-inline std::string num(double v)
-{
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", v);
-    return buf;
-}
 
 // The MAC grid of n cells: the index of a cell and of a u, v, w face, z fastest.
 struct Dims {

@@ -18,7 +18,6 @@ namespace sylva::volume {
 
 using smoke_detail::Dims;
 using smoke_detail::forFluidCells;
-using smoke_detail::num;
 
 namespace {
 
@@ -223,8 +222,8 @@ double SmokeSim::checkedCfl() const
     if (std::isnan(maxSq)) throw Error("simulate: the velocity is no longer finite at step " + std::to_string(m_steps + 1));
     const double cfl = std::sqrt(3.0 * maxSq) * m_s.dt / m_s.cellSize;
     if (cfl > m_s.cflLimit)
-        throw Error("simulate: step " + std::to_string(m_steps + 1) + " would move the smoke " + num(cfl) +
-                    " cells (CFL number), over the limit " + num(m_s.cflLimit) + "; lower the time step (--dt) or the forces");
+        throw Error("simulate: step " + std::to_string(m_steps + 1) + " would move the smoke " + numberText(cfl) +
+                    " cells (CFL number), over the limit " + numberText(m_s.cflLimit) + "; lower the time step (--dt) or the forces");
     return cfl;
 }
 

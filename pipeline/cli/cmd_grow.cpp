@@ -1,6 +1,7 @@
 // sylva grow: a procedural tree written as OBJ + MTL + textures.
 #include <cstdio>
 
+#include "core/base/param_spec.h"
 #include "pipeline/cli/cli_util.h"
 #include "pipeline/cli/commands.h"
 #include "pipeline/cli/common_options.h"
@@ -22,7 +23,7 @@ int runGrow(const Args& args)
         for (const auto& n : speciesNames()) names += (names.empty() ? "" : ", ") + n;
         throw UsageError("option --species: unknown species '" + args.get("--species") + "' (known: " + names + ")");
     }
-    if (args.has("--seed")) opt.seed = uint64_t(parseInteger("--seed", args.get("--seed"), 0, (1LL << 62)));
+    if (args.has("--seed")) opt.seed = uint64_t(parseInteger("--seed", args.get("--seed"), 0, (long long)kMaxSeed));
     if (args.has("--triangles"))
         opt.targetTriangles = size_t(parseInteger("--triangles", args.get("--triangles"), kMinGrowTriangles, kMaxGrowTriangles));
     if (args.has("--height")) {

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "core/base/error.h"
+#include "core/base/param_spec.h"
 #include "core/reference/mc_reference.h"
 #include "pipeline/cli/cli_util.h"
 #include "pipeline/cli/commands.h"
@@ -28,7 +29,7 @@ int runReference(const Args& args)
     ReferenceSettings settings;
     if (args.has("--paths"))
         settings.paths = uint64_t(parseInteger("--paths", args.get("--paths"), 2, (long long)kMaxReferencePaths));
-    if (args.has("--seed")) settings.seed = uint64_t(parseInteger("--seed", args.get("--seed"), 0, (1LL << 62)));
+    if (args.has("--seed")) settings.seed = uint64_t(parseInteger("--seed", args.get("--seed"), 0, (long long)kMaxSeed));
     if (args.has("--max-bounces")) settings.maxBounces = int(parseInteger("--max-bounces", args.get("--max-bounces"), 0, 1000000000));
     if (args.has("--collimated")) settings.incidence = Incidence::Collimated;
     const VoxelizeSettings voxel = voxelSettings(args);

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <iterator>
 #include <map>
@@ -23,6 +22,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/base/error.h"
+#include "core/base/number_text.h"
 #include "core/base/version.h"
 #include "pipeline/io/atomic_file.h"
 
@@ -49,16 +49,9 @@ std::string quoted(const std::string& name)
     return "'" + name + "'";
 }
 
-std::string numberText(double v)
-{
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "%.9g", v);
-    return buf;
-}
-
 std::string triple(double a, double b, double c)
 {
-    return "(" + numberText(a) + ", " + numberText(b) + ", " + numberText(c) + ")";
+    return "(" + numberText(a, kFloatDigits) + ", " + numberText(b, kFloatDigits) + ", " + numberText(c, kFloatDigits) + ")";
 }
 
 // ---- writing ----
@@ -329,7 +322,7 @@ std::string valueRangeText(const GridT& grid)
             }
         }
     }
-    if constexpr (std::is_same_v<ValueT, float>) return "values " + numberText(lo) + " .. " + numberText(hi);
+    if constexpr (std::is_same_v<ValueT, float>) return "values " + numberText(lo, kFloatDigits) + " .. " + numberText(hi, kFloatDigits);
     else return "values " + triple(lo[0], lo[1], lo[2]) + " .. " + triple(hi[0], hi[1], hi[2]);
 }
 
@@ -522,7 +515,7 @@ std::string describeVdbFile(const std::string& path)
     try {
         const DensityGrid d = readVdbDensity(path);
         text += "as a Sylva density: " + std::to_string(d.geometry.dims.x) + "x" + std::to_string(d.geometry.dims.y) + "x" +
-                std::to_string(d.geometry.dims.z) + " nodes, spacing " + numberText(d.geometry.spacing) + ", node (0,0,0) at " +
+                std::to_string(d.geometry.dims.z) + " nodes, spacing " + numberText(d.geometry.spacing, kFloatDigits) + ", node (0,0,0) at " +
                 triple(d.geometry.origin.x, d.geometry.origin.y, d.geometry.origin.z) + "\n";
     } catch (const Error& e) {
         std::string why = e.what();

@@ -38,7 +38,8 @@ namespace {
 SceneReadContext& in(JsonReader& r) { return static_cast<SceneReadContext&>(r); }
 SceneWriteContext& out(JsonWriter& w) { return static_cast<SceneWriteContext&>(w); }
 
-constexpr long long kMaxSeed = 1LL << 62;
+// A seed's rule in the docs: "0 .. 2^62" (kMaxSeed, core/base/param_spec.h).
+std::string seedRule() { return "0 .. " + paramNumber(double(kMaxSeed)); }
 const float kNoUpperBound = std::numeric_limits<float>::max();
 
 const Table<GrowSpec>& growTable()
@@ -50,7 +51,7 @@ const Table<GrowSpec>& growTable()
              [](JsonReader& r, const QJsonValue& v, const KeyPath& p, GrowSpec& g) { g.species = readGrowerSpecies(in(r), v, p); },
              [](JsonWriter& w, const GrowSpec& g, const KeyPath&, int) { w.string(g.species); })
             .doc("string", "`broadleaf`, `birch`, `conifer`, `shrub` (any case; stored lower-case)");
-        b.integer("seed", &GrowSpec::seed, 0, kMaxSeed).doc("integer", "0 .. 2^62");
+        b.integer("seed", &GrowSpec::seed, 0, (long long)kMaxSeed).doc("integer", seedRule());
         b.integer("triangles", &GrowSpec::triangles, (long long)kMinGrowTriangles, (long long)kMaxGrowTriangles)
             .doc("integer", "1000 .. 1000000");
         b.number("height", &GrowSpec::height, Bounds{.lo = 0.1, .hi = 150.0, .unit = " metres", .orZero = " (the species' default)"})
@@ -242,7 +243,7 @@ const Table<TileSetDesc>& tileSetTable()
     static const Table<TileSetDesc> table = [] {
         TableBuilder<TileSetDesc> b(Layout::Block);
         b.number("size", &TileSetDesc::size, above(0.0)).doc("number", "metres, the side of a tile (its frame; mapped onto a cell scaled by cell / size), > 0");
-        b.integer("seed", &TileSetDesc::seed, 0, kMaxSeed).doc("integer", "0 .. 2^62; the populations (splitmix64, as the scatter tool)");
+        b.integer("seed", &TileSetDesc::seed, 0, (long long)kMaxSeed).doc("integer", seedRule() + "; the populations (splitmix64, as the scatter tool)");
         b.array("plants", &TileSetDesc::plants, tilePlantTable(), "a tile set needs at least one species")
             .doc("object", "the species of every tile's population, drawn in this order");
         return b.table;
@@ -301,7 +302,8 @@ const Table<TilingDesc>& tilingTable()
                  "empty or when it cannot tile (a south/west pair its tiles' north/east colours meet has no tile)")
             .shown("every combination")
             .writtenIf([](const TilingDesc& t) { return t.setGiven; });
-        b.integer("seed", &TilingDesc::seed, 0, kMaxSeed).doc("integer", "0 .. 2^62; which matching tile each cell takes (a hash of seed and cell)");
+        b.integer("seed", &TilingDesc::seed, 0, (long long)kMaxSeed)
+            .doc("integer", seedRule() + "; which matching tile each cell takes (a hash of seed and cell)");
         b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& p, TilingDesc& t) {
             try {
                 (void)wangTileSet(t);
