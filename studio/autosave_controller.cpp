@@ -70,10 +70,6 @@ bool AutosaveController::autosaveNow()
         return false;
     }
     if (m_doc->revision() == m_autosavedRevision && QFileInfo::exists(recoveryFilePath())) return false;
-    if (s.species.empty() || s.instances.empty()) {
-        removeRecoveryFile();   // not a scene file the reader accepts; an older autosave would mislead
-        return false;
-    }
     try {
         writeSceneFile(s, recoveryFilePath().toStdString());
         QJsonObject o;

@@ -25,10 +25,6 @@ ExportController::ExportController(SceneDocument* doc, JobManager* jobs, AssetSt
 Job* ExportController::exportRender(const ExportSettings& settings)
 {
     Scene scene = m_doc->scene();
-    if (scene.instances.empty()) {
-        fail(tr("Export failed"), tr("The scene is empty."));
-        return nullptr;
-    }
     scene.render.width = settings.width;
     scene.render.height = settings.height;
     scene.render.spp = settings.spp;

@@ -59,10 +59,10 @@ void LightingScheduler::updateViewport()
     const Scene& s = m_doc->scene();
     const bool lit = viewNeedsLighting();
     std::vector<AssetsPtr> assets = m_assets->forScene(s, lit);
-    const bool content = !s.instances.empty() || s.terrain.enabled();   // a landscape may have no instances
+    const bool speciesReady = assets.size() == s.species.size();   // forScene gives none while one is missing
     Scene shown;
     const bool volumesReady = m_volumes.litScene(s, lit, &shown);   // the volumes with their lighting
-    if (!content || (!assets.empty() && volumesReady)) {
+    if (speciesReady && volumesReady) {
         m_viewport->setScene(volumesReady ? shown : s, std::move(assets));
         return;
     }

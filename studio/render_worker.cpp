@@ -136,8 +136,9 @@ void RenderWorker::run()
 void RenderWorker::process(const Request& req, Progress& progress)
 {
     const Scene& scene = req.scene;
-    if ((scene.instances.empty() && !scene.terrain.enabled()) || req.assets.size() != scene.species.size())
-        throw Error("the scene has no instances and no terrain");
+    if (req.assets.size() != scene.species.size())
+        throw Error("the render has " + std::to_string(req.assets.size()) + " species' assets for the scene's " +
+                    std::to_string(scene.species.size()) + " species");
     const int w = std::max(1, req.size.width()), h = std::max(1, req.size.height());
     std::vector<RenderPass> passes;
     {

@@ -144,8 +144,6 @@ void SceneDocument::open(const QString& path)
 
 void SceneDocument::saveAs(const QString& path)
 {
-    if (m_scene.species.empty() || (m_scene.instances.empty() && !m_scene.terrain.enabled()))
-        throw Error(path.toStdString() + ": a scene file needs at least one species and one instance (or a terrain)");
     writeSceneFile(m_scene, path.toStdString());
     const QString abs = QFileInfo(path).absoluteFilePath();
     if (m_filePath != abs) {

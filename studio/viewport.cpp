@@ -99,10 +99,9 @@ void Viewport::setStatus(const QString& status)
 
 void Viewport::requestRender()
 {
-    const bool content = !m_scene.instances.empty() || m_scene.terrain.enabled();   // a landscape may have no instances
-    if (m_assets.empty() || m_assets.size() != m_scene.species.size() || !content) {
+    // Every species' assets (none in a scene of ground, terrain, sky and volumes alone, which renders too).
+    if (m_assets.size() != m_scene.species.size()) {
         m_worker->clear();
-        if (!content) setStatus(tr("Empty scene: import a mesh or grow a species"));
         return;
     }
     setStatus(QString());
@@ -289,7 +288,7 @@ void Viewport::drawTexture()
 // on the GPU. Passes after the first follow while nothing changes.
 bool Viewport::paintGpu()
 {
-    if (!m_gpuFrame || m_gpuFrame->assets != m_assets || (m_scene.instances.empty() && !m_scene.terrain.enabled())) return false;
+    if (!m_gpuFrame || m_gpuFrame->assets != m_assets) return false;
     if (viewFrameUpdate(m_gpuFrame->built, m_scene).any()) return false;   // a landscape or volume edit: the worker builds it
     if (!viewFrameFits(m_gpuFrame->frame, m_scene)) return false;   // pruning turned on: the worker builds the levels
     std::vector<int> spps;

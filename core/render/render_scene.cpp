@@ -211,7 +211,6 @@ namespace {
 std::vector<uint32_t> checkSceneInput(const Scene& scene, const std::vector<SpeciesAssets>& assets)
 {
     if (assets.size() != scene.species.size()) throw Error("render: one set of assets per species is required");
-    if (scene.instances.empty() && !scene.terrain.enabled()) throw Error("render: the scene has no instances and no terrain");
     if (scene.terrain.enabled() && !scene.terrain.field)
         throw Error("render: the terrain's heights were not loaded (" + scene.terrain.dem + ")");
     for (size_t s = 0; s < assets.size(); ++s)
@@ -274,7 +273,6 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     Scene lifted;
     const Scene& scene = onTerrain(sceneIn, lifted);
     const size_t ni = scene.instances.size();
-    if (ni == 0 && !scene.terrain.enabled()) throw Error("render: the scene has no instances and no terrain");
     if (scene.terrain.enabled() != !rs.terrainHeights.empty())
         throw Error("render: the scene's terrain differs from the one the frame was built with");
     if (rs.meshLevels.size() != scene.species.size() || rs.groupGeometry.size() != scene.groups.size())

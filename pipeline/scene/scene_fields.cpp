@@ -775,14 +775,16 @@ const Table<Scene>& sceneTable()
                 return "scene version " + std::to_string(s.version) + ": " + std::to_string(s.species.size()) + " species, " +
                        std::to_string(s.instances.size()) + " instances\n";
             });
-        b.array("species", &Scene::species, speciesTable(), "needs at least one species", size_t(std::numeric_limits<uint32_t>::max()),
-                "too many species")
-            .doc("object", "at least one")
-            .shown("")
+        // A scene of ground, terrain, sky and volumes alone (look development before any plant) has neither.
+        b.array("species", &Scene::species, speciesTable(), nullptr, size_t(std::numeric_limits<uint32_t>::max()), "too many species")
+            .required(nullptr)
+            .doc("object", "the plants' kinds; none for a scene of ground, terrain, sky and volumes alone")
+            .shown("[]")
             .summarized(describeSpecies);
         b.array("instances", &Scene::instances, instanceTable(), nullptr)
-            .doc("object", "at least one, unless the scene has a terrain")
-            .shown("")
+            .required(nullptr)
+            .doc("object", "the plants placed; each names a species or a group")
+            .shown("[]")
             .summarized(describeInstances);
         b.object("ground", &Scene::ground, groundTable())
             .doc("object", "")
@@ -799,7 +801,8 @@ const Table<Scene>& sceneTable()
             f.children = [](std::vector<json::FieldRow>& o, const std::string& path) { documentFields(terrainTable(), path, o); };
             f.doc("object", "a terrain from a DEM (replaces the ground plane); optional")
                 .shown("")
-                .summarized(sectionLine("terrain", [](const Scene& sc) -> const TerrainDesc& { return sc.terrain; }, terrainTable()));
+                .summarized([line = sectionLine("terrain", [](const Scene& sc) -> const TerrainDesc& { return sc.terrain; }, terrainTable())](
+                                const Scene& sc) { return sc.terrain.enabled() ? line(sc) : std::string(); });
         }
         b.array("volumes", &Scene::volumes, volumeTable(), nullptr, 4096, "too many volumes (at most 4096)")
             .required(nullptr)
@@ -824,7 +827,6 @@ const Table<Scene>& sceneTable()
             .doc("object", "")
             .summarized(sectionLine("render", [](const Scene& s) -> const RenderSettings& { return s.render; }, renderTable()));
         b.table.after = [](JsonReader& r, const QJsonObject&, const KeyPath& path, Scene& sc) {
-            if (sc.instances.empty() && !sc.terrain.enabled()) r.fail(path.field("instances"), "needs at least one instance (or a terrain)");
             for (size_t i = 0; i < sc.instances.size() && !sc.terrain.enabled(); ++i)
                 if (sc.instances[i].onTerrain)
                     r.fail(path.field("instances").at(qsizetype(i)).field("on_terrain"), "needs a terrain (the scene has no \"terrain\")");

@@ -154,7 +154,8 @@ void readInstanceSpecies(SceneReadContext& r, const QJsonValue& v, const KeyPath
     if (it == r.speciesIndex.constEnd()) {
         std::vector<std::string> names;
         for (const auto& s : r.scene->species) names.push_back("'" + s.name + "'");
-        r.fail(path, "unknown species " + quoted(v.toString()) + " (declared: " + nameList(names) + ")");
+        r.fail(path, "unknown species " + quoted(v.toString()) +
+                         (names.empty() ? " (the scene declares no species)" : " (declared: " + nameList(names) + ")"));
     }
     inst.species = *it;
 }

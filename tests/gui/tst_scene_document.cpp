@@ -133,14 +133,26 @@ private Q_SLOTS:
         QCOMPARE(changedParts(reopened.scene(), doc.scene()), ScenePart::None);
     }
 
-    void saveRefusesWhatCannotBeRead()
+    // A new document (no plants: ground and sky) saves and reads back; a file that cannot be written or read
+    // is an error that leaves the document as it was.
+    void saveAndOpenErrors()
     {
         QTemporaryDir dir;
         SceneDocument doc;
-        QVERIFY_THROWS_EXCEPTION(Error, doc.saveAs(dir.filePath("empty.sylva.json")));
-        QVERIFY(!QFile::exists(dir.filePath("empty.sylva.json")));
-        QVERIFY_THROWS_EXCEPTION(Error, doc.open(dir.filePath("missing.sylva.json")));
-        QVERIFY(doc.filePath().isEmpty());
+        doc.saveAs(dir.filePath("empty.sylva.json"));
+        SceneDocument reopened;
+        reopened.open(dir.filePath("empty.sylva.json"));
+        QVERIFY(reopened.scene().species.empty() && reopened.scene().instances.empty());
+        const std::string base = dir.path().toStdString();
+        QCOMPARE(QString::fromStdString(sceneToJson(reopened.scene(), base)), QString::fromStdString(sceneToJson(doc.scene(), base)));
+        SceneDocument other;
+        QFile plain(dir.filePath("plain"));   // a file where the folder should be
+        QVERIFY(plain.open(QIODevice::WriteOnly));
+        plain.close();
+        QVERIFY_THROWS_EXCEPTION(Error, other.saveAs(dir.filePath("plain/x.sylva.json")));
+        QVERIFY(other.filePath().isEmpty());
+        QVERIFY_THROWS_EXCEPTION(Error, other.open(dir.filePath("missing.sylva.json")));
+        QVERIFY(other.filePath().isEmpty());
     }
 
     void outlinerModel()

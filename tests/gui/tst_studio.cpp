@@ -499,6 +499,30 @@ private Q_SLOTS:
         QVERIFY(waitForFinalImage(m_win->viewport(), 60000));
     }
 
+    // A scene without plants (look development of ground and sky): the viewport draws it, it saves, reopens
+    // and exports. The forest is opened again for the tests after this one.
+    void bareScene()
+    {
+        const QString forest = m_dir.filePath("scenes/forest.sylva.json");
+        QVERIFY(m_win->newScene());
+        QVERIFY(scene().species.empty() && scene().instances.empty());
+        QVERIFY(waitForFinalImage(m_win->viewport(), 60000));
+        const QImage shown = m_win->viewport()->lastImage();
+        QVERIFY(!shown.isNull());
+        bool lit = false;
+        for (int y = 0; y < shown.height() && !lit; ++y)
+            for (int x = 0; x < shown.width() && !lit; ++x) lit = (shown.pixel(x, y) & 0xffffffu) != 0;
+        QVERIFY2(lit, "the bare scene's viewport picture is black");
+        const QString path = m_dir.filePath("scenes/bare.sylva.json");
+        QVERIFY(m_win->saveFile(path));
+        QVERIFY(m_win->openFile(path));
+        QVERIFY(scene().species.empty() && scene().instances.empty());
+        QVERIFY(waitForFinalImage(m_win->viewport(), 60000));
+        QVERIFY(m_win->openFile(forest));
+        QVERIFY(!scene().species.empty());
+        QVERIFY(waitForFinalImage(m_win->viewport(), 60000));
+    }
+
     void exportPng_data()
     {
         QTest::addColumn<QString>("name");

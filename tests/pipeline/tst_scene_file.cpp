@@ -510,10 +510,9 @@ private Q_SLOTS:
         QTest::newRow("unknown in instance") << with({"instances", "1", "rot"}, 0) << "instances[1].rot: unknown field";
         QTest::newRow("unknown in grow") << with({"species", "1", "grow", "leaves"}, 0) << "species[1].grow.leaves: unknown field";
         QTest::newRow("duplicate key") << replaced("\"scale\":1.5", "\"scale\":1.5,\"scale\":2") << "instances[0].scale: duplicate key";
-        QTest::newRow("zero instances") << with({"instances"}, QJsonArray()) << "instances: needs at least one instance";
-        QTest::newRow("no instances") << without({"instances"}) << "instances: missing (required)";
-        QTest::newRow("zero species") << with({"species"}, QJsonArray()) << "species: needs at least one species";
-        QTest::newRow("no species") << without({"species"}) << "species: missing (required)";
+        // Without species the instances name none that exists (a scene with neither: tst_bare_scene).
+        QTest::newRow("zero species") << with({"species"}, QJsonArray()) << "instances[0].species: unknown species 'oak' (the scene declares no species)";
+        QTest::newRow("no species") << without({"species"}) << "instances[0].species: unknown species 'oak'";
         QTest::newRow("species not array") << with({"species"}, QJsonObject()) << "species: expected an array, got an object";
         QTest::newRow("unknown species") << with({"instances", "1", "species"}, "elm")
                                          << "instances[1].species: unknown species 'elm' (declared: 'oak', 'birch')";
