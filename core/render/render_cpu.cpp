@@ -22,11 +22,11 @@ static_assert(kTile * kTile <= kPacketRays);
 // The pixels [x0, x1) x [y0, y1) of the frame (at most kPacketRays) into out (row length `stride`): exactly
 // shadePixel's parts for each. A landscape's tile traces each sample's camera rays as one packet, then for each
 // of the first kPacketLights lights the shadow rays of the surfaces they found as another (trace_packet.h: the
-// same answers as ray by ray); other scenes, where packets do not pay, shade pixel by pixel.
+// same answers as ray by ray); other scenes, where packets do not pay, and the path tracer shade pixel by pixel.
 void shadeTile(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts* out, size_t stride)
 {
     const int w = x1 - x0, n = w * (y1 - y0);
-    if (!v.landscape.enabled) {
+    if (!v.landscape.enabled || v.integrator == Integrator::Path) {   // paths: no shadow-ray packets
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) out[size_t(y - y0) * stride + size_t(x - x0)] = shadePixel(v, x, y);
         return;

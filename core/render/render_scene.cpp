@@ -207,10 +207,20 @@ void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
 
 namespace {
 
+// Throws Error on integrator settings the frame cannot take (checked at the build and again at each placement).
+void checkIntegrator(const Scene& scene)
+{
+    if (scene.render.integrator == Integrator::Path && !scene.volumes.empty())
+        throw Error("render: the path tracer does not trace volumes yet (render.integrator lb renders them)");
+    if (scene.render.maxBounces < 0 || scene.render.maxBounces > kMaxPathBounces)
+        throw Error("render: max_bounces must be 0 .. " + std::to_string(kMaxPathBounces));
+}
+
 // Throws Error on input the build cannot take; returns the order groups are built in (each after those it places).
 std::vector<uint32_t> checkSceneInput(const Scene& scene, const std::vector<SpeciesAssets>& assets)
 {
     if (assets.size() != scene.species.size()) throw Error("render: one set of assets per species is required");
+    checkIntegrator(scene);
     if (scene.terrain.enabled() && !scene.terrain.field)
         throw Error("render: the terrain's heights were not loaded (" + scene.terrain.dem + ")");
     for (size_t s = 0; s < assets.size(); ++s)
@@ -279,6 +289,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
         throw Error("render: the scene's species or groups differ from the ones the frame was built with");
     for (size_t i = 0; i < ni; ++i) checkReference(scene, scene.instances[i], "instance " + std::to_string(i));
     if (!hasLevelsFor(rs, scene)) throw Error("render: the frame was built without the levels of detail this camera needs");
+    checkIntegrator(scene);
     const glm::dvec3 origin = scene.camera.position;
     const std::vector<int> level = instanceLevels(scene, rs.meshLevels);
 
@@ -356,6 +367,8 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     b.shadows = scene.render.shadows;
     b.indirectScale = scene.render.indirectScale;
     b.alphaDistance = scene.render.alphaDistance;
+    b.integrator = scene.render.integrator;
+    b.maxBounces = scene.render.maxBounces;
     placeVolumes(rs, scene, scene.camera.position);
     countFrameBytes(rs);
 }

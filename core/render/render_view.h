@@ -118,7 +118,7 @@ struct SpeciesRecord {
     glm::vec3 leafIndirect;  // leaf materials: kd x L x sunRadiance x this
     float barkIndirect;      // other materials
     float leafIndirectCap;   // per channel, kd x leafIndirect is at most this (energy: lb::ScatteredWeights::leafCap)
-    uint32_t pad[3];
+    glm::vec3 leafRatio;     // leaves' diffuse transmission per unit of diffuse colour (lb::LeafOptics::ratio; path tracer)
 };
 static_assert(sizeof(SpeciesRecord) == 64);
 
@@ -246,6 +246,8 @@ struct RenderView {
     float indirectScale;
     float alphaDistance;             // adaptive transparency: alpha tests only within this distance of the camera
                                      // (metres, camera-relative frame); 0 = everywhere
+    Integrator integrator;           // Lb: the stages of shade.h; Path: path_trace.h from the camera's hit on
+    int maxBounces;                  // Path: bounces after the camera's hit
 };
 
 // The light the LB grids are solved toward (the frame's sun: the first of the list, render_scene.cpp

@@ -2,7 +2,9 @@
 #pragma once
 
 #include "core/render/lights.h"
+#include "core/render/path_trace.h"
 #include "core/render/render_view.h"
+#include "core/render/sampling.h"
 #include "core/render/trace.h"
 
 namespace sylva {
@@ -67,12 +69,22 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
     return SampleParts{light.local, light.indirect, s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
 }
 
+// Stage 4 of the path tracer (render.integrator path) at a surface: all the light it sends to the camera
+// (core/render/path_trace.h) as `local`, its albedo, normal and depth as lightStage gives them.
+SYLVA_HD inline SampleParts pathStage(const RenderView& v, const Ray& ray, const SurfacePoint& s, int px, int py, int sample)
+{
+    return SampleParts{pathRadiance(v, ray, s, px, py, sample), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward),
+                       glm::vec3(0.0f)};
+}
+
 // The stages after intersect for a camera ray whose first hit is known (found; hit and its surface sp where
 // found), sample s of pixel (px, py); seen as lightStage takes it.
 SYLVA_HD inline SampleParts shadeFound(const RenderView& v, const Ray& ray, bool found, const Hit& hit, const SurfacePoint& sp, int px, int py, int s,
                                        const int* seen = nullptr)
 {
-    SampleParts out = found ? lightStage(v, sp, px, py, s, seen) : backgroundStage(v, ray);
+    SampleParts out = !found ? backgroundStage(v, ray)
+                      : v.integrator == Integrator::Path ? pathStage(v, ray, sp, px, py, s)
+                                                         : lightStage(v, sp, px, py, s, seen);
     volumeStage(v, ray, found ? hit.t : ray.tmax, out);
     return out;
 }
@@ -96,18 +108,6 @@ SYLVA_HD SYLVA_INLINE Ray cameraRay(const RenderView& v, float x, float y)
     r.tmin = 0.0f;
     r.tmax = 1e30f;
     return r;
-}
-
-// A hash-based random number in [0,1) for sample positions (deterministic per pixel and sample).
-SYLVA_HD SYLVA_INLINE float hashToUnit(uint32_t a, uint32_t b, uint32_t c)
-{
-    uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u) * 0x85EBCA77u ^ (c + 0x165667B1u) * 0xC2B2AE3Du;
-    h ^= h >> 16;
-    h *= 0x7FEB352Du;
-    h ^= h >> 15;
-    h *= 0x846CA68Bu;
-    h ^= h >> 16;
-    return float(h >> 8) * (1.0f / 16777216.0f);
 }
 
 // Sample s of spp inside pixel (px, py): one sample at the centre; a stratified n x n grid when spp

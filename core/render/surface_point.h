@@ -22,6 +22,7 @@ struct SurfacePoint {
     glm::vec3 lighting;      // normalized LB photon density at the point (meshes)
     glm::vec3 indirectWeight; // what the surface makes of it (SpeciesRecord leafIndirect / barkIndirect; 1 on the ground)
     glm::vec3 indirect;      // the surface's indirect light as its kind computes it (meshes: LB; 0 elsewhere)
+    glm::vec3 transmission;  // diffuse transmission through to the other side (leaves; 0 elsewhere): the path tracer's
     bool ground;             // Lambertian ground (plane, terrain, spheres): lit by the uniform sky's ambient
 };
 

@@ -77,6 +77,16 @@ bool parseAccel(const std::string& name, AccelKind* out)
     return true;
 }
 
+const char* integratorName(Integrator i) { return i == Integrator::Path ? "path" : "lb"; }
+
+bool parseIntegrator(const std::string& name, Integrator* out)
+{
+    if (name == "lb") *out = Integrator::Lb;
+    else if (name == "path") *out = Integrator::Path;
+    else return false;
+    return true;
+}
+
 glm::vec3 sunDirection(double elevationDeg, double azimuthDeg)
 {
     const double el = elevationDeg * M_PI / 180.0, az = azimuthDeg * M_PI / 180.0;

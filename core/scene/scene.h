@@ -183,6 +183,10 @@ struct LightingDesc {
 
 enum class RenderMode { Full, Local, Ambient, Lb };
 enum class AccelKind { Bvh, KdTree };
+// How a camera sample's light is computed: lb, the LB model (direct light with shadow rays, the LB grids'
+// scattered light); path, the reference path tracer (every bounce, next-event estimation, core/render/path_trace.h).
+enum class Integrator : uint32_t { Lb, Path };
+inline constexpr int kMaxPathBounces = 100;
 
 struct RenderSettings {
     int width = 896;
@@ -198,6 +202,8 @@ struct RenderSettings {
                                          // Rendering of Forest Ecosystems", section 2.1); 0 = off
     float pruneDistance = 0.0f;          // metres; stochastic pruning of leaves starts there (Cook et al. 2007): an
                                          // instance at distance d keeps about start / d of them; 0 = off
+    Integrator integrator = Integrator::Lb;
+    int maxBounces = 64;                 // path: bounces after the camera's hit, 0 .. kMaxPathBounces (Russian roulette from the 4th)
 };
 
 struct Scene {
@@ -236,6 +242,8 @@ const char* forestGridModeName(ForestGridMode m); // "off", "auto", "on"
 bool parseForestGridMode(const std::string& name, ForestGridMode* out);
 const char* accelName(AccelKind kind);            // "bvh", "kdtree"
 bool parseAccel(const std::string& name, AccelKind* out);
+const char* integratorName(Integrator i);         // "lb", "path"
+bool parseIntegrator(const std::string& name, Integrator* out);
 
 // Direction toward the sun from elevation (degrees above the horizon) and azimuth (degrees, 0 = +Z,
 // 90 = +X), +Y up.

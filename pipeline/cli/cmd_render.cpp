@@ -52,6 +52,9 @@ Scene sceneForArgs(const Args& args, std::string* stem)
     if (args.has("--accel") && !parseAccel(args.get("--accel"), &r.accel))
         throw UsageError("option --accel: expected bvh or kdtree, got '" + args.get("--accel") + "'");
     if (args.has("--no-shadows")) r.shadows = false;
+    if (args.has("--integrator") && !parseIntegrator(args.get("--integrator"), &r.integrator))
+        throw UsageError("option --integrator: expected lb or path, got '" + args.get("--integrator") + "'");
+    if (args.has("--max-bounces")) r.maxBounces = int(parseInteger("--max-bounces", args.get("--max-bounces"), 0, kMaxPathBounces));
     if (args.has("--direct") && !parseDirectLight(args.get("--direct"), &scene.lighting.direct))
         throw UsageError("option --direct: expected once or seed, got '" + args.get("--direct") + "'");
     if (args.has("--cells")) {
@@ -277,6 +280,9 @@ Command renderCommand()
              {"--mode", "M", "full (LB indirect + sun), local (sun only), ambient (sun + matched constant), lb"},
              {"--accel", "bvh|kdtree", "acceleration structure (default: the scene's, bvh)"},
              {"--no-shadows", "", "no shadow rays"},
+             {"--integrator", "lb|path", "lb: the LB model (default: the scene's render.integrator); path: the reference path tracer, "
+                                         "every bounce with next-event estimation to the sun and sky (docs/RENDERING.md \"The path tracer\")"},
+             {"--max-bounces", "N", "path: bounces after the camera's hit, 0 .. 100 (default: the scene's render.max_bounces, 64)"},
              {"--direct", "once|seed", "once: the LB grids add only scattered light to the shadow-rayed sun; seed: the seed's sum "
                                    "(grid as solved, direct light counted twice in crowns); default: the scene's lighting.direct"},
              {"--cells", "N", "plant cells along the terrain's longer side (terrain.cells; the scene needs terrain.tiles)"},

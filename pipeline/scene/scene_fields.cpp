@@ -741,6 +741,16 @@ const Table<RenderSettings>& renderTable()
             .summarized([](const RenderSettings& r) {
                 return r.pruneDistance > 0.0f ? "leaves pruned from " + human(r.pruneDistance) + " m" : std::string();
             });
+        b.enumeration("integrator", &RenderSettings::integrator, parseIntegrator, integratorName, "integrator", "lb, path")
+            .doc("string", "`lb`: the LB model (direct light with shadow rays and the LB grids' scattered light); `path`: the reference "
+                           "path tracer (every bounce, next-event estimation to the sun and sky, Russian roulette; no volumes yet; "
+                           "[RENDERING.md](RENDERING.md) \"The path tracer\")")
+            .summarized([](const RenderSettings& r) {
+                return r.integrator == Integrator::Path ? "path tracer, at most " + std::to_string(r.maxBounces) + " bounces" : std::string();
+            });
+        b.integer("max_bounces", &RenderSettings::maxBounces, 0, kMaxPathBounces)
+            .doc("integer", "`path`: bounces after the camera's hit, 0 .. " + std::to_string(kMaxPathBounces) +
+                                " (0: direct light only; Russian roulette from the 4th)");
         return b.table;
     }();
     return table;

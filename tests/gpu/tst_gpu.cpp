@@ -322,6 +322,12 @@ private Q_SLOTS:
         const Film gpu = cuda::renderCuda(cuda::DeviceScene(rs));
         for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
             QVERIFY(filmsMatch(cpu, gpu, m, s.sky, "GPU against CPU"));
+        // The path tracer: the same paths (the same hashed random numbers) on both.
+        s.render.integrator = Integrator::Path;
+        s.render.maxBounces = 8;
+        const RenderScene paths = buildRenderScene(s, assets, sunRadiance(s.sun));
+        QVERIFY(filmsMatch(renderFilm(paths.view()), cuda::renderCuda(cuda::DeviceScene(paths)), RenderMode::Full, s.sky,
+                           "GPU paths against CPU"));
 #endif
     }
 

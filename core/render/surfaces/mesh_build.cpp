@@ -309,6 +309,7 @@ SpeciesRecord speciesRecord(RenderScene& rs, const Scene& scene, size_t s, const
     sr.leafIndirect = glm::vec3(1.0f);
     sr.barkIndirect = 1.0f;
     sr.leafIndirectCap = std::numeric_limits<float>::max();   // the seed's sum: kd x L, uncapped (old pictures)
+    if (s < scene.species.size()) sr.leafRatio = lb::leafOptics(scene.species[s].lighting).ratio;
     const LightingGrid& g = a.lighting;
     if (g.rgb.empty()) return sr;
     if (g.rgb.size() != g.geometry.nodeCount() * 3) throw Error("render: lighting grid size does not match its dims");

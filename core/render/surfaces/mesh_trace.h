@@ -6,6 +6,7 @@
 #include "core/accel/kdtree.h"
 #include "core/accel/ray.h"
 #include "core/render/render_view.h"
+#include "core/lb/leaf_optics.h"
 #include "core/render/surface_point.h"
 
 namespace sylva {
@@ -292,6 +293,9 @@ SYLVA_HD inline void shadeMesh(const RenderView& v, const Hit& hit, const Instan
     if (m.isLeaf)   // a leaf scatters at most kMaxLeafScattering of what it receives (leaf_optics.h)
         for (int c = 0; c < 3; ++c)
             if (kd[c] * s.indirectWeight[c] > sp.leafIndirectCap) s.indirectWeight[c] = sp.leafIndirectCap / kd[c];
+    // Diffuse transmission as the Blender export's translucent BSDF: kd x ratio, kd + it at most kMaxLeafScattering.
+    if (m.isLeaf)
+        for (int c = 0; c < 3; ++c) s.transmission[c] = fmaxf(0.0f, fminf(kd[c] * sp.leafRatio[c], lb::kMaxLeafScattering - kd[c]));
     s.specular = m.specular;
     s.shininess = m.shininess;
     s.extent = in.scale * fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));
