@@ -30,10 +30,10 @@ SYLVA_HD SYLVA_INLINE glm::vec3 originToward(const SurfacePoint& s, const glm::v
     return offsetPoint(s.p, glm::dot(s.ng, wi) >= 0.0f ? s.ng : -s.ng, s.extent);
 }
 
-// The lobes' sampling weights: reflection (diffuse plus the Phong lobe's colour) against transmission.
+// The diffuse lobes' sampling weights: reflection against transmission.
 SYLVA_HD SYLVA_INLINE float reflectShare(const SurfacePoint& s)
 {
-    const float r = average(s.albedo) + (s.ground ? 0.0f : average(s.specular)), t = average(s.transmission);
+    const float r = average(s.albedo), t = average(s.transmission);
     return r + t > 0.0f ? r / (r + t) : 1.0f;
 }
 
@@ -49,7 +49,16 @@ SYLVA_HD inline glm::vec3 bsdfCos(const SurfacePoint& s, const glm::vec3& wi)
     return s.transmission * (-c / sky::kPi);
 }
 
-// The density bsdfCos's sampling gives unit wi: the lobe's share times cos / pi about its side's normal.
+// Its diffuse part (what the paths continue by): albedo / pi in front, transmission / pi behind. The Phong lobe,
+// unnormalized and unbounded over cos at grazing angles, is met through next-event estimation only: the light
+// it reflects of the sun and the sky, not of other surfaces.
+SYLVA_HD SYLVA_INLINE glm::vec3 diffuseCos(const SurfacePoint& s, const glm::vec3& wi)
+{
+    const float c = glm::dot(s.ng, wi);
+    return (c > 0.0f ? s.albedo : s.transmission) * (fabsf(c) / sky::kPi);
+}
+
+// The density the diffuse lobes' sampling gives unit wi: the lobe's share times cos / pi about its side's normal.
 SYLVA_HD inline float bsdfPdf(const SurfacePoint& s, const glm::vec3& wi)
 {
     const float c = glm::dot(s.ng, wi), r = path_detail::reflectShare(s);
@@ -87,17 +96,19 @@ SYLVA_HD inline glm::vec3 pathRadiance(const RenderView& v, const Ray& ray, cons
             if (!(ls.pdf > 0.0f) || !(ls.value.x > 0.0f || ls.value.y > 0.0f || ls.value.z > 0.0f)) continue;
             const glm::vec3 f = bsdfCos(s, ls.wi);
             if (!(f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) || !lightSampleVisible(v, s, ls)) continue;
+            // The diffuse part weighted against the paths' own directions; the Phong part whole (paths never carry it).
+            const glm::vec3 d = diffuseCos(s, ls.wi);
             const float w = ls.delta ? 1.0f : powerHeuristic(ls.pdf, bsdfPdf(s, ls.wi));
-            L += beta * f * ls.value * w;
+            L += beta * (d * w + (f - d)) * ls.value;
         }
         if (depth >= v.maxBounces) break;
-        // The next direction from the BSDF: a lobe by its share, then cosine about its side's normal.
+        // The next direction from the diffuse lobes: one by its share, then cosine about its side's normal.
         const float lobe = rng.next(), u1 = rng.next(), u2 = rng.next();
         const bool reflect = lobe < path_detail::reflectShare(s);
         const glm::vec3 wi = cosineHemisphere(reflect ? s.ng : -s.ng, u1, u2);
         const float pdf = bsdfPdf(s, wi);
         if (!(pdf > 0.0f)) break;
-        beta *= bsdfCos(s, wi) / pdf;
+        beta *= diffuseCos(s, wi) / pdf;
         if (depth >= 3) {   // Russian roulette
             const float q = fminf(0.95f, fmaxf(beta.x, fmaxf(beta.y, beta.z)));
             if (!(rng.next() < q)) break;
