@@ -50,6 +50,7 @@ void LightingScheduler::cancel()
 
 bool LightingScheduler::viewNeedsLighting() const
 {
+    if (m_doc->scene().render.integrator == Integrator::Path) return false;   // the path tracer reads no grid
     const std::optional<RenderMode> compare = m_viewport->compare();
     return modeNeedsLighting(m_doc->scene().render.mode) || (compare && modeNeedsLighting(*compare));
 }

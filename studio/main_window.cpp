@@ -79,6 +79,15 @@ MainWindow::MainWindow(QWidget* parent)
         m_modeBox->addItem(QString::fromLatin1(renderModeName(m)), int(m));
     m_modeBox->setToolTip(tr("full = sun + LB indirect; local = sun only; ambient = sun + constant; lb = indirect only"));
     bar->addWidget(m_modeBox);
+    bar->addWidget(new QLabel(tr(" Light ")));
+    m_integratorBox = new QComboBox;
+    m_integratorBox->setObjectName("integrator");
+    m_integratorBox->addItem(tr("LB model"), int(Integrator::Lb));
+    m_integratorBox->addItem(tr("Path tracer"), int(Integrator::Path));
+    m_integratorBox->setToolTip(tr("LB model: direct light with shadows plus the lighting grids' scattered light (fast); "
+                                   "path tracer: every bounce of light traced, the reference the LB model is measured against "
+                                   "(slower, noisy at first; no volumes yet)"));
+    bar->addWidget(m_integratorBox);
     bar->addSeparator();
     m_compareToggle = new QCheckBox(tr("Compare with"));
     m_compareToggle->setObjectName("compareToggle");
@@ -99,6 +108,11 @@ MainWindow::MainWindow(QWidget* parent)
         Scene s = m_doc->scene();
         s.render.mode = RenderMode(m_modeBox->itemData(index).toInt());
         m_doc->edit(s, tr("Render mode %1").arg(m_modeBox->itemText(index)));
+    });
+    connect(m_integratorBox, &QComboBox::activated, this, [this](int index) {
+        Scene s = m_doc->scene();
+        s.render.integrator = Integrator(m_integratorBox->itemData(index).toInt());
+        m_doc->edit(s, tr("Light by %1").arg(m_integratorBox->itemText(index)));
     });
     connect(m_compareToggle, &QCheckBox::toggled, this, [this] { updateCompare(); });
     connect(m_compareBox, &QComboBox::currentIndexChanged, this, [this] { updateCompare(); });
@@ -454,6 +468,10 @@ void MainWindow::onDocumentChanged(ScenePart parts)
     {
         const QSignalBlocker block(m_modeBox);
         m_modeBox->setCurrentIndex(m_modeBox->findData(int(s.render.mode)));
+    }
+    {
+        const QSignalBlocker block(m_integratorBox);
+        m_integratorBox->setCurrentIndex(m_integratorBox->findData(int(s.render.integrator)));
     }
     if (parts == ScenePart::All) m_properties->showItem(m_properties->item());
     m_lighting->updateViewport();

@@ -68,6 +68,7 @@ public:
     // GPU when there is one, else the CPU (the log says which at start-up and after a fallback).
     Backend* backend() const { return m_backend.get(); }
     QComboBox* modeSelector() const { return m_modeBox; }
+    QComboBox* integratorSelector() const { return m_integratorBox; }
     // Side-by-side compare: the toggle and the second mode (the right half of the viewport).
     QCheckBox* compareToggle() const { return m_compareToggle; }
     QComboBox* compareSelector() const { return m_compareBox; }
@@ -149,6 +150,7 @@ private:
     JobPanel* m_jobPanel;
     QPlainTextEdit* m_log;
     QComboBox* m_modeBox;
+    QComboBox* m_integratorBox;
     QCheckBox* m_compareToggle;
     QComboBox* m_compareBox;
     VolumeInspector* m_inspector = nullptr;

@@ -453,6 +453,22 @@ private Q_SLOTS:
         action("actionUndo")->trigger();
         QCOMPARE(scene().render.mode, RenderMode::Full);
         QCOMPARE(mode->currentText(), QStringLiteral("full"));
+
+        // The path tracer from the toolbar: another picture of the same scene, one undo step back to the LB model.
+        QVERIFY(waitForFinalImage(v, 60000));
+        const QImage lbPicture = v->lastImage();
+        QComboBox* light = m_win->integratorSelector();
+        const int path = light->findData(int(Integrator::Path));
+        QVERIFY(path >= 0);
+        light->setCurrentIndex(path);
+        Q_EMIT light->activated(path);
+        QCOMPARE(scene().render.integrator, Integrator::Path);
+        QVERIFY(waitForFinalImage(v, 60000));
+        QVERIFY(v->lastImage() != lbPicture);
+        action("actionUndo")->trigger();
+        QCOMPARE(scene().render.integrator, Integrator::Lb);
+        QCOMPARE(light->currentData().toInt(), int(Integrator::Lb));
+        QVERIFY(waitForFinalImage(v, 60000));
     }
 
     void deleteAndUndo()
