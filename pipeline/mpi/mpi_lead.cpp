@@ -37,6 +37,11 @@ int runLead(const RenderJob& job, int size, int localRanks, const std::vector<st
     // own they light their share first anyway), runs its own and waits for theirs. The count of solves is
     // said before the tracing.
     const bool askToShare = job.broadcastScene;
+    // With every rank building its own scene, every rank lights its share first, rank 0 too, and rank 0 tells
+    // the others (kShare) when every share is in the cache: a rank that built before would solve another's
+    // species again (and that rank would find it cached and count one solve fewer).
+    const bool eachShares = !job.broadcastScene && job.lightShare && size > 1;
+    bool ownLit = false;
     std::mutex litMutex;
     int lit = 0;
     bool shareAsked = false, shareSent = false;
@@ -95,7 +100,12 @@ int runLead(const RenderJob& job, int size, int localRanks, const std::vector<st
     const FilmRowsTracer tracer = [&queue](const RenderScene& rs, int y0, int y1, Progress* p) { return queue.trace(rs, y0, y1, p); };
     std::future<int> render = std::async(std::launch::async, [&] {
         limit = threadLimit(wideBuild ? job.threads * localRanks : job.threads);
-        return job.lead(tracer, size, job.broadcastScene && size > 1 ? hostCount : 0, shareLighting);
+        if (eachShares) {
+            shareLighting();
+            std::lock_guard<std::mutex> lock(litMutex);
+            ownLit = true;
+        }
+        return job.lead(tracer, size, job.broadcastScene && size > 1 ? hostCount : 0, eachShares ? std::function<void()>() : shareLighting);
     });
 
     struct Peer {
@@ -200,6 +210,15 @@ int runLead(const RenderJob& job, int size, int localRanks, const std::vector<st
             }
             for (int r = 1; send && r < size; ++r) check(MPI_Send(nullptr, 0, MPI_BYTE, r, kShare, MPI_COMM_WORLD), "Send");
         }
+        if (eachShares) {   // every share lit: the ranks build their scenes
+            bool send = false;
+            {
+                std::lock_guard<std::mutex> lock(litMutex);
+                send = ownLit && !shareSent;
+                shareSent = shareSent || send;
+            }
+            for (int r = 1; send && r < size; ++r) check(MPI_Send(nullptr, 0, MPI_BYTE, r, kShare, MPI_COMM_WORLD), "Send");
+        }
         if (const RenderScene* rs = queue.sceneToSend()) {
             try {
                 if (!headerPosted) {
@@ -261,7 +280,12 @@ int runLead(const RenderJob& job, int size, int localRanks, const std::vector<st
                 continue;
             }
             // A rank waiting on rank 0 (for a tile, or for the scene while rank 0 builds it) hears from it.
-            const bool waiting = p.wanted > 0 || !queue.sceneSent();
+            bool goPending = false;
+            if (eachShares) {
+                std::lock_guard<std::mutex> lock(litMutex);
+                goPending = !shareSent;
+            }
+            const bool waiting = p.wanted > 0 || !queue.sceneSent() || goPending;
             if (waiting && since(p.pinged) > kHeartbeatSeconds) {
                 check(MPI_Send(nullptr, 0, MPI_BYTE, r, kHeartbeat, MPI_COMM_WORLD), "Send");
                 p.pinged = Clock::now();

@@ -311,7 +311,14 @@ int runWorker(const RenderJob& job, int rank, int size, const Hosts& hosts)
             const int32_t solved = w.busy([&] { return job.lightShare(rank, size, &quiet); });
             w.send(&solved, sizeof solved, kLit);
         };
-        if (job.lightShare && !job.broadcastScene) share();
+        if (job.lightShare && !job.broadcastScene) {
+            share();
+            // Every rank's share in the cache before this rank builds (rank 0 says so with kShare): else it would
+            // solve another rank's species again.
+            MPI_Request go;
+            check(MPI_Irecv(nullptr, 0, MPI_BYTE, 0, kShare, MPI_COMM_WORLD, &go), "Irecv");
+            w.await(go);
+        }
         SharedFrame frame;
         RenderScene own;
         const RenderView view = job.broadcastScene ? w.receiveScene(hosts, frame, job.lightShare ? std::function<void()>(share) : nullptr)
