@@ -187,7 +187,7 @@ std::optional<Relighting> LightingScheduler::relightingFor(const Scene& scene) c
     if (m_viewport->backend() != QLatin1String("cpu")) return std::nullopt;   // the device frame is built per set of assets
     // Direct light counted once: the grid is the solve minus its uncollided part, which the bases (full
     // solves) do not separate; the lighting job makes those grids.
-    if (scene.lighting.direct != DirectLight::Seed) return std::nullopt;
+    if (gridDirectLight(scene.lighting) != DirectLight::Seed) return std::nullopt;
     // The sky in the boundary: the bases would compose it too, but its weights follow the sky and the sun's
     // radiance as well; the lighting job makes those grids.
     if (scene.lighting.boundary != LbBoundary::Sun) return std::nullopt;

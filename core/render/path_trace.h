@@ -1,10 +1,12 @@
 // The reference path tracer (render.integrator path): from a camera ray's first surface on, every bounce of
 // light between the surfaces, with next-event estimation to each light of the list (sample / eval / pdf,
 // core/render/lights.h), multiple importance sampling against the BSDF's directions for the lights that are not
-// deltas (the sky), and Russian roulette. Surfaces are those the LB model renders: Lambertian reflection of the
-// diffuse colour, the leaves' diffuse transmission (kd x ratio, capped as the Blender export's translucent BSDF)
-// and the materials' Phong lobe as the renderer's direct light shows it. Volumes are not traced here (the
-// build refuses them). Host and device.
+// deltas (the sky), and Russian roulette. The same paths cut short and ended in the LB grid's light are the LB
+// integrator's radiance cache (lighting.bounces). Surfaces are those the LB model renders: Lambertian reflection
+// of the diffuse colour, the leaves' diffuse transmission (kd x ratio, capped as the Blender export's translucent
+// BSDF) and the materials' Phong lobe as the renderer's direct light shows it. Paths do not scatter in volumes
+// (the path tracer's build refuses them; with the cache, the sun is dimmed by them and the camera segment
+// crosses them as in the LB integrator). Host and device.
 #pragma once
 
 #include "core/render/lights.h"
@@ -14,12 +16,15 @@ namespace sylva {
 
 namespace path_detail {
 
-// Random numbers a path draws in turn: a hash of pixel, sample and dimension; kDims dimensions per sample
-// (2 per light and 4 a bounce).
-inline constexpr uint32_t kDims = 65536;
+// The numbers a path draws in turn, each decision (a light's direction, a lobe and a direction, the roulette) a
+// dimension of its own: low-discrepancy over the pixel's samples (sampling.h lds, scrambled per pixel and
+// dimension), so a pixel's samples spread over every decision's domain evenly. A path draws its dimensions
+// in the same order at every sample (one pair per light and vertex, then the lobe, the direction and from the
+// 4th bounce the roulette), so dimension k is the same decision in all of them.
 struct Rng {
-    uint32_t px, py, base, dim;
-    SYLVA_HD SYLVA_INLINE float next() { return hashToUnit(px, py, base + dim++); }
+    uint32_t pixel, sample, dim;
+    SYLVA_HD SYLVA_INLINE float next() { return lds::sample1(sample, lds::mix(pixel, dim++)); }
+    SYLVA_HD SYLVA_INLINE glm::vec2 next2() { return lds::sample2(sample, lds::mix(pixel, dim++)); }
 };
 
 SYLVA_HD SYLVA_INLINE float average(const glm::vec3& c) { return (c.x + c.y + c.z) * (1.0f / 3.0f); }
@@ -80,32 +85,51 @@ SYLVA_HD inline bool lightSampleVisible(const RenderView& v, const SurfacePoint&
     return segmentVisible(v, o, s.p + ls.wi * ls.distance);
 }
 
-// The radiance the camera ray `ray` brings back from its first surface `first` (sample `sample` of pixel
-// (px, py)): the light each vertex gets from every light of the list, weighted by the path's throughput.
-SYLVA_HD inline glm::vec3 pathRadiance(const RenderView& v, const Ray& ray, const SurfacePoint& first, int px, int py, int sample)
+// What a path brings back to the camera from its first surface: `direct`, the light the first surface gets
+// from every light of the list (next-event estimation there); `indirect`, all the rest.
+struct PathLight {
+    glm::vec3 direct;
+    glm::vec3 indirect;
+};
+
+// The light a path from the camera's first surface `first` (sample `sample` of pixel (px, py)) brings back:
+// at each vertex one sample of every light (multiple importance sampling against the diffuse lobes' directions
+// for lights that are not deltas), then a direction from the diffuse lobes, for `bounces` bounces after the
+// first surface (Russian roulette from the 4th). At the last vertex no direction is drawn, so its lights count
+// whole; with `endInCache` that vertex also adds its own indirect light (SurfacePoint::indirect: the LB grid's
+// scattered light on meshes), the radiance cache standing for every bounce the path does not trace
+// (lighting.bounces). The reference path tracer is bounces = render.max_bounces without the cache.
+SYLVA_HD inline PathLight pathRadiance(const RenderView& v, const SurfacePoint& first, int px, int py, int sample, int bounces, bool endInCache)
 {
-    path_detail::Rng rng{uint32_t(px), uint32_t(py), uint32_t(sample) * path_detail::kDims, 0u};
-    glm::vec3 L(0.0f), beta(1.0f);
+    path_detail::Rng rng{lds::mix(uint32_t(px), uint32_t(py)), uint32_t(sample), 0u};
+    glm::vec3 L(0.0f), beta(1.0f), direct(0.0f);
     SurfacePoint s = first;
-    Ray r = ray;
     for (int depth = 0;; ++depth) {
+        const bool last = depth >= bounces;
         // Next-event estimation: one sample of each light.
         for (uint32_t i = 0; i < v.lightCount; ++i) {
-            const float u1 = rng.next(), u2 = rng.next();
-            const LightSample ls = lightSample(v, v.lights[i], s.p, glm::vec2(u1, u2));
+            const LightSample ls = lightSample(v, v.lights[i], s.p, rng.next2());
             if (!(ls.pdf > 0.0f) || !(ls.value.x > 0.0f || ls.value.y > 0.0f || ls.value.z > 0.0f)) continue;
             const glm::vec3 f = bsdfCos(s, ls.wi);
             if (!(f.x > 0.0f || f.y > 0.0f || f.z > 0.0f) || !lightSampleVisible(v, s, ls)) continue;
-            // The diffuse part weighted against the paths' own directions; the Phong part whole (paths never carry it).
+            // The diffuse part weighted against the paths' own directions (whole at the last vertex, which draws
+            // none); the Phong part whole (paths never carry it).
             const glm::vec3 d = diffuseCos(s, ls.wi);
-            const float w = ls.delta ? 1.0f : powerHeuristic(ls.pdf, bsdfPdf(s, ls.wi));
-            L += beta * (d * w + (f - d)) * ls.value;
+            const float w = ls.delta || last ? 1.0f : powerHeuristic(ls.pdf, bsdfPdf(s, ls.wi));
+            glm::vec3 c = beta * (d * w + (f - d)) * ls.value;
+            if (ls.distance >= 1e30f) c *= mediaTransmittance(v, s.p, ls.wi);   // cloud shadows (the LB integrator's media)
+            if (depth == 0) direct += c;
+            else L += c;
         }
-        if (depth >= v.maxBounces) break;
+        if (last) {
+            if (endInCache) L += beta * s.indirect;
+            break;
+        }
         // The next direction from the diffuse lobes: one by its share, then cosine about its side's normal.
-        const float lobe = rng.next(), u1 = rng.next(), u2 = rng.next();
+        const float lobe = rng.next();
+        const glm::vec2 u = rng.next2();
         const bool reflect = lobe < path_detail::reflectShare(s);
-        const glm::vec3 wi = cosineHemisphere(reflect ? s.ng : -s.ng, u1, u2);
+        const glm::vec3 wi = cosineHemisphere(reflect ? s.ng : -s.ng, u.x, u.y);
         const float pdf = bsdfPdf(s, wi);
         if (!(pdf > 0.0f)) break;
         beta *= diffuseCos(s, wi) / pdf;
@@ -114,7 +138,7 @@ SYLVA_HD inline glm::vec3 pathRadiance(const RenderView& v, const Ray& ray, cons
             if (!(rng.next() < q)) break;
             beta /= q;
         }
-        r = Ray{path_detail::originToward(s, wi), 0.0f, wi, 1e30f};
+        Ray r{path_detail::originToward(s, wi), 0.0f, wi, 1e30f};
         Hit hit{};
         if (!traceScene<false>(v, r, hit)) {
             // The ray escaped: what the lights that are not deltas send along it, weighted against their sampling.
@@ -127,7 +151,7 @@ SYLVA_HD inline glm::vec3 pathRadiance(const RenderView& v, const Ray& ray, cons
         }
         s = surfaceAt(v, r, hit);
     }
-    return L;
+    return PathLight{direct, L};
 }
 
 } // namespace sylva

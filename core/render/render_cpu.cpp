@@ -26,7 +26,7 @@ static_assert(kTile * kTile <= kPacketRays);
 void shadeTile(const RenderView& v, int x0, int y0, int x1, int y1, SampleParts* out, size_t stride)
 {
     const int w = x1 - x0, n = w * (y1 - y0);
-    if (!v.landscape.enabled || v.integrator == Integrator::Path) {   // paths: no shadow-ray packets
+    if (!v.landscape.enabled || tracesPaths(v)) {   // paths: no shadow-ray packets
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) out[size_t(y - y0) * stride + size_t(x - x0)] = shadePixel(v, x, y);
         return;

@@ -183,6 +183,73 @@ void placeLights(RenderScene& rs, const FrameSun& sun)
     rs.lights.push_back(l);
 }
 
+std::vector<float> skySamplingDistribution(const sky::SkyView& sky)
+{
+    const uint32_t R = kSkySamplingRows, C = kSkySamplingCols;
+    std::vector<double> w(size_t(R) * C);
+    double total = 0.0;
+    for (uint32_t r = 0; r < R; ++r)
+        for (uint32_t c = 0; c < C; ++c) {
+            double sum = 0.0;   // the luminance at 3 x 3 points of the cell
+            for (int j = 0; j < 3; ++j)
+                for (int i = 0; i < 3; ++i) {
+                    const float y = 1.0f - 2.0f * (float(r) + (float(j) + 0.5f) / 3.0f) / float(R);
+                    const float phi = 2.0f * sky::kPi * (float(c) + (float(i) + 0.5f) / 3.0f) / float(C);
+                    const float s = std::sqrt(std::max(0.0f, 1.0f - y * y));
+                    const glm::vec3 L = sky::skyRadiance(sky, glm::vec3(s * std::cos(phi), y, s * std::sin(phi)));
+                    sum += 0.2126 * double(L.x) + 0.7152 * double(L.y) + 0.0722 * double(L.z);
+                }
+            w[size_t(r) * C + c] = std::max(0.0, sum / 9.0);
+            total += w[size_t(r) * C + c];
+        }
+    // A floor of 1% of the mean: every direction keeps some density (the cells' points may miss a bright speck).
+    const double floor = total > 0.0 ? 0.01 * total / double(R * C) : 1.0;
+    std::vector<float> out(size_t(R + 1) + size_t(R) * (C + 1));
+    float* rows = out.data();
+    std::vector<double> rowSum(R, 0.0);
+    for (uint32_t r = 0; r < R; ++r) {
+        float* cdf = out.data() + (R + 1) + size_t(r) * (C + 1);
+        double acc = 0.0;
+        for (uint32_t c = 0; c < C; ++c) acc += w[size_t(r) * C + c] + floor;
+        rowSum[r] = acc;
+        double run = 0.0;
+        cdf[0] = 0.0f;
+        for (uint32_t c = 0; c < C; ++c) {
+            run += w[size_t(r) * C + c] + floor;
+            cdf[c + 1] = float(run / acc);
+        }
+        cdf[C] = 1.0f;
+    }
+    double all = 0.0;
+    for (double x : rowSum) all += x;
+    double run = 0.0;
+    rows[0] = 0.0f;
+    for (uint32_t r = 0; r < R; ++r) {
+        run += rowSum[r];
+        rows[r + 1] = float(run / all);
+    }
+    rows[R] = 1.0f;
+    return out;
+}
+
+namespace {
+
+// The sky's sampling distribution for the frame: above the horizon only where the ground plane hides the rest
+// (every point the paths reach lies on or above it, so no direction below the horizon sees the sky); the rows
+// below get no probability and the rest is scaled up to sum to 1.
+std::vector<float> frameSkySampling(const sky::SkyView& sky, bool groundPlane)
+{
+    std::vector<float> d = skySamplingDistribution(sky);
+    if (!groundPlane) return d;
+    const uint32_t R = kSkySamplingRows, upper = R / 2;   // rows 0 .. R/2 - 1 cover y in (0, 1]
+    const float above = d[upper];
+    if (!(above > 0.0f)) return d;
+    for (uint32_t r = 0; r <= R; ++r) d[r] = r <= upper ? d[r] / above : 1.0f;
+    return d;
+}
+
+} // namespace
+
 void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
 {
     rs.frame.sky.model = sky::SkyView{};
@@ -190,7 +257,18 @@ void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
     rs.frame.sky.interleave = sky::Interleave{};
     rs.skyMap.clear();
     rs.skyLights.clear();
-    if (!d.analytic()) return;
+    rs.skySampling.clear();
+    rs.frame.sky.samplingRows = 0;
+    if (!d.analytic()) {
+        // The constant sky: uniform, over the upper hemisphere where the ground plane hides the rest.
+        if (groundPlane) {
+            sky::SkyView flat{};
+            flat.constant = glm::vec3(1.0f);
+            rs.skySampling = frameSkySampling(flat, true);
+            rs.frame.sky.samplingRows = kSkySamplingRows;
+        }
+        return;
+    }
     if (!d.built) throw Error("render: the scene's sky was not built (loadSceneSky)");
     if (d.lights < sky::kMinVirtualLights || d.lights > sky::kMaxVirtualLights)
         throw Error("render: sky.lights must be " + std::to_string(sky::kMinVirtualLights) + " .. " + std::to_string(sky::kMaxVirtualLights));
@@ -203,6 +281,8 @@ void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
     rs.skyLights = sky::skyLights(built, d.lights, 512, groundPlane);
     rs.frame.sky.lightCount = uint32_t(rs.skyLights.size());
     rs.frame.sky.interleave = sky::makeInterleave(d.interleave, int(rs.skyLights.size()));
+    rs.skySampling = frameSkySampling(built.view(), groundPlane);
+    rs.frame.sky.samplingRows = kSkySamplingRows;
 }
 
 namespace {
@@ -214,6 +294,8 @@ void checkIntegrator(const Scene& scene)
         throw Error("render: the path tracer does not trace volumes yet (render.integrator lb renders them)");
     if (scene.render.maxBounces < 0 || scene.render.maxBounces > kMaxPathBounces)
         throw Error("render: max_bounces must be 0 .. " + std::to_string(kMaxPathBounces));
+    if (scene.lighting.bounces < 0 || scene.lighting.bounces > kMaxPathBounces)
+        throw Error("lighting: bounces must be 0 .. " + std::to_string(kMaxPathBounces));
 }
 
 // Throws Error on input the build cannot take; returns the order groups are built in (each after those it places).
@@ -369,6 +451,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     b.alphaDistance = scene.render.alphaDistance;
     b.integrator = scene.render.integrator;
     b.maxBounces = scene.render.maxBounces;
+    b.lightingBounces = scene.lighting.bounces;
     placeVolumes(rs, scene, scene.camera.position);
     countFrameBytes(rs);
 }

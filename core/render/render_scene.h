@@ -154,8 +154,13 @@ bool hasLevelsFor(const RenderScene& rs, const Scene& scene);
 // ends on the ground, for every point above it.
 inline bool groundPlaneShown(const Scene& scene) { return scene.ground.enabled && !scene.terrain.enabled(); }
 
-// The sky's part of a built frame: a Preetham or map sky's per-ray parameters, its map pixels and its
-// virtual lights (d.lights of them, d.interleave subsets; with groundPlane, groundPlaneShown(scene), all of
+// The sky's sampling distribution for the paths' next-event estimation (the layout of RenderView::skySampling,
+// core/render/lights/light_list.h): each equal-area cell in proportion to the sky's mean luminance at 3 x 3 points
+// of it, plus 1% of the mean over all cells.
+std::vector<float> skySamplingDistribution(const sky::SkyView& sky);
+
+// The sky's part of a built frame: a Preetham or map sky's per-ray parameters, its map pixels, its sampling
+// distribution and its virtual lights (d.lights of them, d.interleave subsets; with groundPlane, groundPlaneShown(scene), all of
 // them above the horizon, since the ground hides the rest); the constant sky: none (the frame as before).
 // buildSceneGeometry calls it; changing only the lights or subsets of the same sky needs nothing else (the
 // sun and the LB grids stay). Throws Error when the sky is not built or its counts are out of range.

@@ -201,6 +201,7 @@ struct CameraRecord {
     X(Scene, Both, glm::vec4, landLight, Landscape)        /* the landscape's forest grid (landLightLayout) */ \
     X(Scene, Both, float, skyMap, None)                    /* the sky's map pixels (RGB, skyModel.map's) */    \
     X(Scene, Both, sky::VirtualLight, skyLights, None)     /* the sky's virtual directional lights */          \
+    X(Scene, Both, float, skySampling, None)               /* the sky's sampling distribution (CDFs) */        \
     X(Top, Both, LightRecord, lights, None)                /* the frame's lights (core/render/lights) */       \
     X(Top, Both, SphereRecord, sphereRecords, None)        /* analytic spheres (camera-relative) */            \
     X(Top, Both, VolumeInstanceRecord, volumeInstances, None) /* placed volumes (camera-relative) */        \
@@ -248,7 +249,12 @@ struct RenderView {
                                      // (metres, camera-relative frame); 0 = everywhere
     Integrator integrator;           // Lb: the stages of shade.h; Path: path_trace.h from the camera's hit on
     int maxBounces;                  // Path: bounces after the camera's hit
+    int lightingBounces = 0;         // Lb: bounces traced before the LB grid's light ends a path (0: the grid at the camera's hit)
 };
+
+// Does the frame shade its camera hits along paths (shade.h pathStage): the path tracer, or the LB integrator
+// with a radiance-cache prefix?
+SYLVA_HD SYLVA_INLINE bool tracesPaths(const RenderView& v) { return v.integrator == Integrator::Path || v.lightingBounces > 0; }
 
 // The light the LB grids are solved toward (the frame's sun: the first of the list, render_scene.cpp
 // placeTopLevel); volumes scatter it singly and subtract it from their grids' light.

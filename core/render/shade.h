@@ -69,12 +69,15 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
     return SampleParts{light.local, light.indirect, s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
 }
 
-// Stage 4 of the path tracer (render.integrator path) at a surface: all the light it sends to the camera
-// (core/render/path_trace.h) as `local`, its albedo, normal and depth as lightStage gives them.
-SYLVA_HD inline SampleParts pathStage(const RenderView& v, const Ray& ray, const SurfacePoint& s, int px, int py, int sample)
+// Stage 4 along paths at a surface: the path tracer (render.integrator path, every bounce up to
+// render.max_bounces) or the LB integrator's radiance cache (lighting.bounces > 0: that many bounces, then the
+// LB grid's scattered light), core/render/path_trace.h. The first surface's direct light is `local`, the rest
+// `indirect`; its albedo, normal and depth as lightStage gives them.
+SYLVA_HD inline SampleParts pathStage(const RenderView& v, const SurfacePoint& s, int px, int py, int sample)
 {
-    return SampleParts{pathRadiance(v, ray, s, px, py, sample), glm::vec3(0.0f), s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward),
-                       glm::vec3(0.0f)};
+    const bool path = v.integrator == Integrator::Path;
+    const PathLight l = pathRadiance(v, s, px, py, sample, path ? v.maxBounces : v.lightingBounces, !path);
+    return SampleParts{l.direct, l.indirect, s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
 }
 
 // The stages after intersect for a camera ray whose first hit is known (found; hit and its surface sp where
@@ -82,9 +85,7 @@ SYLVA_HD inline SampleParts pathStage(const RenderView& v, const Ray& ray, const
 SYLVA_HD inline SampleParts shadeFound(const RenderView& v, const Ray& ray, bool found, const Hit& hit, const SurfacePoint& sp, int px, int py, int s,
                                        const int* seen = nullptr)
 {
-    SampleParts out = !found ? backgroundStage(v, ray)
-                      : v.integrator == Integrator::Path ? pathStage(v, ray, sp, px, py, s)
-                                                         : lightStage(v, sp, px, py, s, seen);
+    SampleParts out = !found ? backgroundStage(v, ray) : tracesPaths(v) ? pathStage(v, sp, px, py, s) : lightStage(v, sp, px, py, s, seen);
     volumeStage(v, ray, found ? hit.t : ray.tmax, out);
     return out;
 }

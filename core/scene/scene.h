@@ -178,8 +178,15 @@ struct LightingDesc {
     ForestGridMode forestGrid = ForestGridMode::Off;
     int forestGridResolution = 0;        // forest grid nodes along the plants' longest horizontal extent; 0 =
                                          // automatic (4 across the median crown, at most 32: lb::kAutoResolution)
+    int bounces = 0;                     // the LB integrator's radiance cache: bounces a camera path traces (next-event
+                                         // estimation at each vertex) before the LB grid's scattered light ends it;
+                                         // 0 = the grid at the camera's hit (the seed's lookup), 0 .. kMaxPathBounces
     bool operator==(const LightingDesc&) const = default;   // the scene file writes the block only when it differs
 };
+
+// The direct light the species' LB grids leave to the renderer: with lighting.bounces > 0 the paths trace all
+// direct light, so the grids give their scattered light only, as with `once`, whatever `direct` says.
+inline DirectLight gridDirectLight(const LightingDesc& l) { return l.bounces > 0 ? DirectLight::Once : l.direct; }
 
 enum class RenderMode { Full, Local, Ambient, Lb };
 enum class AccelKind { Bvh, KdTree };

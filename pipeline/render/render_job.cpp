@@ -149,7 +149,7 @@ SpeciesGrids gridsForMesh(const Scene& scene, const SpeciesDesc& sp, const Trian
                        : lightingFor(g.density, p, cache, &lightProgress, log, backend);
     };
     g.lighting = solve(g.params);
-    if (scene.lighting.direct == DirectLight::Once) {
+    if (gridDirectLight(scene.lighting) == DirectLight::Once) {
         // Direct light counted once: the same LB with scattering off is the uncollided sunlight the
         // renderer's shadow rays already draw; the grid keeps the scattered rest (cached like any solve).
         g.lighting = lb::scatteredPart(g.lighting, solve(lb::uncollidedParams(g.params)));
@@ -185,7 +185,7 @@ std::string speciesLightingKey(const Scene& scene)
 {
     char buf[512];
     const glm::vec3 d = glm::normalize(lbSunDirection(scene));
-    std::snprintf(buf, sizeof buf, "sun %.9g %.9g %.9g|direct %s", double(d.x), double(d.y), double(d.z), directLightName(scene.lighting.direct));
+    std::snprintf(buf, sizeof buf, "sun %.9g %.9g %.9g|direct %s", double(d.x), double(d.y), double(d.z), directLightName(gridDirectLight(scene.lighting)));
     std::string key = buf;
     if (scene.lighting.boundary == LbBoundary::Sun) return key;
     const SkyDesc& k = scene.skyModel;

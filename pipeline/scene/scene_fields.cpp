@@ -664,6 +664,17 @@ const Table<LightingDesc>& sceneLightingTable()
                 return l.forestGridResolution == 0 ? std::string("forest grid resolution automatic")
                                                    : "forest grid resolution " + std::to_string(l.forestGridResolution);
             });
+        b.integer("bounces", &LightingDesc::bounces, 0, kMaxPathBounces)
+            .doc("integer", "the LB model as a radiance cache: bounces a camera path traces, 0 .. " + std::to_string(kMaxPathBounces) +
+                                ", next-event estimation to the sun and sky at each of its surfaces, before the LB grid's scattered light "
+                                "ends it. 0 (the default; old files keep their picture): the grid at the camera's hit, as the seed; 1: a "
+                                "final gather; more: closer to the path tracer, slower. With 1 or more the paths carry all direct light "
+                                "(the sky on leaves, the sun through them), so the grids give their scattered light only, as with "
+                                "`direct` once ([RENDERING.md](RENDERING.md) \"The LB grid as a radiance cache\")")
+            .summarized([](const LightingDesc& l) {
+                return l.bounces > 0 ? "radiance cache after " + std::to_string(l.bounces) + (l.bounces == 1 ? " bounce" : " bounces")
+                                     : std::string();
+            });
         return b.table;
     }();
     return table;

@@ -55,6 +55,13 @@ struct SkyRecord {
     sky::SkyView model;          // the sky camera rays see; Map: its pixels are RenderView::skyMap (model.map.rgb unused)
     uint32_t lightCount;         // RenderView::skyLights, its virtual directional lights (0: none)
     sky::Interleave interleave;  // the K subsets of skyLights over pixels and samples
+    uint32_t samplingRows;       // RenderView::skySampling: rows of the sky's sampling distribution (0: uniform, lights/sky.h)
 };
+
+// The sky's sampling distribution (lights/sky.h sampleSky): equal-area cells, kSkySamplingRows bands of equal
+// height in y (the cosine of the zenith angle) by kSkySamplingCols sectors of azimuth, each drawn with a
+// probability in proportion to the sky's luminance over it. RenderView::skySampling holds the rows' CDF (rows + 1
+// values) and then each row's CDF over its cells (cols + 1 values a row).
+inline constexpr uint32_t kSkySamplingRows = 32, kSkySamplingCols = 64;
 
 } // namespace sylva

@@ -321,7 +321,7 @@ SpeciesRecord speciesRecord(RenderScene& rs, const Scene& scene, size_t s, const
         const float norm = a.lightingNorm[int(i % 3)];
         rs.lighting.push_back(norm > 0.0f ? g.rgb[i] / norm : 0.0f);
     }
-    if (scene.lighting.direct == DirectLight::Once && s < scene.species.size()) {
+    if (gridDirectLight(scene.lighting) == DirectLight::Once && s < scene.species.size()) {
         // The grid holds scattered light only: each face gets a quarter of its fluence (leaf_optics.h).
         const lb::ScatteredWeights w = lb::scatteredWeights(scene.species[s].lighting);
         sr.leafIndirect = w.leaf;

@@ -294,7 +294,7 @@ SYLVA_HD inline void shadeMesh(const RenderView& v, const Hit& hit, const Instan
         for (int c = 0; c < 3; ++c)
             if (kd[c] * s.indirectWeight[c] > sp.leafIndirectCap) s.indirectWeight[c] = sp.leafIndirectCap / kd[c];
     // Diffuse transmission as the Blender export's translucent BSDF: kd x ratio, kd + it at most kMaxLeafScattering.
-    if (m.isLeaf && v.integrator == Integrator::Path)   // only the path tracer reads it
+    if (m.isLeaf && tracesPaths(v))   // only paths read it
         for (int c = 0; c < 3; ++c) s.transmission[c] = fmaxf(0.0f, fminf(kd[c] * sp.leafRatio[c], lb::kMaxLeafScattering - kd[c]));
     s.specular = m.specular;
     s.shininess = m.shininess;
