@@ -19,6 +19,10 @@ struct QualityPreset {
     bool fp16;
     int spp;
     float alphaDistance, pruneDistance; // metres, 0 = off
+    Integrator integrator;              // Path: the reference path tracer (the LB settings are set all the same)
+    int bounces;                        // lighting.bounces: the LB grid as a radiance cache after that many bounces
+    DirectLight direct;                 // lighting.direct
+    LbBoundary boundary;                // lighting.boundary
 };
 const std::vector<QualityPreset>& qualityPresets();
 const QualityPreset* findQualityPreset(const std::string& name);
@@ -26,7 +30,8 @@ const QualityPreset* findQualityPreset(const std::string& name);
 // The preset's steps/tolerance and storage on LB parameters (optics untouched). Throws Error on an
 // unknown steps label.
 void applyQualityLighting(const QualityPreset& preset, lb::LbParams& params);
-// The preset on a whole scene: every species' grid, steps and storage; spp, alpha and prune distances.
+// The preset on a whole scene: every species' grid, steps and storage; spp, alpha and prune distances; the
+// integrator and the lighting block's direct light, boundary and bounces (whatever the scene file held).
 void applyQuality(Scene& scene, const QualityPreset& preset);
 
 } // namespace sylva

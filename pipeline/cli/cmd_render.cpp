@@ -57,6 +57,7 @@ Scene sceneForArgs(const Args& args, std::string* stem)
     if (args.has("--max-bounces")) r.maxBounces = int(parseInteger("--max-bounces", args.get("--max-bounces"), 0, kMaxPathBounces));
     if (args.has("--direct") && !parseDirectLight(args.get("--direct"), &scene.lighting.direct))
         throw UsageError("option --direct: expected once or seed, got '" + args.get("--direct") + "'");
+    if (args.has("--bounces")) scene.lighting.bounces = int(parseInteger("--bounces", args.get("--bounces"), 0, kMaxPathBounces));
     if (args.has("--cells")) {
         if (!scene.terrain.enabled()) throw UsageError("option --cells: the scene has no terrain");
         scene.terrain.cells = int(parseInteger("--cells", args.get("--cells"), 1, 65536));
@@ -273,7 +274,9 @@ Command renderCommand()
 {
     return {"render", "[SCENE.sylva.json] [-o OUT.png|.exr|.tif] [--passes -o OUT.exr]",
             "render a scene (the bundled default forest when none is given)",
-            {{"--quality", "preview|final|reference", "quality preset: LB grid, steps and storage of every species, samples and distance knobs (docs/ACCURACY.md); the options below override it"},
+            {{"--quality", "preview|final|reference", "quality preset: LB grid, steps and storage of every species, samples and distance knobs, "
+                                                 "integrator and lighting (preview, final: the LB grid as a radiance cache after 1 and 2 bounces; "
+                                                 "reference: the path tracer; docs/ACCURACY.md); the options below override it"},
              {"--width", "W", "image width in pixels (default: the scene's)"},
              {"--height", "H", "image height in pixels (default: the scene's)"},
              {"--spp", "N", "samples per pixel, 1..4096 (default: the scene's)"},
@@ -285,6 +288,9 @@ Command renderCommand()
              {"--max-bounces", "N", "path: bounces after the camera's hit, 0 .. 100 (default: the scene's render.max_bounces, 64)"},
              {"--direct", "once|seed", "once: the LB grids add only scattered light to the shadow-rayed sun; seed: the seed's sum "
                                    "(grid as solved, direct light counted twice in crowns); default: the scene's lighting.direct"},
+             {"--bounces", "N", "lb: bounces a camera path traces before the LB grid's scattered light ends it, 0 .. 100 "
+                                "(0: the grid at the camera's hit; default: the scene's lighting.bounces; docs/RENDERING.md "
+                                "\"The LB grid as a radiance cache\")"},
              {"--cells", "N", "plant cells along the terrain's longer side (terrain.cells; the scene needs terrain.tiles)"},
              {"--sun", "X,Y,Z", "direction toward the sun (+Y up, any length), replacing the scene's"},
              kSunAt,

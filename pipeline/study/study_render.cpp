@@ -190,7 +190,7 @@ RenderData measureRender(const Options& o)
     }
 
     // The quality presets end to end on the forest: each preset's LB settings for every species (through
-    // the cache), its render settings; against the reference preset's LB with many samples.
+    // the cache), its render settings and integrator; against the reference preset (the path tracer) with many samples.
     {
         const std::vector<QualityPreset>& presets = qualityPresets();
         auto presetScene = [&](const QualityPreset& q) {

@@ -620,8 +620,11 @@ std::string presetSection(const LbData* lb, const RenderData* render)
       << " case above (per species; a forest solves each species once), the render columns end to end on the default forest at "
       << (render ? std::to_string(render->lodWidth) + "x" + std::to_string(render->lodHeight) : std::string("reduced size"))
       << " with the preset's LB settings for every species (build and trace; about 4x the trace time at the default 896x448), "
-         "image error against the reference preset's LB with "
-      << (render ? std::to_string(render->presetReferenceSpp) : std::string("many")) << " spp.\n\n";
+         "image error against the reference preset (the path tracer) with "
+      << (render ? std::to_string(render->presetReferenceSpp) : std::string("many"))
+      << " spp. Each preset also sets the integrator and the lighting block: `preview` and `final` the LB grid as a radiance "
+         "cache after one and two bounces (`lighting.bounces`, `direct` once, `boundary` sun_sky; the choice the ground truth "
+         "below measures against Cycles), `reference` the path tracer.\n\n";
     s << "| preset | LB grid, steps, storage | LB time (s) | LB error vs " << (lbCase ? lbCase->fineGrid : 128)
       << " | spp, alpha distance, prune distance | build (s) | trace wall (s) | trace CPU (s) | image error |\n"
          "| --- | --- | --- | --- | --- | --- | --- | --- | --- |\n";

@@ -393,10 +393,15 @@ private Q_SLOTS:
             QCOMPARE(s.render.spp, q->spp);
             QCOMPARE(s.render.alphaDistance, q->alphaDistance);
             QCOMPARE(s.render.pruneDistance, q->pruneDistance);
+            QVERIFY(s.render.integrator == q->integrator);
+            QCOMPARE(s.lighting.bounces, q->bounces);
+            QVERIFY(s.lighting.direct == q->direct && s.lighting.boundary == q->boundary);
         }
         QVERIFY(!findQualityPreset("draft"));
         QCOMPARE(findQualityPreset("preview")->grid, 32);
-        QCOMPARE(findQualityPreset("reference")->spp, 64);
+        // reference is the path tracer; final the LB grid as a radiance cache after two bounces
+        QVERIFY(findQualityPreset("reference")->integrator == Integrator::Path);
+        QVERIFY(findQualityPreset("final")->integrator == Integrator::Lb && findQualityPreset("final")->bounces == 2);
     }
 
     void lightingStepsAndTolerance()
