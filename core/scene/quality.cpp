@@ -29,6 +29,14 @@ const QualityPreset* findQualityPreset(const std::string& name)
     return nullptr;
 }
 
+std::string qualityPresetSettings(const QualityPreset& q)
+{
+    auto dist = [](float m) { return m > 0.0f ? std::to_string(int(m)) + " m" : std::string("off"); };
+    return "grid " + std::to_string(q.grid) + ", " + q.steps + ", " + (q.fp16 ? "fp16" : "fp32") + ", " + std::to_string(q.spp) +
+           " spp, alpha " + dist(q.alphaDistance) + ", prune " + dist(q.pruneDistance) + ", " + integratorName(q.integrator) + ", " +
+           std::to_string(q.bounces) + " bounces, direct " + directLightName(q.direct) + ", boundary " + lbBoundaryName(q.boundary);
+}
+
 void applyQualityLighting(const QualityPreset& preset, lb::LbParams& params)
 {
     const std::string steps = preset.steps;

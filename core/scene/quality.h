@@ -26,6 +26,9 @@ struct QualityPreset {
 };
 const std::vector<QualityPreset>& qualityPresets();
 const QualityPreset* findQualityPreset(const std::string& name);
+// Everything the preset sets, in words ("grid 64, half, fp16, 64 spp, ..."): what a measurement of it records,
+// so a stored measurement of other settings is not shown as this preset's.
+std::string qualityPresetSettings(const QualityPreset& preset);
 
 // The preset's steps/tolerance and storage on LB parameters (optics untouched). Throws Error on an
 // unknown steps label.

@@ -56,7 +56,7 @@ void fields(Io& io, R& r)
         io("default", r.isDefault);
     } else if constexpr (std::is_same_v<T, PresetRow>) {
         io("name", r.name); io("build_seconds", r.buildSeconds); io("trace_seconds", r.traceSeconds); io("trace_cpu", r.traceCpu);
-        io("err", r.err);
+        io("err", r.err); io("settings", r.settings);
     } else if constexpr (std::is_same_v<T, RenderData>) {
         io("run", r.run); io("spp_scene", r.sppScene); io("spp_width", r.sppWidth); io("spp_height", r.sppHeight);
         io("spp_reference", r.sppReference); io("spp", r.spp); io("lod_scene", r.lodScene); io("lod_width", r.lodWidth);

@@ -108,6 +108,7 @@ struct PresetRow {
     double traceSeconds = 0.0;
     double traceCpu = 0.0;
     double err = 0.0;                   // against the preset reference render
+    std::string settings;               // qualityPresetSettings of the preset measured (empty: measured before it was kept)
 };
 
 struct RenderData {

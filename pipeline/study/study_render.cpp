@@ -219,6 +219,7 @@ RenderData measureRender(const Options& o)
             const RenderScene scene = buildRenderScene(s, assets, sunRadiance(s.sun));
             PresetRow row;
             row.name = q.name;
+            row.settings = qualityPresetSettings(q);
             row.buildSeconds = secondsNow() - b0;
             const Traced t = trace(scene, s, q.spp, q.alphaDistance, reps);
             row.traceSeconds = t.seconds;

@@ -636,6 +636,11 @@ std::string presetSection(const LbData* lb, const RenderData* render)
         if (render)
             for (const PresetRow& p : render->presets)
                 if (p.name == q.name) pr = &p;
+        if (pr && pr->settings != qualityPresetSettings(q)) {   // measured with other settings: not this preset's figures
+            notes.push_back(std::string(q.name) + "'s render columns: not measured with its settings (" + qualityPresetSettings(q) +
+                            "; `sylva study render` measures them)");
+            pr = nullptr;
+        }
         auto dist = [](float m) { return m > 0.0f ? f("%g m", m) : std::string("off"); };
         s << "| **" << q.name << "** | " << q.grid << ", " << q.steps << ", " << storageName(q.fp16) << " | "
           << (row ? secs(row->seconds) + " (CPU " + secs(row->cpuSeconds) + ")" : "-") << " | " << (row ? err(row->errFine) : "-") << " | " << q.spp << ", " << dist(q.alphaDistance)
