@@ -121,6 +121,16 @@ MainWindow::MainWindow(QWidget* parent)
         s.camera = camera;
         m_doc->edit(s, tr("Navigate"), key);
     });
+    // A click in the viewport selects the instance under the cursor in the outliner (nothing: clears it).
+    connect(m_viewport, &Viewport::instancePicked, this, [this](int instance) {
+        if (instance >= 0) {
+            const QModelIndex index = m_model->indexOf({OutlinerItem::Kind::Instance, instance});
+            m_outliner->setCurrentIndex(index);
+            m_outliner->scrollTo(index);
+        } else {
+            m_outliner->selectionModel()->clear();
+        }
+    });
     connect(m_viewport, &Viewport::imageShown, this, [this](int pass, bool last, double seconds) {
         statusBar()->showMessage(tr("Viewport: pass %1%2, %3 s after the change")
                                      .arg(pass + 1)
@@ -206,6 +216,8 @@ void MainWindow::buildDocks()
     m_outliner->header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
     m_outliner->expandAll();
     connect(m_model, &QAbstractItemModel::modelReset, m_outliner, &QTreeView::expandAll);
+    // Rows came or went (a delete, an undo, another file): the selection is gone, and the properties with it.
+    connect(m_model, &QAbstractItemModel::modelReset, this, &MainWindow::onSelectionChanged);
     connect(m_outliner->selectionModel(), &QItemSelectionModel::currentChanged, this, &MainWindow::onSelectionChanged);
     auto* outlinerDock = new QDockWidget(tr("Outliner"), this);
     outlinerDock->setObjectName("outlinerDock");
@@ -363,6 +375,10 @@ void MainWindow::buildActions()
     m_viewMenu = menuBar()->addMenu(tr("&View"));
     for (QDockWidget* d : findChildren<QDockWidget*>()) m_viewMenu->addAction(d->toggleViewAction());
     m_viewMenu->addSeparator();
+    // Blender's View All (Home) and View Selected (numpad period).
+    add(m_viewMenu, tr("Frame &All"), "actionFrameAll", QKeySequence(Qt::Key_Home), [this] { m_viewport->frameAll(); });
+    add(m_viewMenu, tr("Frame &Selected"), "actionFrameSelected", QKeySequence(Qt::KeypadModifier | Qt::Key_Period),
+        [this] { m_viewport->frameSelected(); });
     // F in the viewport toggles it too (a window-wide F shortcut would eat the key in text fields).
     QAction* fly = m_viewMenu->addAction(tr("&Fly Navigation (F in the viewport)"));
     fly->setObjectName("actionFly");
@@ -372,7 +388,7 @@ void MainWindow::buildActions()
         const QSignalBlocker block(fly);
         fly->setChecked(on);
         statusBar()->showMessage(on ? tr("Fly: W/S forward/back, A/D left/right, Q/E down/up (Shift: faster), drag to look; F: back to orbit")
-                                    : tr("Orbit: drag to orbit, Shift+drag or middle drag to pan, wheel to zoom"),
+                                    : tr("Orbit: drag to orbit, Shift+drag or middle drag to pan, wheel to zoom, click to select"),
                                  on ? 0 : 4000);
     });
 
@@ -491,7 +507,9 @@ void MainWindow::updateCompare()
 
 void MainWindow::onSelectionChanged()
 {
-    m_properties->showItem(m_model->itemAt(m_outliner->currentIndex()));
+    const OutlinerItem item = m_model->itemAt(m_outliner->currentIndex());
+    m_properties->showItem(item);
+    m_viewport->setSelectedInstance(item.kind == OutlinerItem::Kind::Instance ? item.row : -1);
     refreshInspector();
 }
 

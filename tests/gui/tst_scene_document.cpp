@@ -335,6 +335,25 @@ private Q_SLOTS:
         QVERIFY(glm::length(all.lo - glm::vec3(-1.0f, 0.0f, -2.0f)) < 1e-5f && glm::length(all.hi - glm::vec3(11.0f, 8.0f, 2.0f)) < 1e-5f);
     }
 
+    // A gesture of merged edits that ends where it began leaves no undo step, and a clean document clean.
+    void gestureBackToStartLeavesNoStep()
+    {
+        SceneDocument doc;
+        Scene s;
+        s.camera.position = {0.0, 2.0, -10.0};
+        doc.reset(s, QString());
+        const int key = SceneDocument::newMergeKey();
+        Scene moved = s;
+        moved.camera.position.x = 3.0;
+        doc.edit(moved, "Navigate", key);
+        QCOMPARE(doc.undoStack()->count(), 1);
+        QVERIFY(doc.isModified());
+        doc.edit(s, "Navigate", key);
+        QCOMPARE(doc.undoStack()->count(), 0);
+        QVERIFY(!doc.isModified());
+        QCOMPARE(doc.scene().camera.position, s.camera.position);
+    }
+
     // Fly navigation: looking turns the view about a fixed eye, moving carries eye and target along
     // the camera's own axes. Expected values worked out by hand for a camera at (1, 2, -10) looking
     // down +Z (its right is -X: right = view x up).
