@@ -2,6 +2,7 @@
 // the controllers it owns do the rest (docs/STUDIO.md, "How it is built").
 #include "studio/main_window.h"
 
+#include <algorithm>
 #include <initializer_list>
 #include <utility>
 
@@ -213,9 +214,20 @@ void MainWindow::buildDocks()
     m_outliner->setObjectName("outliner");
     m_outliner->setModel(m_model);
     m_outliner->setSelectionMode(QAbstractItemView::SingleSelection);
+    // Names as wide as they are; details as wide as their widest text or the room left (a long detail scrolls
+    // sideways instead of being cut off; its tooltip holds it too).
     m_outliner->header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
+    m_outliner->header()->setSectionResizeMode(1, QHeaderView::Interactive);
+    m_outliner->header()->setStretchLastSection(false);
+    m_outliner->setHorizontalScrollMode(QAbstractItemView::ScrollPerPixel);
     m_outliner->expandAll();
     connect(m_model, &QAbstractItemModel::modelReset, m_outliner, &QTreeView::expandAll);
+    connect(m_model, &QAbstractItemModel::modelReset, this, &MainWindow::fitOutlinerDetails, Qt::QueuedConnection);
+    connect(m_model, &QAbstractItemModel::dataChanged, this, &MainWindow::fitOutlinerDetails, Qt::QueuedConnection);
+    connect(m_outliner->header(), &QHeaderView::sectionResized, this, [this](int section) {
+        if (section == 0) fitOutlinerDetails();
+    });
+    m_outliner->viewport()->installEventFilter(this);
     // Rows came or went (a delete, an undo, another file): the selection is gone, and the properties with it.
     connect(m_model, &QAbstractItemModel::modelReset, this, &MainWindow::onSelectionChanged);
     connect(m_outliner->selectionModel(), &QItemSelectionModel::currentChanged, this, &MainWindow::onSelectionChanged);
@@ -503,6 +515,20 @@ void MainWindow::updateCompare()
     if (mode == m_viewport->compare()) return;
     m_viewport->setCompare(mode);
     m_lighting->updateViewport();   // the second mode may need lighting the first does not
+}
+
+void MainWindow::fitOutlinerDetails()
+{
+    const int room = m_outliner->viewport()->width() - m_outliner->header()->sectionSize(0);
+    // (QTreeView makes sizeHintForColumn protected; the item view declares it public.)
+    const int want = std::max(static_cast<const QAbstractItemView*>(m_outliner)->sizeHintForColumn(1), room);
+    if (m_outliner->header()->sectionSize(1) != want) m_outliner->header()->resizeSection(1, want);
+}
+
+bool MainWindow::eventFilter(QObject* watched, QEvent* event)
+{
+    if (m_outliner && watched == m_outliner->viewport() && event->type() == QEvent::Resize) fitOutlinerDetails();
+    return QMainWindow::eventFilter(watched, event);
 }
 
 void MainWindow::onSelectionChanged()

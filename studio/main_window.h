@@ -117,6 +117,7 @@ Q_SIGNALS:
 
 protected:
     void closeEvent(QCloseEvent* event) override;
+    bool eventFilter(QObject* watched, QEvent* event) override;   // the outliner's viewport resized: fitOutlinerDetails
     void showEvent(QShowEvent* event) override;
     void dragEnterEvent(QDragEnterEvent* event) override;
     void dropEvent(QDropEvent* event) override;
@@ -133,6 +134,8 @@ private:
     void onDocumentChanged(ScenePart parts);
     void updateCompare();
     void onSelectionChanged();
+    // The outliner's Details column: as wide as its widest text (the view scrolls sideways) or the room left, whichever is more.
+    void fitOutlinerDetails();
     void refreshInspector();   // the inspector controller, once it exists (and until the window goes)
     void openDialog();
     bool saveAsDialog();
@@ -143,7 +146,7 @@ private:
     std::unique_ptr<GridCache> m_cache;
     std::unique_ptr<Backend> m_backend;
     OutlinerModel* m_model;
-    QTreeView* m_outliner;
+    QTreeView* m_outliner = nullptr;
     PropertyPanel* m_properties;
     SkyPanel* m_skyPanel = nullptr;
     Viewport* m_viewport;

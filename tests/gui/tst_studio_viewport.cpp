@@ -2,10 +2,13 @@
 // step, the scene stays unmodified) and a drag is one; a click on a tree selects its instance (outliner row,
 // properties, an outline over the picture) without tracing again, a click on the sky or the ground clears
 // the selection; Frame All and Frame Selected; the wheel zooms toward what is under the cursor and a pan
-// drags what it grabbed. The oracles are the test's own: a pinhole projection from the camera's
+// drags what it grabbed; the outliner's numbers. The oracles are the test's own: a pinhole projection from the camera's
 // parameters and the boxes of the species' mesh as the lighting job loaded it.
 #include <QAction>
+#include <QDoubleSpinBox>
+#include <QHeaderView>
 #include <QItemSelectionModel>
+#include <QRegularExpression>
 #include <QTreeView>
 #include <QWheelEvent>
 
@@ -14,6 +17,7 @@
 #include <memory>
 
 #include "studio/camera_nav.h"
+#include "studio/outliner_model.h"
 #include "studio/property_panel.h"
 #include "studio/render_worker.h"
 #include "studio_test_util.h"
@@ -182,6 +186,43 @@ private Q_SLOTS:
         QVERIFY(m_win->newScene());
         QCOMPARE(m_prompts, 0);
         doc()->reset(kept, QString());
+        settle();
+    }
+
+    // An orbit a quarter turn about the target puts the eye at x = 1e-15 or so: the outliner shows 0, and
+    // no number in scientific notation; the details column is as wide as its text.
+    void outlinerNumbers()
+    {
+        Scene s = scene();
+        s.camera.position = {-1.225e-15, 3.0, 12690.4};
+        s.camera.target = {0.0, 2.5, 0.0};
+        doc()->edit(s, "camera");
+        OutlinerModel* m = m_win->outlinerModel();
+        const QString text = m->data(m->indexOf({OutlinerItem::Kind::Camera, -1}, 1)).toString();
+        QCOMPARE(text, QStringLiteral("at (0, 3, 12690)"));
+        // The camera's page: 0.000, not -0.000.
+        m_win->outliner()->setCurrentIndex(m->indexOf({OutlinerItem::Kind::Camera, -1}));
+        auto* x = m_win->propertyPanel()->findChild<QDoubleSpinBox*>(QStringLiteral("camera.position.x"));
+        QVERIFY(x);
+        QCOMPARE(x->value(), 0.0);
+        QVERIFY2(!x->text().startsWith(QLatin1Char('-')), qPrintable(x->text()));
+        QCOMPARE(decimalText(-0.0004), QStringLiteral("0"));
+        QCOMPARE(decimalText(2.5), QStringLiteral("2.5"));
+        QCOMPARE(decimalText(-123.456), QStringLiteral("-123.5"));
+        QCOMPARE(decimalText(0.0132), QStringLiteral("0.013"));
+        QCOMPARE(decimalText(1.269e4), QStringLiteral("12690"));
+        for (int g = 0; g < m->rowCount(); ++g) {
+            const QModelIndex group = m->index(g, 0);
+            for (int r = -1; r < m->rowCount(group); ++r) {
+                const QString t = (r < 0 ? m->index(g, 1) : m->index(r, 1, group)).data().toString();
+                QVERIFY2(!t.contains(QRegularExpression("[0-9]e[-+][0-9]")), qPrintable(t));
+            }
+        }
+        QTreeView* tree = m_win->outliner();
+        QTRY_VERIFY(tree->header()->sectionSize(1) >= tree->fontMetrics().horizontalAdvance(text));
+        QVERIFY(tree->header()->sectionSize(0) >= tree->fontMetrics().horizontalAdvance(QStringLiteral("Tree_1 #2")));
+        doc()->undoStack()->undo();
+        doc()->undoStack()->clear();
         settle();
     }
 
