@@ -12,6 +12,7 @@
 #include "pipeline/services/exports.h"
 #include "studio/asset_store.h"
 #include "studio/job_manager.h"
+#include "studio/recent_files.h"
 #include "studio/scene_document.h"
 
 namespace sylva {
@@ -127,8 +128,12 @@ void ExportController::exportGridsDialog(int species, GridFileFormat format)
     }
     const QString folder = QFileDialog::getExistingDirectory(
         m_window, tr("Export the grids of %1 to").arg(QString::fromStdString(m_doc->scene().species[size_t(species)].name)),
-        m_doc->filePath().isEmpty() ? QString() : QFileInfo(m_doc->filePath()).absolutePath());
-    if (!folder.isEmpty()) exportSpeciesGrids(species, folder, format);
+        !lastFolder(QStringLiteral("grids")).isEmpty() ? lastFolder(QStringLiteral("grids"))
+        : m_doc->filePath().isEmpty()               ? QString()
+                                                    : QFileInfo(m_doc->filePath()).absolutePath());
+    if (folder.isEmpty()) return;
+    rememberFolder(QStringLiteral("grids"), folder);
+    exportSpeciesGrids(species, folder, format);
 }
 
 } // namespace sylva

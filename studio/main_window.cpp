@@ -11,6 +11,7 @@
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
+#include <QDir>
 #include <QDockWidget>
 #include <QDragEnterEvent>
 #include <QDropEvent>
@@ -62,6 +63,9 @@ MainWindow::MainWindow(QWidget* parent)
     setAcceptDrops(true);
     lowerTbbWorkerPriority();
     m_reportError = [this](const QString& title, const QString& message) { QMessageBox::critical(this, title, message); };
+    m_chooseOpen = [this](const QString& folder) {
+        return QFileDialog::getOpenFileName(this, tr("Open Scene"), folder, tr(kSceneFilter));
+    };
     m_askSave = [this](const QString& name) {
         return QMessageBox::warning(this, tr("Unsaved changes"), tr("Save the changes to %1?").arg(name),
                                     QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
@@ -458,9 +462,10 @@ bool MainWindow::newScene()
     return true;
 }
 
-bool MainWindow::openFile(const QString& path)
+bool MainWindow::openFile(const QString& path) { return maybeSave() && loadFile(path); }
+
+bool MainWindow::loadFile(const QString& path)
 {
-    if (!maybeSave()) return false;
     try {
         m_doc->open(path);
     } catch (const std::exception& e) {
@@ -468,6 +473,7 @@ bool MainWindow::openFile(const QString& path)
         return false;
     }
     m_recent->add(m_doc->filePath());
+    rememberFolder(QStringLiteral("scenes"), m_doc->filePath());
     appendLog(tr("opened %1").arg(m_doc->filePath()));
     return true;
 }
@@ -483,6 +489,7 @@ bool MainWindow::saveFile(const QString& path)
         return false;
     }
     m_recent->add(m_doc->filePath());
+    rememberFolder(QStringLiteral("scenes"), m_doc->filePath());
     appendLog(tr("saved %1").arg(m_doc->filePath()));
     statusBar()->showMessage(tr("Saved %1").arg(m_doc->filePath()), 3000);
     return true;
@@ -590,15 +597,19 @@ void MainWindow::deleteSelection()
 
 void MainWindow::openDialog()
 {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open Scene"), QString(), tr(kSceneFilter));
-    if (!path.isEmpty()) openFile(path);
+    // The question about the open scene before the chooser: the answer may be Cancel, and then no file is asked for.
+    if (!maybeSave()) return;
+    const QString path = m_chooseOpen ? m_chooseOpen(lastFolder(QStringLiteral("scenes"))) : QString();
+    if (!path.isEmpty()) loadFile(path);
 }
 
 bool MainWindow::saveAsDialog()
 {
-    QString path = QFileDialog::getSaveFileName(this, tr("Save Scene As"),
-                                                m_doc->filePath().isEmpty() ? tr("forest.sylva.json") : m_doc->filePath(),
-                                                tr(kSceneFilter));
+    const QString folder = lastFolder(QStringLiteral("scenes"));
+    const QString suggested = !m_doc->filePath().isEmpty() ? m_doc->filePath()
+                              : folder.isEmpty()           ? tr("forest.sylva.json")
+                                                           : QDir(folder).filePath(tr("forest.sylva.json"));
+    QString path = QFileDialog::getSaveFileName(this, tr("Save Scene As"), suggested, tr(kSceneFilter));
     return !path.isEmpty() && saveFile(path);
 }
 

@@ -95,6 +95,10 @@ public:
     void setErrorReporter(ErrorReporter reporter) { m_reportError = std::move(reporter); }
     using SavePrompt = std::function<QMessageBox::StandardButton(const QString& documentName)>;
     void setSavePrompt(SavePrompt prompt) { m_askSave = std::move(prompt); }
+    // How File > Open asks for the scene file, given the folder to start in (lastFolder("scenes")). Default:
+    // QFileDialog. Asked only after the unsaved-changes question; an empty answer opens nothing.
+    using OpenChooser = std::function<QString(const QString& folder)>;
+    void setOpenChooser(OpenChooser chooser) { m_chooseOpen = std::move(chooser); }
 
     // File
     bool newScene();                       // false when the user cancelled the unsaved-changes prompt
@@ -102,6 +106,8 @@ public:
     bool saveFile(const QString& path);    // false (and an error report) when it cannot be written
     bool save();                           // to the current file, or Save As when untitled
     void loadExampleForest();
+    // File > Open...: the unsaved-changes question first, then the file chooser, then the file.
+    void openDialog();
     // Edit
     void deleteSelection();
     // The species the outliner selection points at (a species row, or an instance's species); -1 if none.
@@ -137,8 +143,8 @@ private:
     // The outliner's Details column: as wide as its widest text (the view scrolls sideways) or the room left, whichever is more.
     void fitOutlinerDetails();
     void refreshInspector();   // the inspector controller, once it exists (and until the window goes)
-    void openDialog();
     bool saveAsDialog();
+    bool loadFile(const QString& path);   // openFile without the unsaved-changes question
 
     SceneDocument* m_doc;
     JobManager* m_jobs;
@@ -172,6 +178,7 @@ private:
 
     ErrorReporter m_reportError;
     SavePrompt m_askSave;
+    OpenChooser m_chooseOpen;
     bool m_docksSized = false;
 };
 

@@ -27,6 +27,7 @@
 #include "core/base/error.h"
 #include "core/sky/sun_position.h"
 #include "studio/camera_nav.h"
+#include "studio/recent_files.h"
 
 #include "studio/form_widgets.h"
 #include "studio/param_widgets.h"
@@ -50,7 +51,10 @@ sky::SunPlace placeOf(const Scene& s) { return s.sun.place ? *s.sun.place : sky:
 SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc(doc)
 {
     m_chooseMap = [this] {
-        return QFileDialog::getOpenFileName(this, tr("HDR Environment Map"), QString(), tr("HDR maps (*.exr *.hdr);;All files (*)"));
+        const QString path = QFileDialog::getOpenFileName(this, tr("HDR Environment Map"), lastFolder(QStringLiteral("maps")),
+                                                          tr("HDR maps (*.exr *.hdr);;All files (*)"));
+        rememberFolder(QStringLiteral("maps"), path);
+        return path;
     };
     auto* layout = new QVBoxLayout(this);
     layout->setContentsMargins(4, 4, 4, 4);

@@ -2,7 +2,8 @@
 // step, the scene stays unmodified) and a drag is one; a click on a tree selects its instance (outliner row,
 // properties, an outline over the picture) without tracing again, a click on the sky or the ground clears
 // the selection; Frame All and Frame Selected; the wheel zooms toward what is under the cursor and a pan
-// drags what it grabbed; the outliner's numbers. The oracles are the test's own: a pinhole projection from the camera's
+// drags what it grabbed; the outliner's numbers; File > Open's question before its file chooser and the
+// dialogs' remembered folder. The oracles are the test's own: a pinhole projection from the camera's
 // parameters and the boxes of the species' mesh as the lighting job loaded it.
 #include <QAction>
 #include <QDoubleSpinBox>
@@ -16,6 +17,7 @@
 #include <cmath>
 #include <memory>
 
+#include "pipeline/scene/scene_file.h"
 #include "studio/camera_nav.h"
 #include "studio/outliner_model.h"
 #include "studio/property_panel.h"
@@ -394,6 +396,56 @@ private Q_SLOTS:
         QVERIFY2(std::abs(moved.x() - to.x()) < 0.75 && std::abs(moved.y() - to.y()) < 0.75,
                  qPrintable(QStringLiteral("%1, %2 vs %3, %4").arg(moved.x()).arg(moved.y()).arg(to.x()).arg(to.y())));
         settle();
+    }
+
+    // File > Open: the unsaved-changes question comes first; Cancel asks for no file; the chooser starts in
+    // the folder of the last scene opened or saved, also in the next window (QSettings).
+    void openAsksFirstAndRemembersTheFolder()
+    {
+        const QString folder = m_dir.filePath("scenes");
+        QVERIFY(QDir().mkpath(folder));
+        const QString path = QDir(folder).filePath("two.sylva.json");
+        QVERIFY(m_win->saveFile(path));
+        QCOMPARE(lastFolder("scenes"), QFileInfo(path).absolutePath());
+
+        Scene s = scene();
+        s.ground.height = 0.25;
+        doc()->edit(s, "ground");
+        QVERIFY(doc()->isModified());
+        int chooserPrompts = -1;
+        QString chooserFolder;
+        m_win->setOpenChooser([&](const QString& f) {
+            chooserPrompts = m_prompts;
+            chooserFolder = f;
+            return path;
+        });
+        m_prompts = 0;
+        m_answer = QMessageBox::Cancel;
+        action("actionOpen")->trigger();
+        QCOMPARE(m_prompts, 1);
+        QCOMPARE(chooserPrompts, -1);   // cancelled: no file asked for
+        QVERIFY(doc()->isModified());
+
+        m_answer = QMessageBox::Discard;
+        action("actionOpen")->trigger();
+        QCOMPARE(m_prompts, 2);
+        QCOMPARE(chooserPrompts, 2);   // asked after the question, and only once
+        QCOMPARE(chooserFolder, QFileInfo(path).absolutePath());
+        QVERIFY(!doc()->isModified());
+        QCOMPARE(scene().ground.height, 0.0);
+        QCOMPARE(doc()->filePath(), QFileInfo(path).absoluteFilePath());
+
+        // The next window's chooser starts there too.
+        MainWindow other;
+        other.lighting()->setAutoLighting(false);
+        other.autosave()->setRecoveryPrompt([](const QString&, const QDateTime&) { return false; });
+        QString otherFolder;
+        other.setOpenChooser([&](const QString& f) {
+            otherFolder = f;
+            return QString();
+        });
+        other.openDialog();
+        QCOMPARE(otherFolder, QFileInfo(path).absolutePath());
     }
 };
 
