@@ -193,6 +193,12 @@ void RenderWorker::process(const Request& req, Progress& progress)
         a.render.mode = b.render.mode;
         a.render.exposureKey = b.render.exposureKey;
         if (changedParts(a, b) == ScenePart::None) {
+            // A request cancelled since may have re-placed the frame for its own scene (an instance deleted, then
+            // the delete undone before its first picture): the frame is placed for this scene again, as what the
+            // viewport picks in must hold the instances shown.
+            if (m_frame && !viewFrameUpdate(m_frameScene, scene).any() && viewFrameFits(*m_frame, scene))
+                place(scene, sunRadiance(scene.sun), std::max(1, req.size.width()), std::max(1, req.size.height()),
+                      passes.empty() ? 1 : passes.back().spp);
             const QImage img = picture(m_lastFilm, scene, req.compare);
             m_lastScene = scene;
             Q_EMIT imageReady(img, m_lastPass, true, elapsed(), req.serial);
