@@ -38,6 +38,10 @@ varying vec2 uv;
 void main() { gl_FragColor = vec4(texture2D(film, uv).rgb, 1.0); }
 )";
 
+// How long a pan or a wheel notch waits for the worker's frame to pick what is under the cursor (the worker
+// holds it only to build, update or re-place it): past that it goes by the target, the GUI does not stall.
+constexpr int kNavigationPickMs = 20;
+
 } // namespace
 
 Viewport::Viewport(QWidget* parent) : QOpenGLWidget(parent), m_worker(new RenderWorker(this)), m_quad(QOpenGLBuffer::VertexBuffer)
@@ -380,7 +384,7 @@ void Viewport::mousePressEvent(QMouseEvent* event)
     m_panDepth = 0.0;
     if (pan) {
         // Grab what is under the cursor: it follows the cursor at its own depth (the target's without a hit).
-        if (const std::optional<ViewPick> hit = pickAt(event->position()); hit && hit->kind != SurfaceKind::None) {
+        if (const std::optional<ViewPick> hit = pickAt(event->position(), kNavigationPickMs); hit && hit->kind != SurfaceKind::None) {
             const glm::dvec3 view = m_scene.camera.target - m_scene.camera.position;
             if (glm::length(view) > 0.0) m_panDepth = glm::dot(hit->point - m_scene.camera.position, glm::normalize(view));
         }
@@ -427,14 +431,14 @@ void Viewport::wheelEvent(QWheelEvent* event)
     if (m_wheelKey == 0 || now - m_lastWheelMs > 500) m_wheelKey = SceneDocument::newMergeKey();
     m_lastWheelMs = now;
     // Toward what is under the cursor (its distance sets the step), else toward the target.
-    const std::optional<ViewPick> hit = pickAt(event->position());
+    const std::optional<ViewPick> hit = pickAt(event->position(), kNavigationPickMs);
     const CameraDesc c = hit && hit->kind != SurfaceKind::None ? zoomCameraAbout(m_scene.camera, steps, hit->point)
                                                               : zoomCamera(m_scene.camera, steps);
     Q_EMIT cameraEdited(c, m_wheelKey);
     event->accept();
 }
 
-std::optional<ViewPick> Viewport::pickAt(QPointF pos) const
+std::optional<ViewPick> Viewport::pickAt(QPointF pos, int waitMs) const
 {
     const QSize size = renderSize();
     const QPointF pixel(pos.x() * double(size.width()) / double(std::max(1, width())),
@@ -446,7 +450,7 @@ std::optional<ViewPick> Viewport::pickAt(QPointF pos) const
             return std::nullopt;
         }
     }
-    return m_worker->pick(m_scene.camera, size, pixel);
+    return m_worker->pick(m_scene.camera, size, pixel, waitMs);
 }
 
 void Viewport::setSelectedInstance(int instance)

@@ -67,8 +67,9 @@ public:
 
     // Picking: what the camera ray through widget position `pos` (logical pixels) hits, traced in the frame
     // the picture is drawn from (the worker's on the CPU, the viewport's on the GPU); nothing before a frame
-    // exists. A click (press and release of the left button without a drag) picks and emits instancePicked.
-    std::optional<ViewPick> pickAt(QPointF pos) const;
+    // exists, or when the worker holds its frame to write it for longer than waitMs. A click (press and release
+    // of the left button without a drag) picks and emits instancePicked.
+    std::optional<ViewPick> pickAt(QPointF pos, int waitMs = 200) const;
 
     // The selected instance (index into Scene::instances; -1: none), outlined over the picture by its box's
     // twelve edges projected with the scene's camera (an overlay: the render does not restart).
