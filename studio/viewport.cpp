@@ -56,6 +56,7 @@ Viewport::Viewport(QWidget* parent) : QOpenGLWidget(parent), m_worker(new Render
     connect(m_worker, &RenderWorker::gpuFrameReady, this, [this](const GpuFramePtr& frame) {
         if (!m_interop || frame->assets != m_assets) return;   // stale: the assets changed again meanwhile
         m_gpuFrame = frame;
+        m_gpuPlacedAt = frame->built.camera.position;   // the worker placed it at the scene's camera
         m_gpuPass = 0;
         update();
     });
