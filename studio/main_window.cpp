@@ -43,6 +43,7 @@
 #include "studio/outliner_model.h"
 #include "studio/property_panel.h"
 #include "studio/recent_files.h"
+#include "studio/render_window.h"
 #include "studio/scatter_tool.h"
 #include "studio/species_importer.h"
 #include "studio/viewport.h"
@@ -189,6 +190,7 @@ MainWindow::~MainWindow()
     m_doc->disconnect(this);
     m_jobs->disconnect(this);
     m_viewport->disconnect(this);
+    delete std::exchange(m_renderWindow, nullptr);
     delete std::exchange(m_autosave, nullptr);
     delete std::exchange(m_inspection, nullptr);
     delete std::exchange(m_importer, nullptr);
@@ -372,6 +374,8 @@ void MainWindow::buildActions()
     add(edit, tr("Simulate S&moke..."), "actionSimulateSmoke", QKeySequence(), [this] { m_volumeTools->smokeDialog(); });
 
     QMenu* render = menuBar()->addMenu(tr("&Render"));
+    add(render, tr("Render &Image"), "actionRenderImage", QKeySequence(Qt::Key_F12), [this] { renderImage(); });
+    render->addSeparator();
     add(render, tr("Compute &Lighting"), "actionLight", QKeySequence(Qt::CTRL | Qt::Key_L), [this] { m_lighting->computeLighting(); });
     add(render, tr("&Reload Lighting"), "actionReload", QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_L),
         [this] { m_lighting->computeLighting(true); });
@@ -414,6 +418,16 @@ void MainWindow::buildActions()
                            tr("<b>Sylva Studio</b> %1<br>Forests lit with the lattice-Boltzmann lighting model.")
                                .arg(QString::fromLatin1(SYLVA_VERSION)));
     });
+}
+
+RenderWindow* MainWindow::renderImage()
+{
+    if (!m_renderWindow) m_renderWindow = new RenderWindow(m_doc, m_export, this);
+    m_renderWindow->show();
+    m_renderWindow->raise();
+    m_renderWindow->activateWindow();
+    m_renderWindow->render();
+    return m_renderWindow;
 }
 
 QString MainWindow::logText() const { return m_log->toPlainText(); }

@@ -38,6 +38,7 @@ class OutlinerModel;
 class PropertyPanel;
 class SkyPanel;
 class RecentFiles;
+class RenderWindow;
 class ScatterTool;
 class SpeciesImporter;
 class StudioController;
@@ -87,6 +88,9 @@ public:
     ScatterTool* scatterTool() const { return m_scatter; }
     SpeciesImporter* importer() const { return m_importer; }
     VolumeTools* volumeTools() const { return m_volumeTools; }
+    // Render > Render Image (F12): shows the render window and starts its render; the window (made on first use).
+    RenderWindow* renderImage();
+    RenderWindow* renderWindow() const { return m_renderWindow; }
 
     // How errors and the unsaved-changes question reach the user. Defaults: modal message boxes.
     // Tests install non-blocking ones; errorReported is emitted either way (for the controllers'
@@ -175,6 +179,7 @@ private:
     ScatterTool* m_scatter = nullptr;
     SpeciesImporter* m_importer = nullptr;
     VolumeTools* m_volumeTools = nullptr;
+    RenderWindow* m_renderWindow = nullptr;
 
     ErrorReporter m_reportError;
     SavePrompt m_askSave;
