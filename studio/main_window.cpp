@@ -399,6 +399,18 @@ void MainWindow::buildActions()
     add(m_viewMenu, tr("Frame &All"), "actionFrameAll", QKeySequence(Qt::Key_Home), [this] { m_viewport->frameAll(); });
     add(m_viewMenu, tr("Frame &Selected"), "actionFrameSelected", QKeySequence(Qt::KeypadModifier | Qt::Key_Period),
         [this] { m_viewport->frameSelected(); });
+    // The render's frame over the viewport (remembered across sessions; on at first).
+    QAction* cameraFrame = m_viewMenu->addAction(tr("&Camera Frame"));
+    cameraFrame->setObjectName("actionCameraFrame");
+    cameraFrame->setCheckable(true);
+    cameraFrame->setToolTip(tr("Show the render's frame in the viewport (its size's proportions; outside it darkened): "
+                               "what lies inside is what Render Image and Export Render show"));
+    connect(cameraFrame, &QAction::toggled, this, [this](bool on) {
+        m_viewport->setCameraFrame(on);
+        QSettings().setValue(QStringLiteral("view/cameraFrame"), on);
+    });
+    cameraFrame->setChecked(QSettings().value(QStringLiteral("view/cameraFrame"), true).toBool());
+    m_viewport->setCameraFrame(cameraFrame->isChecked());
     // F in the viewport toggles it too (a window-wide F shortcut would eat the key in text fields).
     QAction* fly = m_viewMenu->addAction(tr("&Fly Navigation (F in the viewport)"));
     fly->setObjectName("actionFly");

@@ -124,11 +124,11 @@ void Viewport::requestRender()
         m_gpuPass = 0;
         if (!m_gpuFrame || m_gpuFrame->assets != m_assets || !viewFrameFits(m_gpuFrame->frame, m_scene) ||
             viewFrameUpdate(m_gpuFrame->built, m_scene).any())
-            m_worker->request(m_scene, m_assets, renderSize(), m_compare);
+            m_worker->request(viewScene(), m_assets, renderSize(), m_compare);
         update();
         return;
     }
-    m_worker->request(m_scene, m_assets, renderSize(), m_compare, m_relight);
+    m_worker->request(viewScene(), m_assets, renderSize(), m_compare, m_relight);
 }
 
 void Viewport::onImage(const QImage& image, int pass, bool last, double seconds, quint64 serial)
@@ -259,6 +259,7 @@ void Viewport::paintGL()
         m_imageDirty = false;
     }
     drawTexture();
+    drawCameraFrame();
     drawSelection();
     if (m_compare && m_texture && m_texture->width() > 0) {
         // The split the renderer made (column width / 2 of the picture), and which mode is where.
@@ -336,7 +337,7 @@ bool Viewport::paintGpu()
     }
     const size_t pass = m_gpuPass;
     const bool last = pass + 1 == spps.size();
-    placeViewFrame(m_gpuFrame->frame, m_scene, sunRadiance(m_scene.sun), w, h, spps[pass]);
+    placeViewFrame(m_gpuFrame->frame, viewScene(), sunRadiance(m_scene.sun), w, h, spps[pass]);
     m_gpuPlacedAt = m_scene.camera.position;
     const uint32_t skyLights = rs.frame.sky.lightCount;
     if (refine.frames > 0 && !last) rs.frame.sky.lightCount = 0;   // moving: the sun alone
@@ -404,7 +405,14 @@ void Viewport::mouseMoveEvent(QMouseEvent* event)
     switch (m_drag) {
     case Drag::Orbit: c = orbitCamera(m_dragCamera, -0.4 * d.x(), 0.4 * d.y()); break;
     case Drag::Look: c = flyLook(m_dragCamera, 0.3 * d.x(), -0.3 * d.y()); break;
-    default: c = panCamera(m_dragCamera, d.x(), d.y(), height(), m_panDepth); break;
+    default: {
+        // At the viewport's field of view (the grabbed point follows the cursor); the scene's is kept.
+        CameraDesc seen = m_dragCamera;
+        seen.fovY = viewCamera().fovY;
+        c = panCamera(seen, d.x(), d.y(), height(), m_panDepth);
+        c.fovY = m_dragCamera.fovY;
+        break;
+    }
     }
     Q_EMIT cameraEdited(c, m_dragKey);
     event->accept();
@@ -446,12 +454,12 @@ std::optional<ViewPick> Viewport::pickAt(QPointF pos, int waitMs) const
                         pos.y() * double(size.height()) / double(std::max(1, height())));
     if (m_interop && m_gpuFrame) {
         try {
-            return pickViewFrame(m_gpuFrame->frame, m_gpuPlacedAt, m_scene.camera, size.width(), size.height(), pixel.x(), pixel.y());
+            return pickViewFrame(m_gpuFrame->frame, m_gpuPlacedAt, viewCamera(), size.width(), size.height(), pixel.x(), pixel.y());
         } catch (const std::exception&) {
             return std::nullopt;
         }
     }
-    return m_worker->pick(m_scene.camera, size, pixel, waitMs);
+    return m_worker->pick(viewCamera(), size, pixel, waitMs);
 }
 
 void Viewport::setSelectedInstance(int instance)
@@ -477,7 +485,7 @@ QRectF Viewport::selectionRect() const
     for (int k = 0; k < 8; ++k) {
         glm::dvec2 px;
         const glm::dvec3 corner((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
-        if (!projectToView(m_scene.camera, width(), height(), corner, &px)) return {};
+        if (!projectToView(viewCamera(), width(), height(), corner, &px)) return {};
         x0 = std::min(x0, px.x);
         y0 = std::min(y0, px.y);
         x1 = std::max(x1, px.x);
@@ -495,7 +503,7 @@ void Viewport::drawSelection()
     bool front[8];
     for (int k = 0; k < 8; ++k) {
         const glm::dvec3 corner((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
-        front[k] = projectToView(m_scene.camera, width(), height(), corner, &px[k]);
+        front[k] = projectToView(viewCamera(), width(), height(), corner, &px[k]);
     }
     QPainter p(this);
     p.setRenderHint(QPainter::Antialiasing, false);
@@ -511,9 +519,64 @@ void Viewport::drawSelection()
 bool Viewport::frameBox(const Bounds3& box)
 {
     if (!box.valid()) return false;
-    const CameraDesc c = frameBoxCamera(m_scene.camera, box, double(std::max(1, width())) / double(std::max(1, height())));
+    // Into the render's frame when it is shown (what is exported is framed), else the viewport.
+    const double aspect = m_cameraFrame ? double(std::max(1, m_scene.render.width)) / double(std::max(1, m_scene.render.height))
+                                        : double(std::max(1, width())) / double(std::max(1, height()));
+    const CameraDesc c = frameBoxCamera(m_scene.camera, box, aspect);
     Q_EMIT cameraEdited(c, SceneDocument::newMergeKey());
     return true;
+}
+
+void Viewport::setCameraFrame(bool on)
+{
+    if (m_cameraFrame == on) return;
+    m_cameraFrame = on;
+    requestRender();   // the field of view may change
+    update();
+}
+
+CameraDesc Viewport::viewCamera() const
+{
+    CameraDesc c = m_scene.camera;
+    if (!m_cameraFrame || width() <= 0 || height() <= 0 || m_scene.render.width <= 0 || m_scene.render.height <= 0) return c;
+    const double render = double(m_scene.render.width) / double(m_scene.render.height);
+    const double view = double(width()) / double(height());
+    if (render <= view) return c;
+    constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+    const double tanY = std::tan(double(c.fovY) * 0.5 * kDegToRad) * render / view;
+    c.fovY = float(2.0 * std::atan(tanY) / kDegToRad);
+    return c;
+}
+
+Scene Viewport::viewScene() const
+{
+    Scene s = m_scene;
+    s.camera = viewCamera();
+    return s;
+}
+
+QRectF Viewport::cameraFrameRect() const
+{
+    if (!m_cameraFrame || m_scene.render.width <= 0 || m_scene.render.height <= 0 || width() <= 0 || height() <= 0) return {};
+    const double render = double(m_scene.render.width) / double(m_scene.render.height);
+    const double w = width(), h = height();
+    if (render <= w / h) return QRectF(0.5 * (w - h * render), 0.0, h * render, h);   // the full height
+    return QRectF(0.0, 0.5 * (h - w / render), w, w / render);                        // the full width
+}
+
+void Viewport::drawCameraFrame()
+{
+    const QRectF frame = cameraFrameRect();
+    if (frame.isEmpty()) return;
+    QPainter p(this);
+    const QColor shade(0, 0, 0, 120);
+    const QRectF all(rect());
+    p.fillRect(QRectF(all.left(), all.top(), all.width(), frame.top() - all.top()), shade);
+    p.fillRect(QRectF(all.left(), frame.bottom(), all.width(), all.bottom() + 1.0 - frame.bottom()), shade);
+    p.fillRect(QRectF(all.left(), frame.top(), frame.left() - all.left(), frame.height()), shade);
+    p.fillRect(QRectF(frame.right(), frame.top(), all.right() + 1.0 - frame.right(), frame.height()), shade);
+    p.setPen(QPen(QColor(255, 255, 255, 140), 1.0));
+    p.drawRect(frame.adjusted(0.5, 0.5, -0.5, -0.5));
 }
 
 bool Viewport::frameAll() { return frameBox(sceneBounds(m_scene, m_speciesBoxes)); }

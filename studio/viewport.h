@@ -82,6 +82,19 @@ public:
     // The species' mesh boxes (species frame) from the assets the viewport draws (invalid until loaded).
     const std::vector<Bounds3>& speciesBoxes() const { return m_speciesBoxes; }
 
+    // The render camera's frame (View > Camera Frame): the part of the viewport that the render (render.width x
+    // render.height) shows, the rest darkened. On, the viewport's camera is the scene's with its field of view
+    // widened when the render is wider than the viewport (viewCamera), so the whole rendered picture lies
+    // inside the viewport, centred: what is exported is what is framed. Off (the default), the viewport
+    // shows the scene's camera at its own aspect.
+    void setCameraFrame(bool on);
+    bool cameraFrame() const { return m_cameraFrame; }
+    // The render's frame in widget pixels (empty when the camera frame is off).
+    QRectF cameraFrameRect() const;
+    // The camera the viewport traces, picks and projects with: the scene's, its vertical field of view
+    // widened by the render's aspect over the viewport's when the camera frame is on and the render is wider.
+    CameraDesc viewCamera() const;
+
     // View > Frame All / Frame Selected: the scene's box (sceneBounds) or the selected instance's, framed
     // from the current view direction (frameBoxCamera); one camera edit. false (nothing edited) when there is
     // nothing to frame.
@@ -118,6 +131,8 @@ private:
     void disableGpu(const QString& why);
     void drawSelection();
     bool frameBox(const Bounds3& box);
+    void drawCameraFrame();
+    Scene viewScene() const;   // m_scene with viewCamera()
 
     RenderWorker* m_worker;
     Scene m_scene;
@@ -145,6 +160,7 @@ private:
     int m_wheelKey = 0;
     qint64 m_lastWheelMs = 0;
     bool m_fly = false;
+    bool m_cameraFrame = false;
     std::optional<RenderMode> m_compare;
     int m_flyKey = 0;
     qint64 m_lastFlyMs = 0;

@@ -1,6 +1,8 @@
 // The studio as an artist expects it, under Xvfb: the render window (F12) renders the scene at its render
 // size and samples, its passes adding samples, and its picture equals sylva render's (renderScene,
-// composeMode, writeRender as the command runs them); Save writes a file of that size.
+// composeMode, writeRender as the command runs them); Save writes a file of that size. The camera frame
+// in the viewport has the render's proportions, lies inside the viewport, centred, and shows each point
+// where the render shows it (a pinhole projection written here from the camera's parameters).
 #include <QAction>
 #include <QLabel>
 #include <QProgressBar>
@@ -13,11 +15,29 @@
 
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
+#include "studio/camera_nav.h"
 #include "studio/render_window.h"
 #include "studio_test_util.h"
 
 using namespace sylva;
 using namespace sylva::test;
+
+namespace {
+
+// Where world point p lands in a w x h picture of camera c (pixels, y down): a pinhole with the camera's
+// vertical field of view, from the camera's parameters alone.
+QPointF project(const CameraDesc& c, double w, double h, const glm::dvec3& p)
+{
+    const glm::dvec3 f = glm::normalize(c.target - c.position);
+    const glm::dvec3 r = glm::normalize(glm::cross(f, glm::dvec3(c.up)));
+    const glm::dvec3 u = glm::cross(r, f);
+    const glm::dvec3 q = p - c.position;
+    const double z = glm::dot(q, f);
+    const double tanY = std::tan(double(c.fovY) * 3.14159265358979323846 / 360.0), tanX = tanY * w / h;
+    return {(glm::dot(q, r) / (z * tanX) + 1.0) * 0.5 * w, (1.0 - glm::dot(q, u) / (z * tanY)) * 0.5 * h};
+}
+
+} // namespace
 
 class TstStudioArtist : public QObject {
     Q_OBJECT
@@ -134,6 +154,87 @@ private Q_SLOTS:
         doc()->undoStack()->undo();
         QCOMPARE(rw->widthBox()->value(), 72);
         rw->close();
+    }
+
+    void cameraFrame()
+    {
+        Viewport* v = m_win->viewport();
+        QAction* a = action("actionCameraFrame");
+        QVERIFY(a && a->isCheckable());
+        QVERIFY(!a->isChecked());   // the tests' settings turn it off (the studio's default is on)
+        QVERIFY(v->cameraFrameRect().isEmpty());
+        a->setChecked(true);
+        QVERIFY(v->cameraFrame());
+        const double W = v->width(), H = v->height();
+        // Wider than the viewport (letterbox), taller (pillarbox), the viewport's own proportions.
+        for (const QSize render : {QSize(896, 448), QSize(300, 400), QSize(640, 360), QSize(1000, 100)}) {
+            Scene s = scene();
+            s.render.width = render.width();
+            s.render.height = render.height();
+            doc()->edit(s, QStringLiteral("render size"));
+            const QRectF r = v->cameraFrameRect();
+            const QString what = QStringLiteral("%1 x %2: frame %3, %4 %5 x %6")
+                                     .arg(render.width()).arg(render.height())
+                                     .arg(r.x()).arg(r.y()).arg(r.width()).arg(r.height());
+            QVERIFY2(!r.isEmpty(), qPrintable(what));
+            // The render's proportions within a pixel, inside the viewport, centred, as large as fits.
+            QVERIFY2(std::abs(r.width() - r.height() * render.width() / render.height()) <= 1.0, qPrintable(what));
+            QVERIFY2(r.left() >= -1e-9 && r.top() >= -1e-9 && r.right() <= W + 1e-9 && r.bottom() <= H + 1e-9, qPrintable(what));
+            QVERIFY2(std::abs(r.center().x() - 0.5 * W) < 0.5 && std::abs(r.center().y() - 0.5 * H) < 0.5, qPrintable(what));
+            QVERIFY2(std::abs(r.width() - W) < 0.5 || std::abs(r.height() - H) < 0.5, qPrintable(what));
+            // Each point lies in the frame where the render puts it: the viewport's camera (what it traces and
+            // picks with) against the scene's camera at the render's size.
+            for (const InstanceDesc& in : scene().instances)
+                for (const glm::dvec3 off : {glm::dvec3(0.0), glm::dvec3(1.0, 4.0, 0.5), glm::dvec3(-2.0, 1.0, 1.0)}) {
+                    const glm::dvec3 p = in.position + off;
+                    const QPointF inRender = project(scene().camera, render.width(), render.height(), p);
+                    const QPointF expected = r.topLeft() + inRender * (r.width() / render.width());
+                    const QPointF shown = project(v->viewCamera(), W, H, p);
+                    QVERIFY2(std::abs(shown.x() - expected.x()) < 0.5 && std::abs(shown.y() - expected.y()) < 0.5,
+                             qPrintable(what + QStringLiteral(": a point at (%1, %2), expected (%3, %4)")
+                                                   .arg(shown.x()).arg(shown.y()).arg(expected.x()).arg(expected.y())));
+                }
+            QCOMPARE(v->viewCamera().position, scene().camera.position);
+        }
+
+        // The viewport draws the wider view: its settled picture is the scene at viewCamera, outside the frame darker.
+        QSignalSpy finished(m_win->lighting(), &LightingScheduler::lightingFinished);
+        if (m_win->lighting()->computeLighting()) QVERIFY(finished.wait(120000));   // null: the render's assets are in memory
+        Scene s = scene();
+        s.render.width = 896;
+        s.render.height = 300;
+        doc()->edit(s, QStringLiteral("render size"));
+        QVERIFY(waitForFinalImage(v, 60000));
+        const QRectF r = v->cameraFrameRect();
+        QVERIFY(r.top() > 20.0);
+        const QImage fb = v->grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+        const QImage pic = v->lastImage().convertToFormat(QImage::Format_RGB32);
+        const double sx = double(fb.width()) / W, sy = double(fb.height()) / H;
+        int darker = 0, samples = 0;
+        for (int x = 10; x < int(W) - 10; x += 37) {
+            const int y = int(r.top() * 0.5);
+            const QRgb drawn = fb.pixel(int(x * sx), int(y * sy));
+            const QRgb traced = pic.pixel(int(x * pic.width() / W), int(y * pic.height() / H));
+            ++samples;
+            if (qGray(drawn) < qGray(traced) || qGray(traced) == 0) ++darker;
+        }
+        QCOMPARE(darker, samples);
+
+        // Frame All frames into the render's picture: every corner of every instance's box inside it.
+        QVERIFY(v->frameAll());
+        for (const InstanceDesc& in : scene().instances) {
+            const Bounds3 b = instanceBounds(scene(), in, v->speciesBoxes()[in.species]);
+            QVERIFY(b.valid());
+            for (int k = 0; k < 8; ++k) {
+                const glm::dvec3 c((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
+                const QPointF p = project(scene().camera, 896, 300, c);
+                QVERIFY2(p.x() >= 0 && p.x() <= 896 && p.y() >= 0 && p.y() <= 300,
+                         qPrintable(QStringLiteral("corner at (%1, %2)").arg(p.x()).arg(p.y())));
+            }
+        }
+        a->setChecked(false);
+        QVERIFY(v->cameraFrameRect().isEmpty());
+        QCOMPARE(v->viewCamera().fovY, scene().camera.fovY);
     }
 };
 
