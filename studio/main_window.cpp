@@ -156,6 +156,7 @@ MainWindow::MainWindow(QWidget* parent)
     m_export = new ExportController(m_doc, m_jobs, &m_assets, m_cache.get(), m_backend.get(), this, this);
     m_materials = new MaterialsController(m_doc, m_jobs, this, this);
     m_scatter = new ScatterTool(m_doc, [this] { return selectedSpecies(); }, this, this);
+    connect(m_scatter, &ScatterTool::frameRequested, this, [this] { m_viewport->frameAll(); });
     m_importer = new SpeciesImporter(m_doc, m_jobs, this, this);
     m_volumeTools = new VolumeTools(m_doc, m_jobs, this, this);
     for (StudioController* c : std::initializer_list<StudioController*>{m_lighting, m_export, m_materials, m_scatter, m_importer, m_volumeTools})

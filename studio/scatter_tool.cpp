@@ -23,6 +23,8 @@ ScatterSpec ScatterTool::defaultScatter() const
     spec.height = s.ground.height;
     spec.scaleMin = 0.8f;
     spec.scaleMax = 1.2f;
+    spec.clearCentre = {s.camera.position.x, s.camera.position.z};
+    spec.clearRadius = kDefaultClearance;
     if (!s.instances.empty()) {
         glm::dvec2 lo(1e300), hi(-1e300);
         for (const InstanceDesc& in : s.instances) {
@@ -36,7 +38,7 @@ ScatterSpec ScatterTool::defaultScatter() const
     return spec;
 }
 
-bool ScatterTool::scatter(const ScatterSpec& spec)
+bool ScatterTool::scatter(const ScatterSpec& spec, bool frame)
 {
     Scene s = m_doc->scene();
     if (spec.species >= s.species.size()) {
@@ -59,11 +61,18 @@ bool ScatterTool::scatter(const ScatterSpec& spec)
         b.extend({float(spec.max.x), float(spec.height) + 5.0f, float(spec.max.y)});
         s.camera = framingCamera(s.camera, b);
     }
-    m_doc->edit(s, tr("Scatter %n instance(s) of %1", nullptr, spec.count).arg(QString::fromStdString(s.species[spec.species].name)));
+    const int placed = int(added.size());
+    m_doc->edit(s, tr("Scatter %n instance(s) of %1", nullptr, placed).arg(QString::fromStdString(s.species[spec.species].name)));
     log(tr("scattered %1 instances of %2 (seed %3)")
-            .arg(spec.count)
+            .arg(placed)
             .arg(QString::fromStdString(s.species[spec.species].name))
             .arg(spec.seed));
+    if (placed < spec.count)
+        log(tr("%1 of the %2 instances found no place outside the %3 m kept clear around the camera and were left out")
+                .arg(spec.count - placed)
+                .arg(spec.count)
+                .arg(spec.clearRadius));
+    if (frame) Q_EMIT frameRequested();
     return true;
 }
 
@@ -77,7 +86,7 @@ void ScatterTool::scatterDialog()
     QStringList names;
     for (const SpeciesDesc& sp : s.species) names << QString::fromStdString(sp.name);
     ScatterDialog d(names, defaultScatter(), m_window);
-    if (d.exec() == QDialog::Accepted) scatter(d.spec());
+    if (d.exec() == QDialog::Accepted) scatter(d.spec(), d.frameResult());
 }
 
 } // namespace sylva

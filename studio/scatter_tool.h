@@ -23,13 +23,21 @@ public:
 
     // Adds spec.count instances of a species scattered over a rectangle as one undo step (the first
     // instances of a scene also frame the camera on the rectangle); false (and an error) for a bad
-    // spec or species.
-    bool scatter(const ScatterSpec& spec);
+    // spec or species. None lies within spec.clearRadius of spec.clearCentre; those that found no room
+    // outside it are left out and the log says how many. frame: frameRequested afterwards (the window
+    // frames the whole scene, a second undo step).
+    bool scatter(const ScatterSpec& spec, bool frame = false);
+    // The clearance kept around the camera's eye by default, metres.
+    static constexpr double kDefaultClearance = 3.0;
     // The form's starting values: the selected species, 100 instances over the instances' footprint
-    // (20 m around the origin when there are none) on the ground.
+    // (20 m around the origin when there are none) on the ground, kDefaultClearance about the camera's eye.
     ScatterSpec defaultScatter() const;
     // The form (ScatterDialog), then scatter; an error when the scene has no species.
     void scatterDialog();
+
+Q_SIGNALS:
+    // A scatter asked to frame its result (View > Frame All).
+    void frameRequested();
 
 private:
     SceneDocument* m_doc;

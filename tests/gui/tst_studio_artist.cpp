@@ -2,8 +2,11 @@
 // size and samples, its passes adding samples, and its picture equals sylva render's (renderScene,
 // composeMode, writeRender as the command runs them); Save writes a file of that size. The camera frame
 // in the viewport has the render's proportions, lies inside the viewport, centred, and shows each point
-// where the render shows it (a pinhole projection written here from the camera's parameters).
+// where the render shows it (a pinhole projection written here from the camera's parameters). Scatter keeps
+// its clearance around the camera's eye and frames its result.
 #include <QAction>
+#include <QCheckBox>
+#include <QDoubleSpinBox>
 #include <QLabel>
 #include <QProgressBar>
 #include <QPushButton>
@@ -16,6 +19,7 @@
 #include "pipeline/cache/grid_cache.h"
 #include "pipeline/render/render_job.h"
 #include "studio/camera_nav.h"
+#include "studio/dialogs.h"
 #include "studio/render_window.h"
 #include "studio_test_util.h"
 
@@ -235,6 +239,87 @@ private Q_SLOTS:
         a->setChecked(false);
         QVERIFY(v->cameraFrameRect().isEmpty());
         QCOMPARE(v->viewCamera().fovY, scene().camera.fovY);
+    }
+
+    void scatterClearance()
+    {
+        // The camera stands inside the area: 3000 instances over 60 x 60 m around it.
+        Scene s = scene();
+        s.camera.position = {2.0, 1.7, -3.0};
+        s.camera.target = {2.0, 1.7, 10.0};
+        doc()->edit(s, QStringLiteral("camera inside"));
+        const size_t before = scene().instances.size();
+        ScatterSpec spec = m_win->scatterTool()->defaultScatter();
+        QCOMPARE(spec.clearRadius, ScatterTool::kDefaultClearance);
+        QCOMPARE(spec.clearCentre, glm::dvec2(2.0, -3.0));   // the eye, on the ground plane
+        spec.count = 3000;
+        spec.min = {-28.0, -33.0};
+        spec.max = {32.0, 27.0};
+        spec.clearRadius = 4.5;
+        const int steps = doc()->undoStack()->index();
+        const CameraDesc camera = scene().camera;
+        QVERIFY(m_win->scatterTool()->scatter(spec));
+        QCOMPARE(doc()->undoStack()->index(), steps + 1);
+        QCOMPARE(scene().camera.position, camera.position);   // not framed unless asked
+        QCOMPARE(scene().instances.size(), before + 3000);   // the count kept: those drawn near the eye drawn again
+        double nearest = 1e300;
+        for (size_t i = before; i < scene().instances.size(); ++i) {
+            const glm::dvec3 p = scene().instances[i].position;
+            nearest = std::min(nearest, std::hypot(p.x - camera.position.x, p.z - camera.position.z));
+            QVERIFY(p.x >= spec.min.x && p.x <= spec.max.x && p.z >= spec.min.y && p.z <= spec.max.y);
+        }
+        QVERIFY2(nearest >= 4.5, qPrintable(QString::number(nearest)));
+        QVERIFY(nearest < 5.5);   // ... and the trees come close to it: only the disc is kept clear
+        // Without a clearance the same spec puts some inside it (the disc holds about 1.8% of the area).
+        spec.clearRadius = 0.0;
+        int inside = 0;
+        for (const InstanceDesc& in : scatterInstances(spec))
+            inside += std::hypot(in.position.x - camera.position.x, in.position.z - camera.position.z) < 4.5;
+        QVERIFY(inside > 20);
+        doc()->undoStack()->undo();
+        QCOMPARE(scene().instances.size(), before);
+
+        // An area all within the clearance: an error, nothing changed.
+        m_errors.clear();
+        spec.clearRadius = 50.0;
+        spec.min = {-5.0, -8.0};
+        spec.max = {9.0, 2.0};
+        QVERIFY(!m_win->scatterTool()->scatter(spec));
+        QCOMPARE(m_errors.size(), 1);
+        QCOMPARE(doc()->undoStack()->index(), steps);
+        // A thin ring left outside the clearance: some instances find no room, the log says how many.
+        m_win->clearLog();
+        spec.clearRadius = 8.3;
+        spec.min = {-4.0, -9.0};
+        spec.max = {8.0, 3.0};   // a 12 m square about the eye: only its corners' tips lie beyond 8.3 m (0.1% of it)
+        spec.count = 200;
+        QVERIFY(m_win->scatterTool()->scatter(spec));
+        const size_t placed = scene().instances.size() - before;
+        QVERIFY2(placed > 0 && placed < 200, qPrintable(QString::number(placed)));
+        QVERIFY2(m_win->logText().contains(QStringLiteral("%1 of the 200 instances").arg(200 - placed)), qPrintable(m_win->logText()));
+        for (size_t i = before; i < scene().instances.size(); ++i) {
+            const glm::dvec3 p = scene().instances[i].position;
+            QVERIFY(std::hypot(p.x - camera.position.x, p.z - camera.position.z) >= 8.3);
+        }
+        doc()->undoStack()->undo();
+
+        // The dialog: the clearance and "frame the result", and a framed scatter moves the camera out (a second step).
+        ScatterDialog d({QStringLiteral("Tree_1")}, m_win->scatterTool()->defaultScatter());
+        QCOMPARE(d.clearanceBox()->value(), ScatterTool::kDefaultClearance);
+        QVERIFY(d.frameBox()->isChecked());
+        d.clearanceBox()->setValue(6.0);
+        ScatterSpec fromForm = d.spec();
+        QCOMPARE(fromForm.clearRadius, 6.0);
+        QCOMPARE(fromForm.clearCentre, glm::dvec2(2.0, -3.0));
+        fromForm.min = {-28.0, -33.0};
+        fromForm.max = {32.0, 27.0};
+        const int steps2 = doc()->undoStack()->index();
+        QVERIFY(m_win->scatterTool()->scatter(fromForm, d.frameResult()));
+        QCOMPARE(doc()->undoStack()->index(), steps2 + 2);
+        QVERIFY(scene().camera.position != camera.position);
+        doc()->undoStack()->undo();
+        doc()->undoStack()->undo();
+        QCOMPARE(scene().camera.position, camera.position);
     }
 };
 
