@@ -49,6 +49,7 @@
 #include "studio/viewport.h"
 #include "studio/volume_dialogs.h"
 #include "studio/volume_inspector.h"
+#include "studio/words.h"
 
 namespace sylva {
 namespace {
@@ -78,34 +79,35 @@ MainWindow::MainWindow(QWidget* parent)
     cl->setContentsMargins(0, 0, 0, 0);
     cl->setSpacing(0);
     auto* bar = new QToolBar;
-    bar->addWidget(new QLabel(tr(" Mode ")));
+    // Artists' words (studio/words.cpp); the items' data are the scene's values.
+    bar->addWidget(new QLabel(tr(" Light: ")));
     m_modeBox = new QComboBox;
     m_modeBox->setObjectName("renderMode");
-    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
-        m_modeBox->addItem(QString::fromLatin1(renderModeName(m)), int(m));
-    m_modeBox->setToolTip(tr("full = sun + LB indirect; local = sun only; ambient = sun + constant; lb = indirect only"));
+    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb}) {
+        m_modeBox->addItem(renderModeLabel(m), int(m));
+        m_modeBox->setItemData(m_modeBox->count() - 1, renderModeToolTip(m), Qt::ToolTipRole);
+    }
     bar->addWidget(m_modeBox);
-    bar->addWidget(new QLabel(tr(" Light ")));
+    bar->addWidget(new QLabel(tr(" Method: ")));
     m_integratorBox = new QComboBox;
     m_integratorBox->setObjectName("integrator");
-    m_integratorBox->addItem(tr("LB model"), int(Integrator::Lb));
+    m_integratorBox->addItem(tr("Lighting model"), int(Integrator::Lb));
     m_integratorBox->addItem(tr("Path tracer"), int(Integrator::Path));
-    m_integratorBox->setToolTip(tr("LB model: direct light with shadows plus the lighting grids' scattered light (fast); "
-                                   "path tracer: every bounce of light traced, the reference the LB model is measured against "
-                                   "(slower, noisy at first; no volumes yet)"));
     bar->addWidget(m_integratorBox);
     bar->addSeparator();
     m_compareToggle = new QCheckBox(tr("Compare with"));
     m_compareToggle->setObjectName("compareToggle");
-    m_compareToggle->setToolTip(tr("Side by side: the left half in the mode on the left, the right half in this mode, from one trace"));
     bar->addWidget(m_compareToggle);
     m_compareBox = new QComboBox;
     m_compareBox->setObjectName("compareMode");
-    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
-        m_compareBox->addItem(QString::fromLatin1(renderModeName(m)), int(m));
+    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb}) {
+        m_compareBox->addItem(renderModeLabel(m), int(m));
+        m_compareBox->setItemData(m_compareBox->count() - 1, renderModeToolTip(m), Qt::ToolTipRole);
+    }
     m_compareBox->setCurrentIndex(m_compareBox->findData(int(RenderMode::Lb)));
     m_compareBox->setEnabled(false);
     bar->addWidget(m_compareBox);
+    applyToolTips(bar);
     cl->addWidget(bar);
     m_viewport = new Viewport;
     cl->addWidget(m_viewport, 1);
@@ -113,12 +115,12 @@ MainWindow::MainWindow(QWidget* parent)
     connect(m_modeBox, &QComboBox::activated, this, [this](int index) {
         Scene s = m_doc->scene();
         s.render.mode = RenderMode(m_modeBox->itemData(index).toInt());
-        m_doc->edit(s, tr("Render mode %1").arg(m_modeBox->itemText(index)));
+        m_doc->edit(s, tr("Light: %1").arg(m_modeBox->itemText(index)));
     });
     connect(m_integratorBox, &QComboBox::activated, this, [this](int index) {
         Scene s = m_doc->scene();
         s.render.integrator = Integrator(m_integratorBox->itemData(index).toInt());
-        m_doc->edit(s, tr("Light by %1").arg(m_integratorBox->itemText(index)));
+        m_doc->edit(s, tr("Method: %1").arg(m_integratorBox->itemText(index)));
     });
     connect(m_compareToggle, &QCheckBox::toggled, this, [this] { updateCompare(); });
     connect(m_compareBox, &QComboBox::currentIndexChanged, this, [this] { updateCompare(); });

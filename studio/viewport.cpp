@@ -18,6 +18,7 @@
 #include "studio/camera_nav.h"
 #include "studio/render_worker.h"
 #include "studio/scene_document.h"
+#include "studio/words.h"
 
 namespace sylva {
 namespace {
@@ -268,8 +269,8 @@ void Viewport::paintGL()
         const int x = int(double(width()) * double(iw / 2) / double(iw));
         p.setPen(QColor(255, 255, 255, 200));
         p.drawLine(x, 0, x, height());
-        p.drawText(QRect(8, 8, x - 16, 20), Qt::AlignLeft | Qt::AlignTop, QString::fromLatin1(renderModeName(m_scene.render.mode)));
-        p.drawText(QRect(x + 8, 8, width() - x - 16, 20), Qt::AlignLeft | Qt::AlignTop, QString::fromLatin1(renderModeName(*m_compare)));
+        p.drawText(QRect(8, 8, x - 16, 20), Qt::AlignLeft | Qt::AlignTop, renderModeLabel(m_scene.render.mode));
+        p.drawText(QRect(x + 8, 8, width() - x - 16, 20), Qt::AlignLeft | Qt::AlignTop, renderModeLabel(*m_compare));
     }
     if (!m_status.isEmpty()) {
         QPainter p(this);

@@ -3,8 +3,15 @@
 // composeMode, writeRender as the command runs them); Save writes a file of that size. The camera frame
 // in the viewport has the render's proportions, lies inside the viewport, centred, and shows each point
 // where the render shows it (a pinhole projection written here from the camera's parameters). Scatter keeps
-// its clearance around the camera's eye and frames its result.
+// its clearance around the camera's eye and frames its result. Every control of the toolbar and the panels
+// has a tooltip in words (no scene-file keys); the sun dial's compass points lie where they set the sun.
 #include <QAction>
+#include <QAbstractSlider>
+#include <QComboBox>
+#include <QLineEdit>
+#include <QRegularExpression>
+#include <QScrollBar>
+#include <QToolBar>
 #include <QCheckBox>
 #include <QDoubleSpinBox>
 #include <QLabel>
@@ -20,6 +27,9 @@
 #include "pipeline/render/render_job.h"
 #include "studio/camera_nav.h"
 #include "studio/dialogs.h"
+#include "studio/property_panel.h"
+#include "studio/sky_panel.h"
+#include "studio/words.h"
 #include "studio/render_window.h"
 #include "studio_test_util.h"
 
@@ -239,6 +249,77 @@ private Q_SLOTS:
         a->setChecked(false);
         QVERIFY(v->cameraFrameRect().isEmpty());
         QCOMPARE(v->viewCamera().fovY, scene().camera.fovY);
+    }
+
+    void words()
+    {
+        // The toolbar's light modes in artists' words, the scene's values underneath.
+        QComboBox* mode = m_win->modeSelector();
+        QStringList labels;
+        for (int i = 0; i < mode->count(); ++i) labels << mode->itemText(i);
+        QCOMPARE(labels, (QStringList{"All", "Direct only", "Flat ambient", "Bounce only"}));
+        QCOMPARE(mode->itemData(0).toInt(), int(RenderMode::Full));
+        QCOMPARE(mode->itemData(1).toInt(), int(RenderMode::Local));
+        QCOMPARE(mode->itemData(2).toInt(), int(RenderMode::Ambient));
+        QCOMPARE(mode->itemData(3).toInt(), int(RenderMode::Lb));
+        for (int i = 0; i < mode->count(); ++i) QVERIFY(!mode->itemData(i, Qt::ToolTipRole).toString().isEmpty());
+
+        // Every control of the toolbar, the properties (all pages) and the sky panel: a tooltip, without the
+        // scene file's keys (sun_sky, lighting.boundary) or code quotes.
+        const QRegularExpression key(QStringLiteral("`|\\b[a-z]+_[a-z_]+\\b|\\b[a-z]+\\.[a-z][a-z_.]*\\b"));
+        QStringList missing, keyed;
+        int controls = 0;
+        for (QWidget* root : {static_cast<QWidget*>(mode->parentWidget()), static_cast<QWidget*>(m_win->propertyPanel()),
+                              static_cast<QWidget*>(m_win->skyPanel())}) {
+            for (QWidget* w : root->findChildren<QWidget*>()) {
+                const bool control = qobject_cast<QComboBox*>(w) || qobject_cast<QAbstractSpinBox*>(w) ||
+                                     qobject_cast<QAbstractButton*>(w) || qobject_cast<QLineEdit*>(w) ||
+                                     (qobject_cast<QAbstractSlider*>(w) && !qobject_cast<QScrollBar*>(w));
+                if (!control || w->objectName().startsWith(QLatin1String("qt_"))) continue;
+                if (qobject_cast<QLineEdit*>(w) && qobject_cast<QAbstractSpinBox*>(w->parentWidget())) continue;   // a spin box's own
+                if (qobject_cast<QLineEdit*>(w) && qobject_cast<QComboBox*>(w->parentWidget())) continue;
+                ++controls;
+                const QString tip = w->toolTip();
+                if (tip.trimmed().isEmpty()) missing << w->objectName() + QStringLiteral(" (") + w->metaObject()->className() + ')';
+                else if (key.match(tip).hasMatch()) keyed << w->objectName() + QStringLiteral(": ") + tip;
+            }
+        }
+        QVERIFY(controls > 40);
+        QVERIFY2(missing.isEmpty(), qPrintable(missing.join(", ")));
+        QVERIFY2(keyed.isEmpty(), qPrintable(keyed.join("\n")));
+
+        // The two one-colour skies read differently and say which lights the plants.
+        auto* kind = m_win->skyPanel()->findChild<QComboBox*>(QStringLiteral("sky.kind"));
+        QVERIFY(kind);
+        const int constant = kind->findData(int(sky::SkyKind::Constant)), uniform = kind->findData(int(sky::SkyKind::Uniform));
+        QVERIFY(constant >= 0 && uniform >= 0);
+        QCOMPARE(kind->itemText(constant), QStringLiteral("Colour backdrop (lights nothing)"));
+        QCOMPARE(kind->itemText(uniform), QStringLiteral("Even sky light (lights the plants)"));
+        QVERIFY(kind->itemData(constant, Qt::ToolTipRole).toString().contains(QStringLiteral("lights nothing")));
+        QVERIFY(kind->itemData(uniform, Qt::ToolTipRole).toString().contains(QStringLiteral("lights the plants")));
+        QVERIFY(kind->itemData(constant, Qt::ToolTipRole) != kind->itemData(uniform, Qt::ToolTipRole));
+
+        // The compass dial: a click on a point's letter turns the sun there (east +X, north -Z, the scene's axes).
+        SceneDocument doc;
+        Scene s = scene();
+        s.sun.direction = glm::normalize(glm::vec3(0.0f, 1.0f, 1.0f));
+        doc.reset(s, QString());
+        SkyPanel panel(&doc);
+        panel.show();
+        QVERIFY(QTest::qWaitForWindowExposed(&panel));
+        auto* dial = dynamic_cast<CompassDial*>(panel.sunAzimuthDial());
+        QVERIFY(dial);
+        const struct {
+            double azimuth;
+            glm::vec3 toward;
+        } points[] = {{90.0, {1.0f, 0.0f, 0.0f}}, {180.0, {0.0f, 0.0f, -1.0f}}, {270.0, {-1.0f, 0.0f, 0.0f}}, {0.0, {0.0f, 0.0f, 1.0f}}};
+        for (const auto& pt : points) {
+            QTest::mouseClick(dial, Qt::LeftButton, Qt::NoModifier, dial->labelCentre(pt.azimuth).toPoint());
+            const glm::vec3 d = doc.scene().sun.direction;
+            const glm::vec3 flat = glm::normalize(glm::vec3(d.x, 0.0f, d.z));
+            QVERIFY2(glm::dot(flat, pt.toward) > 0.95,
+                     qPrintable(QStringLiteral("azimuth %1: dial %2, sun (%3, %4, %5)").arg(pt.azimuth).arg(dial->value()).arg(d.x).arg(d.y).arg(d.z)));
+        }
     }
 
     void scatterClearance()
