@@ -34,6 +34,7 @@
 #include "studio/autosave_controller.h"
 #include "studio/background_priority.h"
 #include "studio/export_controller.h"
+#include "studio/help_dialogs.h"
 #include "studio/inspector_controller.h"
 #include "studio/job_manager.h"
 #include "studio/job_panel.h"
@@ -428,6 +429,9 @@ void MainWindow::buildActions()
     });
 
     QMenu* help = menuBar()->addMenu(tr("&Help"));
+    add(help, tr("&Manual"), "actionManual", QKeySequence(Qt::Key_F1), [this] { showManual(); });
+    add(help, tr("&Keyboard Shortcuts"), "actionShortcuts", QKeySequence(), [this] { showShortcuts(); });
+    help->addSeparator();
     add(help, tr("&About Sylva Studio"), "actionAbout", QKeySequence(), [this] {
         QMessageBox::about(this, tr("About Sylva Studio"),
                            tr("<b>Sylva Studio</b> %1<br>Forests lit with the lattice-Boltzmann lighting model.")
@@ -443,6 +447,22 @@ RenderWindow* MainWindow::renderImage()
     m_renderWindow->activateWindow();
     m_renderWindow->render();
     return m_renderWindow;
+}
+
+ManualDialog* MainWindow::showManual()
+{
+    if (!m_manual) m_manual = new ManualDialog(this);
+    m_manual->show();
+    m_manual->raise();
+    return m_manual;
+}
+
+ShortcutSheet* MainWindow::showShortcuts()
+{
+    delete m_shortcuts;   // made again: the actions' shortcuts as they are now
+    m_shortcuts = new ShortcutSheet(this, this);
+    m_shortcuts->show();
+    return m_shortcuts;
 }
 
 QString MainWindow::logText() const { return m_log->toPlainText(); }

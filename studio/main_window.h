@@ -39,6 +39,8 @@ class PropertyPanel;
 class SkyPanel;
 class RecentFiles;
 class RenderWindow;
+class ManualDialog;
+class ShortcutSheet;
 class ScatterTool;
 class SpeciesImporter;
 class StudioController;
@@ -91,6 +93,9 @@ public:
     // Render > Render Image (F12): shows the render window and starts its render; the window (made on first use).
     RenderWindow* renderImage();
     RenderWindow* renderWindow() const { return m_renderWindow; }
+    // Help > Manual (F1) and Help > Keyboard Shortcuts: shown (not modal), made on first use.
+    ManualDialog* showManual();
+    ShortcutSheet* showShortcuts();
 
     // How errors and the unsaved-changes question reach the user. Defaults: modal message boxes.
     // Tests install non-blocking ones; errorReported is emitted either way (for the controllers'
@@ -180,6 +185,8 @@ private:
     SpeciesImporter* m_importer = nullptr;
     VolumeTools* m_volumeTools = nullptr;
     RenderWindow* m_renderWindow = nullptr;
+    ManualDialog* m_manual = nullptr;
+    ShortcutSheet* m_shortcuts = nullptr;
 
     ErrorReporter m_reportError;
     SavePrompt m_askSave;

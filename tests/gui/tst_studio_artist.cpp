@@ -5,7 +5,15 @@
 // where the render shows it (a pinhole projection written here from the camera's parameters). Scatter keeps
 // its clearance around the camera's eye and frames its result. Every control of the toolbar and the panels
 // has a tooltip in words (no scene-file keys); the sun dial's compass points lie where they set the sun.
+// Help > Manual shows the user documents (headings read from the files themselves); Help > Keyboard
+// Shortcuts lists every action of the window that has a shortcut.
 #include <QAction>
+#include <QFile>
+#include <QListWidget>
+#include <QTableWidget>
+#include <QTextBlock>
+#include <QTextBrowser>
+#include <QTextDocument>
 #include <QAbstractSlider>
 #include <QComboBox>
 #include <QLineEdit>
@@ -27,6 +35,7 @@
 #include "pipeline/render/render_job.h"
 #include "studio/camera_nav.h"
 #include "studio/dialogs.h"
+#include "studio/help_dialogs.h"
 #include "studio/property_panel.h"
 #include "studio/sky_panel.h"
 #include "studio/words.h"
@@ -320,6 +329,95 @@ private Q_SLOTS:
             QVERIFY2(glm::dot(flat, pt.toward) > 0.95,
                      qPrintable(QStringLiteral("azimuth %1: dial %2, sun (%3, %4, %5)").arg(pt.azimuth).arg(dial->value()).arg(d.x).arg(d.y).arg(d.z)));
         }
+    }
+
+    void manual()
+    {
+        // The documents' headings, read from the files here: level 1 (the title) and the level-2 headings.
+        auto headings = [](const QString& file, int level) {
+            QFile f(file);
+            if (!f.open(QIODevice::ReadOnly | QIODevice::Text)) return QStringList{};
+            const QString prefix = QString(level, QLatin1Char('#')) + QLatin1Char(' ');
+            QStringList out;
+            bool fenced = false;
+            for (const QString& line : QString::fromUtf8(f.readAll()).split(QLatin1Char('\n'))) {
+                if (line.startsWith(QLatin1String("```"))) fenced = !fenced;
+                if (!fenced && line.startsWith(prefix)) out << line.mid(prefix.size()).remove(QLatin1Char('`')).trimmed();
+            }
+            return out;
+        };
+        // The browser's headings of a level, as shown.
+        auto shown = [](QTextBrowser* b, int level) {
+            QStringList out;
+            for (QTextBlock block = b->document()->begin(); block.isValid(); block = block.next())
+                if (block.blockFormat().headingLevel() == level) out << block.text().trimmed();
+            return out;
+        };
+        const QString docs = QStringLiteral(SYLVA_RESOURCES "/../docs");
+        const QStringList studioTitle = headings(docs + QStringLiteral("/STUDIO.md"), 1);
+        const QStringList studioSections = headings(docs + QStringLiteral("/STUDIO.md"), 2);
+        QCOMPARE(studioTitle.size(), 1);
+        QVERIFY(studioSections.contains(QStringLiteral("Menus and shortcuts")));
+
+        QAction* a = action("actionManual");
+        QVERIFY(a);
+        QCOMPARE(a->shortcut(), QKeySequence(Qt::Key_F1));
+        a->trigger();
+        auto* manual = m_win->findChild<ManualDialog*>();
+        QVERIFY(manual);
+        QVERIFY(manual->isVisible());
+        QVERIFY(!ManualDialog::docsRoot().isEmpty());
+        QCOMPARE(manual->list()->count(), 3);
+        // The studio's document first, rendered from Markdown: its title and every section heading as headings.
+        QCOMPARE(shown(manual->browser(), 1), studioTitle);
+        QCOMPARE(shown(manual->browser(), 2), studioSections);
+        QVERIFY(manual->browser()->toPlainText().contains(QStringLiteral("Render window")));
+        // The scene file's document from the list.
+        manual->list()->setCurrentRow(1);
+        QCOMPARE(shown(manual->browser(), 1), headings(docs + QStringLiteral("/SCENE.md"), 1));
+        QVERIFY(!manual->showDocument(QStringLiteral("docs/NO_SUCH.md")));
+        manual->close();
+    }
+
+    void shortcutSheet()
+    {
+        QAction* a = action("actionShortcuts");
+        QVERIFY(a);
+        a->trigger();
+        auto* sheet = m_win->findChild<ShortcutSheet*>();
+        QVERIFY(sheet && sheet->isVisible());
+        QTableWidget* t = sheet->table();
+        // Every action of the window with a shortcut has its row: its name (the end of the menu path) and its keys.
+        QSet<QAction*> withKeys;
+        for (QAction* act : m_win->findChildren<QAction*>())
+            if (!act->shortcuts().isEmpty()) withKeys.insert(act);
+        QVERIFY(withKeys.size() >= 15);
+        QCOMPARE(t->rowCount(), int(withKeys.size()));
+        for (QAction* act : withKeys) {
+            QString name = act->text();
+            name.remove(QLatin1Char('&'));
+            const QString keys = act->shortcut().toString(QKeySequence::NativeText);
+            bool found = false;
+            for (int r = 0; r < t->rowCount() && !found; ++r)
+                found = t->item(r, 0)->text().endsWith(name) && t->item(r, 1)->text().split(QStringLiteral(", ")).contains(keys);
+            QVERIFY2(found, qPrintable(name + QStringLiteral(" ") + keys));
+        }
+        // Rows named by their menus.
+        QStringList names;
+        for (int r = 0; r < t->rowCount(); ++r) names << t->item(r, 0)->text() + QStringLiteral(" = ") + t->item(r, 1)->text();
+        QVERIFY2(names.contains(QStringLiteral("Render > Render Image = F12")), qPrintable(names.join('\n')));
+        QVERIFY2(names.contains(QStringLiteral("Help > Manual = F1")), qPrintable(names.join('\n')));
+        QVERIFY2(names.contains(QStringLiteral("View > Frame All = Home")), qPrintable(names.join('\n')));
+        QVERIFY2(names.contains(QStringLiteral("File > Open... = ") + QKeySequence(QKeySequence::Open).toString(QKeySequence::NativeText)),
+                 qPrintable(names.join('\n')));
+        // A shortcut added to an action shows in the next sheet: the sheet is made from the actions.
+        QAction* materials = action("actionMaterials");
+        QVERIFY(materials && materials->shortcut().isEmpty());
+        materials->setShortcut(QKeySequence(Qt::CTRL | Qt::ALT | Qt::Key_M));
+        ShortcutSheet* again = m_win->showShortcuts();
+        QCOMPARE(again->table()->rowCount(), int(withKeys.size()) + 1);
+        materials->setShortcut(QKeySequence());
+        again->close();
     }
 
     void scatterClearance()
