@@ -33,7 +33,6 @@ QSpinBox* intSpin(const QString& name, int lo, int hi)
     return s;
 }
 
-const char* kTracers[3] = {"lb", "single", "combined"};
 
 } // namespace
 
@@ -196,7 +195,10 @@ QWidget* SceneItemPages::buildVolumePage()
     });
     m_volumeTracer = new QComboBox;
     m_volumeTracer->setObjectName("volume.tracer");
-    for (const char* t : kTracers) m_volumeTracer->addItem(QString::fromLatin1(t));
+    // In the order of VolumeTracer (lb, single, combined): the index is the value.
+    m_volumeTracer->addItem(tr("Scattered light (lighting grid)"));
+    m_volumeTracer->addItem(tr("Sun shadow only"));
+    m_volumeTracer->addItem(tr("Both"));
     connect(m_volumeTracer, &QComboBox::currentIndexChanged, this, [this](int idx) {
         const int i = m_item.row;
         if (i < 0 || idx < 0) return;
@@ -233,8 +235,8 @@ QWidget* SceneItemPages::buildVolumePage()
         });
     });
     form->addRow(m_volumeInfo);
-    form->addRow(tr("Optics"), m_volumePreset);
-    form->addRow(tr("Tracer"), m_volumeTracer);
+    form->addRow(tr("Material"), m_volumePreset);
+    form->addRow(tr("Lit by"), m_volumeTracer);
     form->addRow(tr("Density scale"), m_volumeDensityScale);
     form->addRow(tr("Position (m)"), posRow);
     form->addRow(tr("Scale"), m_volumeScale);
