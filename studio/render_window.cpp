@@ -54,7 +54,8 @@ RenderWindow::RenderWindow(SceneDocument* doc, ExportController* exporter, QWidg
     m_cancelButton->setToolTip(tr("Stop the render; the picture keeps the samples it has"));
     m_saveButton = new QPushButton(tr("Save..."));
     m_saveButton->setObjectName("renderSave");
-    m_saveButton->setToolTip(tr("Save the finished picture: PNG or TIFF (8-bit, as shown) or EXR (linear, half float)"));
+    m_saveButton->setToolTip(tr("Save the picture as shown (a cancelled render with the samples it has): PNG or TIFF "
+                                "(8-bit) or EXR (linear, half float)"));
     top->addWidget(m_renderButton);
     top->addWidget(m_cancelButton);
     top->addWidget(m_saveButton);
@@ -143,9 +144,7 @@ Job* RenderWindow::render()
     Job* job = m_exporter->renderImage(scene, [this, scene](const Film& film, int samples) {
         // On the job's thread: the picture as the export writes it (composeMode, the tone map), then to the window.
         const QImage image = filmImage(film, scene.render.mode, composeSky(scene), scene.render.exposureKey);
-        Film kept = samples >= scene.render.spp ? film : Film{};
-        QMetaObject::invokeMethod(
-            this, [this, image, kept = std::move(kept), samples]() { showPass(image, kept, samples); }, Qt::QueuedConnection);
+        QMetaObject::invokeMethod(this, [this, image, film, samples]() { showPass(image, film, samples); }, Qt::QueuedConnection);
     });
     m_job = job;
     if (!job) {
@@ -183,7 +182,7 @@ void RenderWindow::showPass(const QImage& image, const Film& film, int samples)
 bool RenderWindow::saveImage(const QString& path)
 {
     if (m_film.width <= 0) {
-        m_message->setText(tr("Nothing to save yet: render first (a render is saved once all its samples are in)."));
+        m_message->setText(tr("Nothing to save yet: render first."));
         return false;
     }
     try {

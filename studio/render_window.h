@@ -38,8 +38,9 @@ public:
     QImage image() const { return m_image; }
     int samples() const { return m_samples; }
     int targetSamples() const { return m_target; }
-    // Writes the shown render with the export's writer (PNG/TIFF tone-mapped, EXR linear, by the
-    // extension); false (and an error under the picture) when there is none or it cannot be written.
+    // Writes the shown render (a cancelled one with the samples it has) with the export's writer (PNG/TIFF
+    // tone-mapped, EXR linear, by the extension); false (and an error under the picture) when there is
+    // none or it cannot be written.
     bool saveImage(const QString& path);
     // Save...: a file chooser, then saveImage.
     void saveDialog();
@@ -65,7 +66,7 @@ private:
     ExportController* m_exporter;
     QPointer<Job> m_job;
     Scene m_scene;    // what the render shows
-    Film m_film;      // its film so far (what Save writes)
+    Film m_film;      // its film so far, the samples shown (what Save writes)
     QImage m_image;
     int m_samples = 0, m_target = 0;
 

@@ -176,6 +176,23 @@ private Q_SLOTS:
         QTRY_COMPARE(rw->image().size(), QSize(40, 30));
         doc()->undoStack()->undo();
         QCOMPARE(rw->widthBox()->value(), 72);
+
+        // Cancel after the first pass: the picture keeps its samples, and Save writes it.
+        rw->samplesBox()->setValue(4096);
+        QSignalSpy firstPass(rw, &RenderWindow::passShown);
+        QSignalSpy ended3(rw, &RenderWindow::renderEnded);
+        QVERIFY(rw->render());
+        QVERIFY(firstPass.wait(60000));
+        rw->cancel();
+        QVERIFY(ended3.wait(60000));
+        QVERIFY(!ended3.at(0).at(0).toBool());
+        QVERIFY(!rw->isRendering());
+        QVERIFY(rw->samples() >= 1 && rw->samples() < 4096);
+        QCOMPARE(rw->sampleCounter()->text(), QStringLiteral("Samples %1 / 4096").arg(rw->samples()));
+        const QString partial = m_dir.filePath("partial.png");
+        QVERIFY(rw->saveImage(partial));
+        QCOMPARE(QImage(partial).convertToFormat(QImage::Format_RGB32), rw->image().convertToFormat(QImage::Format_RGB32));
+        doc()->undoStack()->undo();
         rw->close();
     }
 
