@@ -160,6 +160,10 @@ MainWindow::MainWindow(QWidget* parent)
     m_materials = new MaterialsController(m_doc, m_jobs, this, this);
     m_scatter = new ScatterTool(m_doc, [this] { return selectedSpecies(); }, this, this);
     connect(m_scatter, &ScatterTool::frameRequested, this, [this] { m_viewport->frameAll(); });
+    m_scatter->setSpeciesBox([this](int species) {
+        const std::vector<Bounds3>& boxes = m_viewport->speciesBoxes();
+        return species >= 0 && size_t(species) < boxes.size() ? boxes[size_t(species)] : Bounds3{};
+    });
     m_importer = new SpeciesImporter(m_doc, m_jobs, this, this);
     m_volumeTools = new VolumeTools(m_doc, m_jobs, this, this);
     for (StudioController* c : std::initializer_list<StudioController*>{m_lighting, m_export, m_materials, m_scatter, m_importer, m_volumeTools})

@@ -2,6 +2,7 @@
 #include "studio/scatter_tool.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "studio/camera_nav.h"
 #include "studio/dialogs.h"
@@ -24,7 +25,8 @@ ScatterSpec ScatterTool::defaultScatter() const
     spec.scaleMin = 0.8f;
     spec.scaleMax = 1.2f;
     spec.clearCentre = {s.camera.position.x, s.camera.position.z};
-    spec.clearRadius = kDefaultClearance;
+    const Bounds3 box = m_speciesBox && spec.species < s.species.size() ? m_speciesBox(int(spec.species)) : Bounds3{};
+    spec.clearRadius = std::max(kDefaultClearance, crownReach(box) * double(spec.scaleMax));
     if (!s.instances.empty()) {
         glm::dvec2 lo(1e300), hi(-1e300);
         for (const InstanceDesc& in : s.instances) {
@@ -36,6 +38,14 @@ ScatterSpec ScatterTool::defaultScatter() const
         spec.max = hi + pad;
     }
     return spec;
+}
+
+double ScatterTool::crownReach(const Bounds3& b)
+{
+    if (!b.valid()) return 0.0;
+    const double x = std::max(std::abs(double(b.lo.x)), std::abs(double(b.hi.x)));
+    const double z = std::max(std::abs(double(b.lo.z)), std::abs(double(b.hi.z)));
+    return std::sqrt(x * x + z * z);
 }
 
 bool ScatterTool::scatter(const ScatterSpec& spec, bool frame)

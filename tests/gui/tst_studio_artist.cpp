@@ -446,7 +446,24 @@ private Q_SLOTS:
         doc()->edit(s, QStringLiteral("camera inside"));
         const size_t before = scene().instances.size();
         ScatterSpec spec = m_win->scatterTool()->defaultScatter();
-        QCOMPARE(spec.clearRadius, ScatterTool::kDefaultClearance);
+        // The default clearance: 3 m, or Tree_1's crown reach at the largest scale when that is more (its
+        // mesh's box from the loaded assets, the farthest corner from the trunk along the ground).
+        const std::vector<AssetsPtr> assets = m_win->assetStore()->forScene(scene(), true);
+        QCOMPARE(assets.size(), size_t(1));
+        double reach = 0.0;
+        for (const glm::vec3& p : assets[0]->mesh.positions) reach = std::max(reach, std::hypot(double(p.x), double(p.z)));
+        double boxReach = 0.0;   // the box's corner: at least as far as any vertex
+        {
+            glm::dvec2 lo(1e30), hi(-1e30);
+            for (const glm::vec3& p : assets[0]->mesh.positions) {
+                lo = glm::min(lo, glm::dvec2(p.x, p.z));
+                hi = glm::max(hi, glm::dvec2(p.x, p.z));
+            }
+            boxReach = std::hypot(std::max(std::abs(lo.x), std::abs(hi.x)), std::max(std::abs(lo.y), std::abs(hi.y)));
+        }
+        QVERIFY(boxReach >= reach);
+        QVERIFY2(std::abs(spec.clearRadius - std::max(ScatterTool::kDefaultClearance, boxReach * double(spec.scaleMax))) < 1e-4,
+                 qPrintable(QStringLiteral("%1 against %2").arg(spec.clearRadius).arg(boxReach)));
         QCOMPARE(spec.clearCentre, glm::dvec2(2.0, -3.0));   // the eye, on the ground plane
         spec.count = 3000;
         spec.min = {-28.0, -33.0};
@@ -501,7 +518,7 @@ private Q_SLOTS:
 
         // The dialog: the clearance and "frame the result", and a framed scatter moves the camera out (a second step).
         ScatterDialog d({QStringLiteral("Tree_1")}, m_win->scatterTool()->defaultScatter());
-        QCOMPARE(d.clearanceBox()->value(), ScatterTool::kDefaultClearance);
+        QCOMPARE(d.clearanceBox()->value(), std::round(m_win->scatterTool()->defaultScatter().clearRadius * 10.0) / 10.0);
         QVERIFY(d.frameBox()->isChecked());
         d.clearanceBox()->setValue(6.0);
         ScatterSpec fromForm = d.spec();
