@@ -1,6 +1,8 @@
 // RenderWindow: the render job of the export controller, its passes shown, Save through writeRenderFilm.
 #include "studio/render_window.h"
 
+#include <array>
+
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QFormLayout>
@@ -109,7 +111,12 @@ RenderWindow::~RenderWindow()
 
 void RenderWindow::syncFromScene()
 {
+    // Only when the scene's size or samples changed (an undo, another file): other edits (a camera move)
+    // leave what was typed in the boxes and not rendered yet.
     const RenderSettings& r = m_doc->scene().render;
+    const std::array<int, 3> now{r.width, r.height, r.spp};
+    if (now == m_synced) return;
+    m_synced = now;
     for (auto [box, value] : {std::pair{m_width, r.width}, std::pair{m_height, r.height}, std::pair{m_spp, r.spp}}) {
         const QSignalBlocker block(box);
         box->setValue(value);

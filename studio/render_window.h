@@ -3,6 +3,8 @@
 // samples, with a progress bar, a sample counter and Save (the export's writer, writeRenderFilm).
 #pragma once
 
+#include <array>
+
 #include <QImage>
 #include <QPointer>
 #include <QWidget>
@@ -69,6 +71,7 @@ private:
     Film m_film;      // its film so far, the samples shown (what Save writes)
     QImage m_image;
     int m_samples = 0, m_target = 0;
+    std::array<int, 3> m_synced{0, 0, 0};   // the scene's width, height and spp the boxes last showed
 
     QSpinBox* m_width;
     QSpinBox* m_height;

@@ -177,6 +177,15 @@ private Q_SLOTS:
         doc()->undoStack()->undo();
         QCOMPARE(rw->widthBox()->value(), 72);
 
+        // A value typed in a box stays through other edits (a camera move) until it is rendered.
+        rw->widthBox()->setValue(64);
+        Scene moved = scene();
+        moved.camera.position.x += 0.5;
+        doc()->edit(moved, QStringLiteral("camera"));
+        QCOMPARE(rw->widthBox()->value(), 64);
+        doc()->undoStack()->undo();
+        rw->widthBox()->setValue(72);
+
         // Cancel after the first pass: the picture keeps its samples, and Save writes it.
         rw->samplesBox()->setValue(4096);
         QSignalSpy firstPass(rw, &RenderWindow::passShown);
