@@ -25,6 +25,9 @@ install(TARGETS sylva_oiio LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/sylva)
 install(FILES ${CMAKE_SOURCE_DIR}/resources/default_forest.sylva.json ${CMAKE_SOURCE_DIR}/resources/README.md
   DESTINATION ${CMAKE_INSTALL_DATADIR}/sylva)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/resources/color DESTINATION ${CMAKE_INSTALL_DATADIR}/sylva)
+# The user documents, which the studio's Help > Manual shows (from ../share/doc/sylva beside the program).
+install(FILES ${CMAKE_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/sylva)
+install(DIRECTORY ${CMAKE_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/sylva/docs FILES_MATCHING PATTERN "*.md")
 install(FILES ${CMAKE_SOURCE_DIR}/resources/desktop/sylva-studio.desktop DESTINATION ${CMAKE_INSTALL_DATADIR}/applications)
 install(FILES ${CMAKE_SOURCE_DIR}/resources/desktop/sylva-studio.svg DESTINATION ${CMAKE_INSTALL_DATADIR}/icons/hicolor/scalable/apps)
 install(FILES ${CMAKE_SOURCE_DIR}/resources/desktop/sylva-scene.xml DESTINATION ${CMAKE_INSTALL_DATADIR}/mime/packages)

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/render/render_scene.h"
 #include "core/terrain/height_field.h"
 
 namespace sylva {
@@ -15,6 +16,7 @@ constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
 // from +Z toward +X and pitch above the horizon, pitch clamped to +-89 degrees. v must not be zero.
 glm::dvec3 turned(const glm::dvec3& v, double yawDeg, double pitchDeg)
 {
+    if (yawDeg == 0.0 && pitchDeg == 0.0) return v;   // exactly unchanged (no rounding of the angles' round trip)
     const double dist = glm::length(v);
     const double yaw = std::atan2(v.x, v.z) + yawDeg * kDegToRad;
     const double pitch = std::clamp(std::asin(std::clamp(v.y / dist, -1.0, 1.0)) + pitchDeg * kDegToRad, -89.0 * kDegToRad, 89.0 * kDegToRad);
@@ -32,13 +34,13 @@ CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg)
     return c;
 }
 
-CameraDesc panCamera(const CameraDesc& camera, double dx, double dy, double viewHeight)
+CameraDesc panCamera(const CameraDesc& camera, double dx, double dy, double viewHeight, double depth)
 {
     CameraDesc c = camera;
     const glm::dvec3 fwd = c.target - c.position;
-    const double dist = glm::length(fwd);
-    if (!(dist > 0.0) || !(viewHeight > 0.0)) return c;
-    const glm::dvec3 f = fwd / dist;
+    const double dist = depth > 0.0 ? depth : glm::length(fwd);
+    if (!(glm::length(fwd) > 0.0) || !(dist > 0.0) || !(viewHeight > 0.0) || (dx == 0.0 && dy == 0.0)) return c;
+    const glm::dvec3 f = fwd / glm::length(fwd);
     glm::dvec3 right = glm::cross(f, glm::dvec3(c.up));
     if (!(glm::length(right) > 1e-9)) return c;
     right = glm::normalize(right);
@@ -58,6 +60,17 @@ CameraDesc zoomCamera(const CameraDesc& camera, double steps, double factor)
     if (!(dist > 0.0)) return c;
     const double next = std::max(0.01, dist * std::pow(factor, steps));
     c.position = c.target + offset * (next / dist);
+    return c;
+}
+
+CameraDesc zoomCameraAbout(const CameraDesc& camera, double steps, const glm::dvec3& about, double factor)
+{
+    CameraDesc c = camera;
+    const double dist = glm::length(c.position - about);
+    if (!(dist > 0.0) || steps == 0.0) return c;
+    const double k = std::max(0.01, dist * std::pow(factor, steps)) / dist;
+    c.position = about + (c.position - about) * k;
+    c.target = about + (c.target - about) * k;
     return c;
 }
 
@@ -98,6 +111,97 @@ double flyStepFor(const Scene& scene)
         return std::max(0.05, 0.005 * side);
     }
     return std::max(0.05, 0.05 * glm::length(scene.camera.target - scene.camera.position));
+}
+
+Bounds3 instanceBounds(const Scene& scene, const InstanceDesc& instance, const Bounds3& speciesBox)
+{
+    glm::dvec3 p = instance.position;
+    const TerrainDesc& t = scene.terrain;
+    if (instance.onTerrain && t.enabled() && t.field) {
+        const double h = surfaceHeight(*t.field, p.x - t.origin.x, p.z - t.origin.z);
+        if (std::isfinite(h)) p.y += t.origin.y + h;
+    }
+    Bounds3 out;
+    if (!speciesBox.valid()) {
+        out.extend(glm::vec3(p));
+        return out;
+    }
+    // world = R (s x) + p, the renderer's instance map (makeInstance).
+    const glm::dmat3 r = rotationDeg(instance.rotationDeg);
+    for (int k = 0; k < 8; ++k) {
+        const glm::dvec3 corner((k & 1) ? speciesBox.hi.x : speciesBox.lo.x, (k & 2) ? speciesBox.hi.y : speciesBox.lo.y,
+                                (k & 4) ? speciesBox.hi.z : speciesBox.lo.z);
+        out.extend(glm::vec3(r * (double(instance.scale) * corner) + p));
+    }
+    return out;
+}
+
+Bounds3 sceneBounds(const Scene& scene, const std::vector<Bounds3>& speciesBoxes)
+{
+    Bounds3 out;
+    for (const InstanceDesc& in : scene.instances) {
+        const Bounds3 none;
+        const Bounds3& box = in.group == kNoGroup && in.species < speciesBoxes.size() ? speciesBoxes[in.species] : none;
+        const Bounds3 b = instanceBounds(scene, in, box);
+        out.extend(b.lo);
+        out.extend(b.hi);
+    }
+    const TerrainDesc& t = scene.terrain;
+    if (t.enabled() && t.field && !t.field->heights.empty()) {
+        const HeightFieldLayout& L = t.field->layout;
+        const auto [lo, hi] = std::minmax_element(t.field->heights.begin(), t.field->heights.end());
+        out.extend(glm::vec3(t.origin + glm::dvec3(0.0, double(*lo), 0.0)));
+        out.extend(glm::vec3(t.origin + glm::dvec3(double(L.nx - 1) * double(L.dx), double(*hi), double(L.nz - 1) * double(L.dz))));
+    }
+    return out;
+}
+
+CameraDesc frameBoxCamera(const CameraDesc& current, const Bounds3& b, double aspect, double fill)
+{
+    CameraDesc c = current;
+    if (!b.valid() || !(aspect > 0.0) || !(fill > 0.0)) return c;
+    glm::dvec3 f = c.target - c.position;
+    if (!(glm::length(f) > 0.0)) f = glm::dvec3(0.0, 0.0, 1.0);
+    f = glm::normalize(f);
+    glm::dvec3 right = glm::cross(f, glm::dvec3(c.up));
+    if (!(glm::length(right) > 1e-9)) return c;
+    right = glm::normalize(right);
+    const glm::dvec3 up = glm::cross(right, f);
+    const double tanY = std::tan(double(c.fovY) * 0.5 * kDegToRad) * fill, tanX = tanY * aspect;
+    const glm::dvec3 centre = glm::dvec3(b.center());
+    // A corner q (from the centre) seen from centre - D f lies at depth D + q.f; it is inside the framed part
+    // when |q.right| <= tanX (D + q.f) and |q.up| <= tanY (D + q.f): D is the largest such bound.
+    double dist = 0.0, nearest = 0.0;
+    for (int k = 0; k < 8; ++k) {
+        const glm::dvec3 q = glm::dvec3((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z) - centre;
+        const double along = glm::dot(q, f);
+        dist = std::max({dist, std::abs(glm::dot(q, right)) / tanX - along, std::abs(glm::dot(q, up)) / tanY - along});
+        nearest = std::max(nearest, -along);
+    }
+    // The eye stays in front of every corner (a flat box seen edge-on) and 1 cm from the centre.
+    dist = std::max({dist, nearest + 0.01, 0.01});
+    c.target = centre;
+    c.position = centre - dist * f;
+    return c;
+}
+
+bool projectToView(const CameraDesc& camera, double width, double height, const glm::dvec3& p, glm::dvec2* pixel)
+{
+    glm::dvec3 f = camera.target - camera.position;
+    if (!(glm::length(f) > 0.0) || !(width > 0.0) || !(height > 0.0)) return false;
+    f = glm::normalize(f);
+    glm::dvec3 right = glm::cross(f, glm::dvec3(camera.up));
+    if (!(glm::length(right) > 1e-9)) return false;
+    right = glm::normalize(right);
+    const glm::dvec3 up = glm::cross(right, f);
+    const glm::dvec3 q = p - camera.position;
+    const double depth = glm::dot(q, f);
+    if (!(depth > 1e-9)) return false;
+    const double tanY = std::tan(double(camera.fovY) * 0.5 * kDegToRad), tanX = tanY * width / height;
+    const double sx = glm::dot(q, right) / (depth * tanX), sy = glm::dot(q, up) / (depth * tanY);
+    // The inverse of cameraRay (core/render/shade.h): sx = 2x/w - 1, sy = 1 - 2y/h.
+    *pixel = glm::dvec2(0.5 * (sx + 1.0) * width, 0.5 * (1.0 - sy) * height);
+    return true;
 }
 
 void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg)

@@ -10,13 +10,20 @@ namespace sylva {
 // pitch kept within 1 degree of the poles. The target stays put.
 CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg);
 
-// Moves eye and target together by (dx, dy) pixels of an image `viewHeight` pixels tall, so the point
-// under the cursor at the target's distance follows the cursor.
-CameraDesc panCamera(const CameraDesc& camera, double dx, double dy, double viewHeight);
+// Moves eye and target together by (dx, dy) pixels of an image `viewHeight` pixels tall, so a point at
+// `depth` metres ahead of the eye (along the view axis; 0: the target's distance) follows the cursor: grab
+// what is under the cursor and it stays under it. No movement (dx = dy = 0) returns the camera unchanged.
+CameraDesc panCamera(const CameraDesc& camera, double dx, double dy, double viewHeight, double depth = 0.0);
 
 // Moves the eye toward the target by factor^steps of the distance (steps > 0: closer); the distance
 // stays above 1 cm.
 CameraDesc zoomCamera(const CameraDesc& camera, double steps, double factor = 0.85);
+
+// Zoom toward a world point (what is under the cursor): eye and target scaled about `about` by
+// factor^steps, so the view direction stays, `about` stays on the same pixel and each step covers the same
+// fraction of the distance to it (near things zoom finely, far ones fast). The eye stays at least 1 cm
+// from `about`. zoomCameraAbout(c, s, c.target) is zoomCamera(c, s).
+CameraDesc zoomCameraAbout(const CameraDesc& camera, double steps, const glm::dvec3& about, double factor = 0.85);
 
 // Fly navigation: turns the view about the eye. yawDeg > 0 turns toward the camera's right (about
 // world +Y), pitchDeg > 0 looks up; the pitch stays within 1 degree of the poles. The eye stays put,
@@ -35,6 +42,26 @@ double flyStepFor(const Scene& scene);
 // A camera that shows world box b whole, from the front-left and a little above (current's field of
 // view; up is world +Y): what the studio frames the first instances of a scene with.
 CameraDesc framingCamera(const CameraDesc& current, const Bounds3& b);
+
+// The world box of an instance of a species whose mesh has box `speciesBox` (species frame): the eight
+// corners turned, scaled and moved as the renderer places the instance. An instance standing on the terrain
+// (onTerrain) is lifted by the terrain's height under it when the scene has one.
+Bounds3 instanceBounds(const Scene& scene, const InstanceDesc& instance, const Bounds3& speciesBox);
+
+// The box of what a scene shows: its instances (speciesBoxes[k]: species k's mesh box; an instance whose
+// species has no valid box, or of a group, counts as its position) and its terrain. Not valid when the
+// scene has neither.
+Bounds3 sceneBounds(const Scene& scene, const std::vector<Bounds3>& speciesBoxes);
+
+// Frames box b in a view `aspect` (width / height) wide: keeps the view direction and field of view, aims at
+// the box's centre and moves the eye back (or forward) until the farthest of the box's projected corners
+// lies at `fill` of the way from the centre to the picture's edge (horizontally or vertically, whichever is
+// reached first). Blender's View All / View Selected.
+CameraDesc frameBoxCamera(const CameraDesc& current, const Bounds3& b, double aspect, double fill = 0.9);
+
+// Where world point p lands in a width x height picture of `camera` (pixels, y down, the renderer's
+// pinhole); false when p is not in front of the eye.
+bool projectToView(const CameraDesc& camera, double width, double height, const glm::dvec3& p, glm::dvec2* pixel);
 
 // Elevation and azimuth (degrees, scene.h's convention) of a direction toward the sun.
 void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg);

@@ -107,7 +107,7 @@ ExportSettings ExportDialog::settings() const
 }
 
 ScatterDialog::ScatterDialog(const QStringList& speciesNames, const ScatterSpec& initial, QWidget* parent)
-    : QDialog(parent), m_height(initial.height)
+    : QDialog(parent), m_height(initial.height), m_clearCentre(initial.clearCentre)
 {
     setWindowTitle(tr("Scatter Instances"));
     auto* form = new QFormLayout(this);
@@ -159,11 +159,27 @@ ScatterDialog::ScatterDialog(const QStringList& speciesNames, const ScatterSpec&
     form->addRow(tr("Rotation"), m_rotate);
     form->addRow(tr("Scale from / to"), pair(m_s0, m_s1));
     form->addRow(tr("Seed"), m_seed);
+    m_clear = new QDoubleSpinBox;
+    m_clear->setObjectName("scatterClearance");
+    m_clear->setRange(0.0, 1e4);
+    m_clear->setDecimals(1);
+    m_clear->setSuffix(tr(" m"));
+    m_clear->setValue(initial.clearRadius);
+    m_clear->setToolTip(tr("No tree is placed closer than this to the camera (measured along the ground), "
+                           "so the camera does not start inside a trunk or a crown. 0: no clearance"));
+    form->addRow(tr("Keep clear around the camera"), m_clear);
+    m_frame = new QCheckBox(tr("Frame the result"));
+    m_frame->setObjectName("scatterFrame");
+    m_frame->setChecked(true);
+    m_frame->setToolTip(tr("Afterwards, move the camera back so the whole scene is in view (View > Frame All)"));
+    form->addRow(QString(), m_frame);
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
     connect(buttons, &QDialogButtonBox::accepted, this, &QDialog::accept);
     connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);
     form->addRow(buttons);
 }
+
+bool ScatterDialog::frameResult() const { return m_frame->isChecked(); }
 
 ScatterSpec ScatterDialog::spec() const
 {
@@ -178,6 +194,8 @@ ScatterSpec ScatterDialog::spec() const
     s.scaleMin = float(std::min(m_s0->value(), m_s1->value()));
     s.scaleMax = float(std::max(m_s0->value(), m_s1->value()));
     s.seed = uint64_t(m_seed->value());
+    s.clearCentre = m_clearCentre;
+    s.clearRadius = m_clear->value();
     return s;
 }
 

@@ -66,6 +66,10 @@ public:
     QComboBox* speciesBox() const { return m_species; }
     QSpinBox* countBox() const { return m_count; }
     QSpinBox* seedBox() const { return m_seed; }
+    QDoubleSpinBox* clearanceBox() const { return m_clear; }
+    // "Frame the result": Frame All after the scatter (on at first).
+    QCheckBox* frameBox() const { return m_frame; }
+    bool frameResult() const;
 
 private:
     QComboBox* m_species;
@@ -78,7 +82,10 @@ private:
     QDoubleSpinBox* m_s0;
     QDoubleSpinBox* m_s1;
     QSpinBox* m_seed;
+    QDoubleSpinBox* m_clear;
+    QCheckBox* m_frame;
     double m_height;
+    glm::dvec2 m_clearCentre;
 };
 
 // One material of a species' mesh for the material dialog: its name, what the importer's rules make

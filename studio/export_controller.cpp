@@ -8,10 +8,13 @@
 #include <QFileInfo>
 
 #include "core/backend/backend.h"
+#include "core/base/error.h"
+#include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/services/exports.h"
 #include "studio/asset_store.h"
 #include "studio/job_manager.h"
+#include "studio/recent_files.h"
 #include "studio/scene_document.h"
 
 namespace sylva {
@@ -20,6 +23,87 @@ ExportController::ExportController(SceneDocument* doc, JobManager* jobs, AssetSt
                                    Backend* backend, QWidget* window, QObject* parent)
     : StudioController(parent), m_doc(doc), m_jobs(jobs), m_assets(assets), m_cache(cache), m_backend(backend), m_window(window)
 {
+}
+
+namespace {
+
+// The species' assets of an export's scene (the lighting grids when its mode needs them), from the store or made.
+std::vector<SpeciesAssets> exportAssets(const Scene& scene, AssetStore* store, GridCache* cache, Backend* backend, Job& job,
+                                        Progress& progress)
+{
+    const bool lit = modeNeedsLighting(scene.render.mode);
+    const std::vector<AssetsPtr> shared =
+        ensureAssets(scene, lit, *store, cache, &progress, [&job](const std::string& line) { job.log(QString::fromStdString(line)); },
+                     backend);
+    std::vector<SpeciesAssets> assets;
+    for (const AssetsPtr& a : shared) assets.push_back(*a);
+    return assets;
+}
+
+} // namespace
+
+std::vector<int> ExportController::renderSamplePasses(int spp, int subsets)
+{
+    const int total = std::max(1, spp), step = std::max(1, subsets);
+    std::vector<int> ends;
+    int done = std::min(total, step);
+    ends.push_back(done);
+    while (done < total) {
+        const int more = std::max(step, done / step * step);   // double, in whole cycles of the subsets
+        done = std::min(total, done + more);
+        ends.push_back(done);
+    }
+    return ends;
+}
+
+Job* ExportController::renderImage(const Scene& scene, PassCallback onPass)
+{
+    if (scene.render.width < 1 || scene.render.height < 1 || scene.render.spp < 1) {
+        fail(tr("Render failed"), tr("The render size and samples must be at least 1."));
+        return nullptr;
+    }
+    GridCache* cache = m_cache;
+    AssetStore* store = m_assets;
+    Backend* backend = m_backend;
+    log(tr("rendering %1 x %2, %3 spp").arg(scene.render.width).arg(scene.render.height).arg(scene.render.spp));
+    return m_jobs->start(tr("Render image"),
+                         [scene, store, cache, backend, onPass](Job& job, Progress& progress) {
+                             SubProgress assetsPart(&progress, 0.0, 0.3);
+                             Progress assetsProgress([&](double f, const std::string& m) { assetsPart.report(f, m); });
+                             const std::vector<SpeciesAssets> assets = exportAssets(scene, store, cache, backend, job, assetsProgress);
+                             progress.report(0.3, "building");
+                             const RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
+                             if (progress.isCancelled()) throw Cancelled();
+                             if (backend && backend->name() != "cpu") {
+                                 SubProgress tracePart(&progress, 0.35, 1.0);
+                                 Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
+                                 onPass(backend->render(rs, &traceProgress), scene.render.spp);
+                                 return;
+                             }
+                             const RenderView base = rs.view();
+                             const std::vector<int> ends = renderSamplePasses(base.spp, base.sky.lightCount > 0 ? base.sky.interleave.subsets : 1);
+                             Film sum;
+                             int done = 0;
+                             for (const int end : ends) {
+                                 RenderView view = base;
+                                 view.sampleBegin = done;
+                                 view.sampleEnd = end;
+                                 SubProgress passPart(&progress, 0.35 + 0.65 * done / base.spp, 0.35 + 0.65 * end / base.spp);
+                                 Progress passProgress([&](double f, const std::string&) {
+                                     passPart.report(f, "samples " + std::to_string(done) + " of " + std::to_string(base.spp));
+                                 });
+                                 if (progress.isCancelled()) throw Cancelled();
+                                 const Film part = renderFilm(view, &passProgress);
+                                 accumulateFilm(sum, done, part, end - done);
+                                 done = end;
+                                 onPass(sum, done);
+                             }
+                         },
+                         [this](Job* job) {
+                             if (job->state() == Job::State::Succeeded) log(tr("rendered in %1 s").arg(job->seconds(), 0, 'f', 2));
+                             else if (job->state() == Job::State::Failed) fail(tr("Render failed"), job->error());
+                             else log(tr("render cancelled"));
+                         });
 }
 
 Job* ExportController::exportRender(const ExportSettings& settings)
@@ -42,14 +126,9 @@ Job* ExportController::exportRender(const ExportSettings& settings)
             .arg(passes ? tr(", render passes") : QString()));
     return m_jobs->start(tr("Export %1").arg(QFileInfo(settings.path).fileName()),
                          [scene, path, store, cache, backend, passes](Job& job, Progress& progress) {
-                             const bool lit = modeNeedsLighting(scene.render.mode);
                              SubProgress assetsPart(&progress, 0.0, 0.4);
                              Progress assetsProgress([&](double f, const std::string& m) { assetsPart.report(f, m); });
-                             const std::vector<AssetsPtr> shared = ensureAssets(
-                                 scene, lit, *store, cache, &assetsProgress,
-                                 [&job](const std::string& line) { job.log(QString::fromStdString(line)); }, backend);
-                             std::vector<SpeciesAssets> assets;
-                             for (const AssetsPtr& a : shared) assets.push_back(*a);
+                             const std::vector<SpeciesAssets> assets = exportAssets(scene, store, cache, backend, job, assetsProgress);
                              SubProgress renderPart(&progress, 0.4, 1.0);
                              Progress renderProgress([&](double f, const std::string& m) { renderPart.report(f, m); });
                              sylva::exportRender(scene, assets, path, backend, &renderProgress, passes);
@@ -127,8 +206,12 @@ void ExportController::exportGridsDialog(int species, GridFileFormat format)
     }
     const QString folder = QFileDialog::getExistingDirectory(
         m_window, tr("Export the grids of %1 to").arg(QString::fromStdString(m_doc->scene().species[size_t(species)].name)),
-        m_doc->filePath().isEmpty() ? QString() : QFileInfo(m_doc->filePath()).absolutePath());
-    if (!folder.isEmpty()) exportSpeciesGrids(species, folder, format);
+        !lastFolder(QStringLiteral("grids")).isEmpty() ? lastFolder(QStringLiteral("grids"))
+        : m_doc->filePath().isEmpty()               ? QString()
+                                                    : QFileInfo(m_doc->filePath()).absolutePath());
+    if (folder.isEmpty()) return;
+    rememberFolder(QStringLiteral("grids"), folder);
+    exportSpeciesGrids(species, folder, format);
 }
 
 } // namespace sylva

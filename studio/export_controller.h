@@ -3,7 +3,12 @@
 // exportSpeciesGrids), each a background job on the studio's backend, with their dialogs.
 #pragma once
 
+#include <functional>
+#include <vector>
+
 #include <QString>
+
+#include "core/render/render_cpu.h"
 
 #include "pipeline/io/grid_file.h"
 #include "studio/dialogs.h"
@@ -31,6 +36,18 @@ public:
     // Renders the scene at the settings' size and samples into settings.path (PNG/TIFF tone-mapped,
     // EXR linear). Null (and an error) for an empty scene.
     Job* exportRender(const ExportSettings& settings);
+    // Render > Render Image: `scene` at its render size and samples, traced in passes of growing sample
+    // counts (renderSamplePasses) that are accumulated (RenderView::sampleBegin/End, accumulateFilm) into
+    // the frame of render.spp samples: sylva render's frame (up to float rounding), built and traced by
+    // the calls exportRender makes. On a backend other than the CPU the frame is traced whole, in one
+    // pass. onPass runs on the job's thread after each pass with the film so far and its samples per
+    // pixel. Null (and an error) for a bad render size.
+    using PassCallback = std::function<void(const Film& film, int samples)>;
+    Job* renderImage(const Scene& scene, PassCallback onPass);
+    // The sample counts the passes of renderImage end at: the first of `subsets` samples (one cycle of
+    // a sky's light subsets; at least 1), then doubling in multiples of it, the last spp (ascending).
+    static std::vector<int> renderSamplePasses(int spp, int subsets);
+
     // Writes a species' grids (loadSpeciesGrids) into folder as NAME.density.npy (+ NAME.density.wood.npy)
     // and NAME.lighting.npy, each with its JSON sidecar (CONTRACTS.md), or with GridFileFormat::Vdb as
     // one NAME.vdb (density, wood fraction and lighting grids, docs/FILES.md); NAME is gridFileBase of

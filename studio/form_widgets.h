@@ -9,6 +9,7 @@
 #include <QString>
 #include <QWidget>
 
+#include <cmath>
 #include <initializer_list>
 
 namespace sylva::widgets {
@@ -27,11 +28,12 @@ inline QDoubleSpinBox* spin(const QString& name, double lo, double hi, int decim
     return s;
 }
 
-// Shows a value without emitting valueChanged (a refresh from the scene is not an edit).
+// Shows a value without emitting valueChanged (a refresh from the scene is not an edit). What rounds to
+// zero at the box's decimals shows as 0.000, not -0.000 (an orbit leaves coordinates of 1e-15 either side).
 inline void setValue(QDoubleSpinBox* box, double v)
 {
     const QSignalBlocker block(box);
-    box->setValue(v);
+    box->setValue(std::abs(v) < 0.5 * std::pow(10.0, -box->decimals()) ? 0.0 : v);
 }
 inline void setValue(QSpinBox* box, int v)
 {

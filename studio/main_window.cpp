@@ -2,6 +2,7 @@
 // the controllers it owns do the rest (docs/STUDIO.md, "How it is built").
 #include "studio/main_window.h"
 
+#include <algorithm>
 #include <initializer_list>
 #include <utility>
 
@@ -10,6 +11,7 @@
 #include <QCloseEvent>
 #include <QComboBox>
 #include <QDateTime>
+#include <QDir>
 #include <QDockWidget>
 #include <QDragEnterEvent>
 #include <QDropEvent>
@@ -32,6 +34,7 @@
 #include "studio/autosave_controller.h"
 #include "studio/background_priority.h"
 #include "studio/export_controller.h"
+#include "studio/help_dialogs.h"
 #include "studio/inspector_controller.h"
 #include "studio/job_manager.h"
 #include "studio/job_panel.h"
@@ -41,11 +44,13 @@
 #include "studio/outliner_model.h"
 #include "studio/property_panel.h"
 #include "studio/recent_files.h"
+#include "studio/render_window.h"
 #include "studio/scatter_tool.h"
 #include "studio/species_importer.h"
 #include "studio/viewport.h"
 #include "studio/volume_dialogs.h"
 #include "studio/volume_inspector.h"
+#include "studio/words.h"
 
 namespace sylva {
 namespace {
@@ -61,6 +66,9 @@ MainWindow::MainWindow(QWidget* parent)
     setAcceptDrops(true);
     lowerTbbWorkerPriority();
     m_reportError = [this](const QString& title, const QString& message) { QMessageBox::critical(this, title, message); };
+    m_chooseOpen = [this](const QString& folder) {
+        return QFileDialog::getOpenFileName(this, tr("Open Scene"), folder, tr(kSceneFilter));
+    };
     m_askSave = [this](const QString& name) {
         return QMessageBox::warning(this, tr("Unsaved changes"), tr("Save the changes to %1?").arg(name),
                                     QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, QMessageBox::Save);
@@ -72,34 +80,35 @@ MainWindow::MainWindow(QWidget* parent)
     cl->setContentsMargins(0, 0, 0, 0);
     cl->setSpacing(0);
     auto* bar = new QToolBar;
-    bar->addWidget(new QLabel(tr(" Mode ")));
+    // Artists' words (studio/words.cpp); the items' data are the scene's values.
+    bar->addWidget(new QLabel(tr(" Light: ")));
     m_modeBox = new QComboBox;
     m_modeBox->setObjectName("renderMode");
-    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
-        m_modeBox->addItem(QString::fromLatin1(renderModeName(m)), int(m));
-    m_modeBox->setToolTip(tr("full = sun + LB indirect; local = sun only; ambient = sun + constant; lb = indirect only"));
+    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb}) {
+        m_modeBox->addItem(renderModeLabel(m), int(m));
+        m_modeBox->setItemData(m_modeBox->count() - 1, renderModeToolTip(m), Qt::ToolTipRole);
+    }
     bar->addWidget(m_modeBox);
-    bar->addWidget(new QLabel(tr(" Light ")));
+    bar->addWidget(new QLabel(tr(" Method: ")));
     m_integratorBox = new QComboBox;
     m_integratorBox->setObjectName("integrator");
-    m_integratorBox->addItem(tr("LB model"), int(Integrator::Lb));
+    m_integratorBox->addItem(tr("Lighting model"), int(Integrator::Lb));
     m_integratorBox->addItem(tr("Path tracer"), int(Integrator::Path));
-    m_integratorBox->setToolTip(tr("LB model: direct light with shadows plus the lighting grids' scattered light (fast); "
-                                   "path tracer: every bounce of light traced, the reference the LB model is measured against "
-                                   "(slower, noisy at first; no volumes yet)"));
     bar->addWidget(m_integratorBox);
     bar->addSeparator();
     m_compareToggle = new QCheckBox(tr("Compare with"));
     m_compareToggle->setObjectName("compareToggle");
-    m_compareToggle->setToolTip(tr("Side by side: the left half in the mode on the left, the right half in this mode, from one trace"));
     bar->addWidget(m_compareToggle);
     m_compareBox = new QComboBox;
     m_compareBox->setObjectName("compareMode");
-    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb})
-        m_compareBox->addItem(QString::fromLatin1(renderModeName(m)), int(m));
+    for (RenderMode m : {RenderMode::Full, RenderMode::Local, RenderMode::Ambient, RenderMode::Lb}) {
+        m_compareBox->addItem(renderModeLabel(m), int(m));
+        m_compareBox->setItemData(m_compareBox->count() - 1, renderModeToolTip(m), Qt::ToolTipRole);
+    }
     m_compareBox->setCurrentIndex(m_compareBox->findData(int(RenderMode::Lb)));
     m_compareBox->setEnabled(false);
     bar->addWidget(m_compareBox);
+    applyToolTips(bar);
     cl->addWidget(bar);
     m_viewport = new Viewport;
     cl->addWidget(m_viewport, 1);
@@ -107,12 +116,12 @@ MainWindow::MainWindow(QWidget* parent)
     connect(m_modeBox, &QComboBox::activated, this, [this](int index) {
         Scene s = m_doc->scene();
         s.render.mode = RenderMode(m_modeBox->itemData(index).toInt());
-        m_doc->edit(s, tr("Render mode %1").arg(m_modeBox->itemText(index)));
+        m_doc->edit(s, tr("Light: %1").arg(m_modeBox->itemText(index)));
     });
     connect(m_integratorBox, &QComboBox::activated, this, [this](int index) {
         Scene s = m_doc->scene();
         s.render.integrator = Integrator(m_integratorBox->itemData(index).toInt());
-        m_doc->edit(s, tr("Light by %1").arg(m_integratorBox->itemText(index)));
+        m_doc->edit(s, tr("Method: %1").arg(m_integratorBox->itemText(index)));
     });
     connect(m_compareToggle, &QCheckBox::toggled, this, [this] { updateCompare(); });
     connect(m_compareBox, &QComboBox::currentIndexChanged, this, [this] { updateCompare(); });
@@ -120,6 +129,16 @@ MainWindow::MainWindow(QWidget* parent)
         Scene s = m_doc->scene();
         s.camera = camera;
         m_doc->edit(s, tr("Navigate"), key);
+    });
+    // A click in the viewport selects the instance under the cursor in the outliner (nothing: clears it).
+    connect(m_viewport, &Viewport::instancePicked, this, [this](int instance) {
+        if (instance >= 0) {
+            const QModelIndex index = m_model->indexOf({OutlinerItem::Kind::Instance, instance});
+            m_outliner->setCurrentIndex(index);
+            m_outliner->scrollTo(index);
+        } else {
+            m_outliner->selectionModel()->clear();
+        }
     });
     connect(m_viewport, &Viewport::imageShown, this, [this](int pass, bool last, double seconds) {
         statusBar()->showMessage(tr("Viewport: pass %1%2, %3 s after the change")
@@ -140,6 +159,11 @@ MainWindow::MainWindow(QWidget* parent)
     m_export = new ExportController(m_doc, m_jobs, &m_assets, m_cache.get(), m_backend.get(), this, this);
     m_materials = new MaterialsController(m_doc, m_jobs, this, this);
     m_scatter = new ScatterTool(m_doc, [this] { return selectedSpecies(); }, this, this);
+    connect(m_scatter, &ScatterTool::frameRequested, this, [this] { m_viewport->frameAll(); });
+    m_scatter->setSpeciesBox([this](int species) {
+        const std::vector<Bounds3>& boxes = m_viewport->speciesBoxes();
+        return species >= 0 && size_t(species) < boxes.size() ? boxes[size_t(species)] : Bounds3{};
+    });
     m_importer = new SpeciesImporter(m_doc, m_jobs, this, this);
     m_volumeTools = new VolumeTools(m_doc, m_jobs, this, this);
     for (StudioController* c : std::initializer_list<StudioController*>{m_lighting, m_export, m_materials, m_scatter, m_importer, m_volumeTools})
@@ -174,6 +198,7 @@ MainWindow::~MainWindow()
     m_doc->disconnect(this);
     m_jobs->disconnect(this);
     m_viewport->disconnect(this);
+    delete std::exchange(m_renderWindow, nullptr);
     delete std::exchange(m_autosave, nullptr);
     delete std::exchange(m_inspection, nullptr);
     delete std::exchange(m_importer, nullptr);
@@ -203,9 +228,22 @@ void MainWindow::buildDocks()
     m_outliner->setObjectName("outliner");
     m_outliner->setModel(m_model);
     m_outliner->setSelectionMode(QAbstractItemView::SingleSelection);
+    // Names as wide as they are; details as wide as their widest text or the room left (a long detail scrolls
+    // sideways instead of being cut off; its tooltip holds it too).
     m_outliner->header()->setSectionResizeMode(0, QHeaderView::ResizeToContents);
+    m_outliner->header()->setSectionResizeMode(1, QHeaderView::Interactive);
+    m_outliner->header()->setStretchLastSection(false);
+    m_outliner->setHorizontalScrollMode(QAbstractItemView::ScrollPerPixel);
     m_outliner->expandAll();
     connect(m_model, &QAbstractItemModel::modelReset, m_outliner, &QTreeView::expandAll);
+    connect(m_model, &QAbstractItemModel::modelReset, this, &MainWindow::fitOutlinerDetails, Qt::QueuedConnection);
+    connect(m_model, &QAbstractItemModel::dataChanged, this, &MainWindow::fitOutlinerDetails, Qt::QueuedConnection);
+    connect(m_outliner->header(), &QHeaderView::sectionResized, this, [this](int section) {
+        if (section == 0) fitOutlinerDetails();
+    });
+    m_outliner->viewport()->installEventFilter(this);
+    // Rows came or went (a delete, an undo, another file): the selection is gone, and the properties with it.
+    connect(m_model, &QAbstractItemModel::modelReset, this, &MainWindow::onSelectionChanged);
     connect(m_outliner->selectionModel(), &QItemSelectionModel::currentChanged, this, &MainWindow::onSelectionChanged);
     auto* outlinerDock = new QDockWidget(tr("Outliner"), this);
     outlinerDock->setObjectName("outlinerDock");
@@ -344,6 +382,8 @@ void MainWindow::buildActions()
     add(edit, tr("Simulate S&moke..."), "actionSimulateSmoke", QKeySequence(), [this] { m_volumeTools->smokeDialog(); });
 
     QMenu* render = menuBar()->addMenu(tr("&Render"));
+    add(render, tr("Render &Image"), "actionRenderImage", QKeySequence(Qt::Key_F12), [this] { renderImage(); });
+    render->addSeparator();
     add(render, tr("Compute &Lighting"), "actionLight", QKeySequence(Qt::CTRL | Qt::Key_L), [this] { m_lighting->computeLighting(); });
     add(render, tr("&Reload Lighting"), "actionReload", QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_L),
         [this] { m_lighting->computeLighting(true); });
@@ -363,6 +403,22 @@ void MainWindow::buildActions()
     m_viewMenu = menuBar()->addMenu(tr("&View"));
     for (QDockWidget* d : findChildren<QDockWidget*>()) m_viewMenu->addAction(d->toggleViewAction());
     m_viewMenu->addSeparator();
+    // Blender's View All (Home) and View Selected (numpad period).
+    add(m_viewMenu, tr("Frame &All"), "actionFrameAll", QKeySequence(Qt::Key_Home), [this] { m_viewport->frameAll(); });
+    add(m_viewMenu, tr("Frame &Selected"), "actionFrameSelected", QKeySequence(Qt::KeypadModifier | Qt::Key_Period),
+        [this] { m_viewport->frameSelected(); });
+    // The render's frame over the viewport (remembered across sessions; on at first).
+    QAction* cameraFrame = m_viewMenu->addAction(tr("&Camera Frame"));
+    cameraFrame->setObjectName("actionCameraFrame");
+    cameraFrame->setCheckable(true);
+    cameraFrame->setToolTip(tr("Show the render's frame in the viewport (its size's proportions; outside it darkened): "
+                               "what lies inside is what Render Image and Export Render show"));
+    connect(cameraFrame, &QAction::toggled, this, [this](bool on) {
+        m_viewport->setCameraFrame(on);
+        QSettings().setValue(QStringLiteral("view/cameraFrame"), on);
+    });
+    cameraFrame->setChecked(QSettings().value(QStringLiteral("view/cameraFrame"), true).toBool());
+    m_viewport->setCameraFrame(cameraFrame->isChecked());
     // F in the viewport toggles it too (a window-wide F shortcut would eat the key in text fields).
     QAction* fly = m_viewMenu->addAction(tr("&Fly Navigation (F in the viewport)"));
     fly->setObjectName("actionFly");
@@ -372,16 +428,45 @@ void MainWindow::buildActions()
         const QSignalBlocker block(fly);
         fly->setChecked(on);
         statusBar()->showMessage(on ? tr("Fly: W/S forward/back, A/D left/right, Q/E down/up (Shift: faster), drag to look; F: back to orbit")
-                                    : tr("Orbit: drag to orbit, Shift+drag or middle drag to pan, wheel to zoom"),
+                                    : tr("Orbit: drag to orbit, Shift+drag or middle drag to pan, wheel to zoom, click to select"),
                                  on ? 0 : 4000);
     });
 
     QMenu* help = menuBar()->addMenu(tr("&Help"));
+    add(help, tr("&Manual"), "actionManual", QKeySequence(Qt::Key_F1), [this] { showManual(); });
+    add(help, tr("&Keyboard Shortcuts"), "actionShortcuts", QKeySequence(), [this] { showShortcuts(); });
+    help->addSeparator();
     add(help, tr("&About Sylva Studio"), "actionAbout", QKeySequence(), [this] {
         QMessageBox::about(this, tr("About Sylva Studio"),
                            tr("<b>Sylva Studio</b> %1<br>Forests lit with the lattice-Boltzmann lighting model.")
                                .arg(QString::fromLatin1(SYLVA_VERSION)));
     });
+}
+
+RenderWindow* MainWindow::renderImage()
+{
+    if (!m_renderWindow) m_renderWindow = new RenderWindow(m_doc, m_export, this);
+    m_renderWindow->show();
+    m_renderWindow->raise();
+    m_renderWindow->activateWindow();
+    m_renderWindow->render();
+    return m_renderWindow;
+}
+
+ManualDialog* MainWindow::showManual()
+{
+    if (!m_manual) m_manual = new ManualDialog(this);
+    m_manual->show();
+    m_manual->raise();
+    return m_manual;
+}
+
+ShortcutSheet* MainWindow::showShortcuts()
+{
+    delete m_shortcuts;   // made again: the actions' shortcuts as they are now
+    m_shortcuts = new ShortcutSheet(this, this);
+    m_shortcuts->show();
+    return m_shortcuts;
 }
 
 QString MainWindow::logText() const { return m_log->toPlainText(); }
@@ -430,9 +515,10 @@ bool MainWindow::newScene()
     return true;
 }
 
-bool MainWindow::openFile(const QString& path)
+bool MainWindow::openFile(const QString& path) { return maybeSave() && loadFile(path); }
+
+bool MainWindow::loadFile(const QString& path)
 {
-    if (!maybeSave()) return false;
     try {
         m_doc->open(path);
     } catch (const std::exception& e) {
@@ -440,6 +526,7 @@ bool MainWindow::openFile(const QString& path)
         return false;
     }
     m_recent->add(m_doc->filePath());
+    rememberFolder(QStringLiteral("scenes"), m_doc->filePath());
     appendLog(tr("opened %1").arg(m_doc->filePath()));
     return true;
 }
@@ -455,6 +542,7 @@ bool MainWindow::saveFile(const QString& path)
         return false;
     }
     m_recent->add(m_doc->filePath());
+    rememberFolder(QStringLiteral("scenes"), m_doc->filePath());
     appendLog(tr("saved %1").arg(m_doc->filePath()));
     statusBar()->showMessage(tr("Saved %1").arg(m_doc->filePath()), 3000);
     return true;
@@ -489,9 +577,25 @@ void MainWindow::updateCompare()
     m_lighting->updateViewport();   // the second mode may need lighting the first does not
 }
 
+void MainWindow::fitOutlinerDetails()
+{
+    const int room = m_outliner->viewport()->width() - m_outliner->header()->sectionSize(0);
+    // (QTreeView makes sizeHintForColumn protected; the item view declares it public.)
+    const int want = std::max(static_cast<const QAbstractItemView*>(m_outliner)->sizeHintForColumn(1), room);
+    if (m_outliner->header()->sectionSize(1) != want) m_outliner->header()->resizeSection(1, want);
+}
+
+bool MainWindow::eventFilter(QObject* watched, QEvent* event)
+{
+    if (m_outliner && watched == m_outliner->viewport() && event->type() == QEvent::Resize) fitOutlinerDetails();
+    return QMainWindow::eventFilter(watched, event);
+}
+
 void MainWindow::onSelectionChanged()
 {
-    m_properties->showItem(m_model->itemAt(m_outliner->currentIndex()));
+    const OutlinerItem item = m_model->itemAt(m_outliner->currentIndex());
+    m_properties->showItem(item);
+    m_viewport->setSelectedInstance(item.kind == OutlinerItem::Kind::Instance ? item.row : -1);
     refreshInspector();
 }
 
@@ -546,15 +650,19 @@ void MainWindow::deleteSelection()
 
 void MainWindow::openDialog()
 {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open Scene"), QString(), tr(kSceneFilter));
-    if (!path.isEmpty()) openFile(path);
+    // The question about the open scene before the chooser: the answer may be Cancel, and then no file is asked for.
+    if (!maybeSave()) return;
+    const QString path = m_chooseOpen ? m_chooseOpen(lastFolder(QStringLiteral("scenes"))) : QString();
+    if (!path.isEmpty()) loadFile(path);
 }
 
 bool MainWindow::saveAsDialog()
 {
-    QString path = QFileDialog::getSaveFileName(this, tr("Save Scene As"),
-                                                m_doc->filePath().isEmpty() ? tr("forest.sylva.json") : m_doc->filePath(),
-                                                tr(kSceneFilter));
+    const QString folder = lastFolder(QStringLiteral("scenes"));
+    const QString suggested = !m_doc->filePath().isEmpty() ? m_doc->filePath()
+                              : folder.isEmpty()           ? tr("forest.sylva.json")
+                                                           : QDir(folder).filePath(tr("forest.sylva.json"));
+    QString path = QFileDialog::getSaveFileName(this, tr("Save Scene As"), suggested, tr(kSceneFilter));
     return !path.isEmpty() && saveFile(path);
 }
 

@@ -38,6 +38,9 @@ class OutlinerModel;
 class PropertyPanel;
 class SkyPanel;
 class RecentFiles;
+class RenderWindow;
+class ManualDialog;
+class ShortcutSheet;
 class ScatterTool;
 class SpeciesImporter;
 class StudioController;
@@ -87,6 +90,12 @@ public:
     ScatterTool* scatterTool() const { return m_scatter; }
     SpeciesImporter* importer() const { return m_importer; }
     VolumeTools* volumeTools() const { return m_volumeTools; }
+    // Render > Render Image (F12): shows the render window and starts its render; the window (made on first use).
+    RenderWindow* renderImage();
+    RenderWindow* renderWindow() const { return m_renderWindow; }
+    // Help > Manual (F1) and Help > Keyboard Shortcuts: shown (not modal), made on first use.
+    ManualDialog* showManual();
+    ShortcutSheet* showShortcuts();
 
     // How errors and the unsaved-changes question reach the user. Defaults: modal message boxes.
     // Tests install non-blocking ones; errorReported is emitted either way (for the controllers'
@@ -95,6 +104,10 @@ public:
     void setErrorReporter(ErrorReporter reporter) { m_reportError = std::move(reporter); }
     using SavePrompt = std::function<QMessageBox::StandardButton(const QString& documentName)>;
     void setSavePrompt(SavePrompt prompt) { m_askSave = std::move(prompt); }
+    // How File > Open asks for the scene file, given the folder to start in (lastFolder("scenes")). Default:
+    // QFileDialog. Asked only after the unsaved-changes question; an empty answer opens nothing.
+    using OpenChooser = std::function<QString(const QString& folder)>;
+    void setOpenChooser(OpenChooser chooser) { m_chooseOpen = std::move(chooser); }
 
     // File
     bool newScene();                       // false when the user cancelled the unsaved-changes prompt
@@ -102,6 +115,8 @@ public:
     bool saveFile(const QString& path);    // false (and an error report) when it cannot be written
     bool save();                           // to the current file, or Save As when untitled
     void loadExampleForest();
+    // File > Open...: the unsaved-changes question first, then the file chooser, then the file.
+    void openDialog();
     // Edit
     void deleteSelection();
     // The species the outliner selection points at (a species row, or an instance's species); -1 if none.
@@ -117,6 +132,7 @@ Q_SIGNALS:
 
 protected:
     void closeEvent(QCloseEvent* event) override;
+    bool eventFilter(QObject* watched, QEvent* event) override;   // the outliner's viewport resized: fitOutlinerDetails
     void showEvent(QShowEvent* event) override;
     void dragEnterEvent(QDragEnterEvent* event) override;
     void dropEvent(QDropEvent* event) override;
@@ -133,9 +149,11 @@ private:
     void onDocumentChanged(ScenePart parts);
     void updateCompare();
     void onSelectionChanged();
+    // The outliner's Details column: as wide as its widest text (the view scrolls sideways) or the room left, whichever is more.
+    void fitOutlinerDetails();
     void refreshInspector();   // the inspector controller, once it exists (and until the window goes)
-    void openDialog();
     bool saveAsDialog();
+    bool loadFile(const QString& path);   // openFile without the unsaved-changes question
 
     SceneDocument* m_doc;
     JobManager* m_jobs;
@@ -143,7 +161,7 @@ private:
     std::unique_ptr<GridCache> m_cache;
     std::unique_ptr<Backend> m_backend;
     OutlinerModel* m_model;
-    QTreeView* m_outliner;
+    QTreeView* m_outliner = nullptr;
     PropertyPanel* m_properties;
     SkyPanel* m_skyPanel = nullptr;
     Viewport* m_viewport;
@@ -166,9 +184,13 @@ private:
     ScatterTool* m_scatter = nullptr;
     SpeciesImporter* m_importer = nullptr;
     VolumeTools* m_volumeTools = nullptr;
+    RenderWindow* m_renderWindow = nullptr;
+    ManualDialog* m_manual = nullptr;
+    ShortcutSheet* m_shortcuts = nullptr;
 
     ErrorReporter m_reportError;
     SavePrompt m_askSave;
+    OpenChooser m_chooseOpen;
     bool m_docksSized = false;
 };
 

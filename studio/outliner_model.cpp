@@ -1,6 +1,9 @@
 // OutlinerModel: group rows with internal id 0, child rows with internal id group + 1.
 #include "studio/outliner_model.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <QFileInfo>
 
 #include "core/terrain/height_field.h"
@@ -10,13 +13,29 @@ namespace {
 
 QString vec3Text(double x, double y, double z)
 {
-    return QStringLiteral("(%1, %2, %3)").arg(x, 0, 'g', 4).arg(y, 0, 'g', 4).arg(z, 0, 'g', 4);
+    return QStringLiteral("(%1, %2, %3)").arg(decimalText(x), decimalText(y), decimalText(z));
 }
 
 // Rows under Terrain: Tiles, Tiling, Density for a landscape (a terrain with cells), none otherwise.
 int terrainRows(const Scene& s) { return s.terrain.enabled() && s.terrain.cells > 0 ? 3 : 0; }
 
 } // namespace
+
+QString decimalText(double v)
+{
+    if (!std::isfinite(v)) return QString::number(v);
+    // Four significant digits, but never fewer than the units and never more than millimetres: 12690,
+    // 123.5, 2.5, 0.013; what rounds to zero is 0 (not 1.2e-15, not -0).
+    const double a = std::abs(v);
+    const int decimals = a > 0.0 ? std::clamp(3 - int(std::floor(std::log10(a))), 0, 3) : 0;
+    QString text = QString::number(v, 'f', decimals);
+    if (text.contains(QLatin1Char('.'))) {
+        while (text.endsWith(QLatin1Char('0'))) text.chop(1);
+        if (text.endsWith(QLatin1Char('.'))) text.chop(1);
+    }
+    if (text == QLatin1String("-0")) text = QStringLiteral("0");
+    return text;
+}
 
 OutlinerModel::OutlinerModel(SceneDocument* doc, QObject* parent) : QAbstractItemModel(parent), m_doc(doc)
 {
@@ -146,10 +165,10 @@ QVariant OutlinerModel::data(const QModelIndex& index, int role) const
     case K::SpeciesGroup: return name ? tr("Species") : tr("%n species", nullptr, m_species);
     case K::InstancesGroup: return name ? tr("Instances") : tr("%n instance(s)", nullptr, m_instances);
     case K::Ground:
-        return name ? tr("Ground") : s.ground.enabled ? tr("plane at y = %1 m").arg(s.ground.height) : tr("off");
+        return name ? tr("Ground") : s.ground.enabled ? tr("plane at y = %1 m").arg(decimalText(s.ground.height)) : tr("off");
     case K::Sun: {
         if (name) return tr("Sun");
-        return tr("%1 K, intensity %2").arg(s.sun.temperature).arg(double(s.sun.intensity));
+        return tr("%1 K, intensity %2").arg(decimalText(s.sun.temperature), decimalText(double(s.sun.intensity)));
     }
     case K::Camera:
         if (name) return tr("Camera");
@@ -167,6 +186,13 @@ QVariant OutlinerModel::data(const QModelIndex& index, int role) const
         const InstanceDesc& in = s.instances[size_t(it.row)];
         if (name) {
             const QString sp = in.species < s.species.size() ? QString::fromStdString(s.species[in.species].name) : tr("?");
+            // Instances have no name in the scene file: the number is the place in its instances list (from 1),
+            // so the ones after a deleted instance move up a number, as they do in the file.
+            if (role == Qt::ToolTipRole)
+                return tr("%1, instance %2 of the scene's %3 (numbered by their place in the scene file's list)")
+                    .arg(sp)
+                    .arg(it.row + 1)
+                    .arg(s.instances.size());
             return tr("%1 #%2").arg(sp).arg(it.row + 1);
         }
         return vec3Text(in.position.x, in.position.y, in.position.z);
@@ -180,14 +206,14 @@ QVariant OutlinerModel::data(const QModelIndex& index, int role) const
             text += tr(", %1 x %2 samples, %3 m apart")
                         .arg(t.field->layout.nx)
                         .arg(t.field->layout.nz)
-                        .arg(t.spacing);
+                        .arg(decimalText(t.spacing));
         if (t.cells > 0) text += tr(", %1 cells a side").arg(t.cells);
         return text;
     }
     case K::Tiles: {
         if (name) return tr("Tiles");
         const TileSetDesc& ts = s.terrain.tiles;
-        return tr("%1 m square, %n plant kind(s), seed %2", nullptr, int(ts.plants.size())).arg(ts.size).arg(ts.seed);
+        return tr("%1 m square, %n plant kind(s), seed %2", nullptr, int(ts.plants.size())).arg(decimalText(ts.size)).arg(ts.seed);
     }
     case K::Tiling: {
         if (name) return tr("Tiling");
@@ -199,7 +225,8 @@ QVariant OutlinerModel::data(const QModelIndex& index, int role) const
         if (name) return tr("Density");
         const DensityDesc& d = s.terrain.density;
         if (!d.enabled) return tr("off: every plant grows");
-        return tr("%1 at %2 m to %3 at %4 m").arg(double(d.atLower)).arg(d.lower).arg(double(d.atUpper)).arg(d.upper);
+        return tr("%1 at %2 m to %3 at %4 m")
+            .arg(decimalText(double(d.atLower)), decimalText(d.lower), decimalText(double(d.atUpper)), decimalText(d.upper));
     }
     case K::VolumesGroup: return name ? tr("Volumes") : tr("%n volume(s)", nullptr, m_volumes);
     case K::Volume: {

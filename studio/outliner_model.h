@@ -17,6 +17,10 @@ struct OutlinerItem {
     bool operator==(const OutlinerItem&) const = default;
 };
 
+// A number as the studio shows it: fixed notation with four significant digits, at most three decimals and
+// none past them: decimalText(12690.4) is "12690", 1.225e-15 gives "0", 2.5 gives "2.5", 0.0132 "0.013".
+QString decimalText(double v);
+
 class OutlinerModel : public QAbstractItemModel {
     Q_OBJECT
 

@@ -24,6 +24,7 @@
 
 #include "studio/form_widgets.h"
 #include "studio/param_widgets.h"
+#include "studio/words.h"
 
 namespace sylva {
 using namespace widgets;
@@ -50,6 +51,7 @@ PropertyPanel::PropertyPanel(SceneDocument* doc, QWidget* parent) : QWidget(pare
                            doc, [this](QObject* editor, const QString& text, const std::function<void(Scene&)>& change) {
                                apply(editor, text, change);
                            }));
+    applyToolTips(this);   // the artists' words for every control (studio/words.cpp)
     connect(doc, &SceneDocument::changed, this, [this] { refresh(); });
     showItem({});
 }
@@ -137,7 +139,7 @@ QWidget* PropertyPanel::buildSpeciesPage()
         const lb::Preset* preset = lb::findPreset(name.toStdString());
         const int i = m_item.row;
         if (!preset || i < 0) return;
-        apply(m_speciesPreset, tr("Change LB preset"), [&](Scene& s) {
+        apply(m_speciesPreset, tr("Change light transport preset"), [&](Scene& s) {
             SpeciesDesc& sp = s.species.at(size_t(i));
             // A preset sets the optics; solve settings the user chose stay.
             const lb::LbParams old = sp.lighting;
@@ -157,8 +159,8 @@ QWidget* PropertyPanel::buildSpeciesPage()
     form->addRow(m_speciesTitle);
     form->addRow(tr("Name"), m_speciesName);
     form->addRow(tr("Source"), m_speciesSource);
-    form->addRow(tr("LB preset"), m_speciesPreset);
-    form->addRow(tr("Grid"), m_speciesGrid);
+    form->addRow(tr("Light transport preset"), m_speciesPreset);
+    form->addRow(tr("Lighting detail"), m_speciesGrid);
     return page;
 }
 
@@ -169,13 +171,8 @@ QWidget* PropertyPanel::buildSunPage()
     m_sunElevation = sceneSpin("sun.elevation", "sun.elevation", 1, 1.0);
     m_sunAzimuth = spin("sun.azimuth", 0.0, 360.0, 1, 1.0);
     m_sunAzimuth->setWrapping(true);
-    m_sunDial = new QDial;
+    m_sunDial = new CompassDial;
     m_sunDial->setObjectName("sun.azimuthDial");
-    m_sunDial->setRange(0, 359);
-    m_sunDial->setWrapping(true);
-    m_sunDial->setNotchesVisible(true);
-    m_sunDial->setNotchTarget(15.0);
-    m_sunDial->setFixedSize(72, 72);
     m_sunTemperature = sceneSpin("sun.temperature", "sun.temperature", 0, 100.0);
     m_sunIntensity = sceneSpin("sun.intensity", "sun.intensity", 3, 0.1);
     auto setAngles = [this](QObject* editor, double elevation, double azimuth) {
@@ -188,7 +185,7 @@ QWidget* PropertyPanel::buildSunPage()
             [this, setAngles](double v) { setAngles(m_sunElevation, v, m_sunAzimuth->value()); });
     connect(m_sunAzimuth, &QDoubleSpinBox::valueChanged, this,
             [this, setAngles](double v) { setAngles(m_sunAzimuth, m_sunElevation->value(), v); });
-    // The dial's 0 is at the bottom; azimuth 0 (+Z) there, growing clockwise as on a compass seen from above.
+    // The compass dial's value is the azimuth (0 south at the bottom, 90 east at the right: a map, north up).
     connect(m_sunDial, &QDial::valueChanged, this,
             [this, setAngles](int v) { setAngles(m_sunDial, m_sunElevation->value(), double(v)); });
     connect(m_sunTemperature, &QDoubleSpinBox::valueChanged, this, [this](double v) {
@@ -224,7 +221,7 @@ QWidget* PropertyPanel::buildCameraPage()
     });
     form->addRow(tr("Position (m)"), row({m_camPos[0], m_camPos[1], m_camPos[2]}));
     form->addRow(tr("Target (m)"), row({m_camTarget[0], m_camTarget[1], m_camTarget[2]}));
-    form->addRow(tr("Vertical FOV (deg)"), m_camFov);
+    form->addRow(tr("Field of view (deg)"), m_camFov);
     return page;
 }
 

@@ -8,6 +8,19 @@
 
 namespace sylva {
 
+QString lastFolder(const QString& kind)
+{
+    const QString folder = QSettings().value(QStringLiteral("lastFolder/") + kind).toString();
+    return !folder.isEmpty() && QFileInfo(folder).isDir() ? folder : QString();
+}
+
+void rememberFolder(const QString& kind, const QString& path)
+{
+    if (path.isEmpty()) return;
+    const QFileInfo info(path);
+    QSettings().setValue(QStringLiteral("lastFolder/") + kind, info.isDir() ? info.absoluteFilePath() : info.absolutePath());
+}
+
 RecentFiles::RecentFiles(QMenu* menu, QObject* parent) : QObject(parent), m_menu(menu) { updateMenu(); }
 
 QStringList RecentFiles::files() const { return QSettings().value("recentFiles").toStringList(); }

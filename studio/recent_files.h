@@ -8,6 +8,13 @@ class QMenu;
 
 namespace sylva {
 
+// The folder a file dialog of one kind ("scenes", "meshes", "maps", "grids") starts in: the folder of the
+// last file (or the last folder) of that kind chosen, opened or saved (settings key lastFolder/<kind>), so
+// it survives the session; empty (the dialog's own default) before any.
+QString lastFolder(const QString& kind);
+// Remembers `path`'s folder (path itself when it is a folder) for dialogs of `kind`.
+void rememberFolder(const QString& kind, const QString& path);
+
 class RecentFiles : public QObject {
     Q_OBJECT
 

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <QMutexLocker>
+#include <QReadWriteLock>
 
 #include "core/backend/backend.h"
 #include "core/base/error.h"
@@ -126,7 +127,10 @@ void RenderWorker::run()
             process(req, progress);
         } catch (const Cancelled&) {
         } catch (const std::exception& e) {
-            m_frame.reset();
+            {
+                QWriteLocker lock(&m_frameLock);
+                m_frame.reset();
+            }
             m_frameAssets.clear();
             Q_EMIT failed(QString::fromStdString(e.what()));
         }
@@ -189,6 +193,12 @@ void RenderWorker::process(const Request& req, Progress& progress)
         a.render.mode = b.render.mode;
         a.render.exposureKey = b.render.exposureKey;
         if (changedParts(a, b) == ScenePart::None) {
+            // A request cancelled since may have re-placed the frame for its own scene (an instance deleted, then
+            // the delete undone before its first picture): the frame is placed for this scene again, as what the
+            // viewport picks in must hold the instances shown.
+            if (m_frame && !viewFrameUpdate(m_frameScene, scene).any() && viewFrameFits(*m_frame, scene))
+                place(scene, sunRadiance(scene.sun), std::max(1, req.size.width()), std::max(1, req.size.height()),
+                      passes.empty() ? 1 : passes.back().spp);
             const QImage img = picture(m_lastFilm, scene, req.compare);
             m_lastScene = scene;
             Q_EMIT imageReady(img, m_lastPass, true, elapsed(), req.serial);
@@ -201,17 +211,26 @@ void RenderWorker::process(const Request& req, Progress& progress)
     // built sky, light count, interleave, or the ground plane under it) builds the frame again.
     const ViewFrameUpdate update = m_frame ? viewFrameUpdate(m_frameScene, scene) : ViewFrameUpdate{};
     if (!m_frame || m_frameAssets != req.assets || !viewFrameFits(*m_frame, scene) || update.rebuild) {
-        m_frame.reset();
+        {
+            QWriteLocker lock(&m_frameLock);
+            m_frame.reset();
+        }
         std::vector<SpeciesAssets> copies;
         copies.reserve(req.assets.size());
         for (const AssetsPtr& a : req.assets) copies.push_back(*a);
-        m_frame = buildViewFrame(scene, copies, sunRadiance(scene.sun));
+        ViewFrame built = buildViewFrame(scene, copies, sunRadiance(scene.sun));
+        {
+            QWriteLocker lock(&m_frameLock);
+            m_frame = std::move(built);
+            m_placedAt = scene.camera.position;   // buildViewFrame places it at the scene's camera
+        }
         m_frameAssets = req.assets;
         m_frameRelight = {};
         m_frameScene = scene;
         ++m_frameBuilds;
         if (interrupted()) throw Cancelled();
     } else if (update.any()) {
+        QWriteLocker lock(&m_frameLock);
         try {
             updateViewFrame(*m_frame, scene, update);
         } catch (...) {
@@ -226,7 +245,10 @@ void RenderWorker::process(const Request& req, Progress& progress)
     if (!(m_frameRelight == req.relight)) {
         // A sun change relit from the species' bases: the composed grids into the kept frame (not
         // interrupted: a frame half relit would have to be built again).
-        applyRelighting(m_frame->rs, req.assets, req.relight);
+        {
+            QWriteLocker lock(&m_frameLock);
+            applyRelighting(m_frame->rs, req.assets, req.relight);
+        }
         m_frameRelight = req.relight;
         relit = req.relight.active();
         if (relit) ++m_relitFrames;
@@ -239,7 +261,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
                                              scene.render.spp, passes.empty() ? 0 : passes.back().spp);
     for (size_t p = 0; p < passes.size(); ++p) {
         const int pw = std::max(1, w / passes[p].divisor), ph = std::max(1, h / passes[p].divisor);
-        placeViewFrame(*m_frame, scene, sun, pw, ph, passes[p].spp);
+        place(scene, sun, pw, ph, passes[p].spp);
         RenderView view = m_frame->rs.view();
         if (refine.frames > 0) view.sky.lightCount = 0;   // moving: the sun alone
         // The first pass of a relit frame runs to its end even when the next sun is already asked for:
@@ -258,7 +280,7 @@ void RenderWorker::process(const Request& req, Progress& progress)
         Q_EMIT imageReady(img, int(p), last, elapsed(), req.serial);
     }
     if (refine.frames == 0) return;
-    placeViewFrame(*m_frame, scene, sun, w, h, refine.samples);
+    place(scene, sun, w, h, refine.samples);
     Film sum;
     int done = 0;
     for (int f = 0; f < refine.frames; ++f) {
@@ -277,6 +299,26 @@ void RenderWorker::process(const Request& req, Progress& progress)
         m_lastPass = last ? int(passes.size()) - 1 : -1;
         Q_EMIT imageReady(img, int(passes.size()) + f, last, elapsed(), req.serial);
     }
+}
+
+void RenderWorker::place(const Scene& scene, const glm::vec3& sun, int width, int height, int spp)
+{
+    QWriteLocker lock(&m_frameLock);
+    placeViewFrame(*m_frame, scene, sun, width, height, spp);
+    m_placedAt = scene.camera.position;
+}
+
+std::optional<ViewPick> RenderWorker::pick(const CameraDesc& camera, QSize size, QPointF pixel, int waitMs) const
+{
+    if (!m_frameLock.tryLockForRead(waitMs)) return std::nullopt;
+    std::optional<ViewPick> hit;
+    try {
+        if (m_frame) hit = pickViewFrame(*m_frame, m_placedAt, camera, size.width(), size.height(), pixel.x(), pixel.y());
+    } catch (const std::exception&) {
+        hit.reset();   // a degenerate camera: nothing to pick
+    }
+    m_frameLock.unlock();
+    return hit;
 }
 
 Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp)

@@ -12,6 +12,8 @@
 #include <QElapsedTimer>
 #include <QImage>
 #include <QMutex>
+#include <QPointF>
+#include <QReadWriteLock>
 #include <QSize>
 #include <QThread>
 #include <QWaitCondition>
@@ -101,6 +103,12 @@ public:
     int frameBuilds() const { return m_frameBuilds.load(); }
     int frameUpdates() const { return m_frameUpdates.load(); }
 
+    // What the camera ray through `pixel` (render pixels, y down) of a `size` picture of `camera` hits in the
+    // kept frame (pickViewFrame): read from the GUI thread while the worker traces (reads only; the worker's
+    // writes to the frame wait for it). Nothing when no frame is kept yet, or the worker is writing it
+    // (building, re-placing) for longer than `waitMs`.
+    std::optional<ViewPick> pick(const CameraDesc& camera, QSize size, QPointF pixel, int waitMs = 200) const;
+
 Q_SIGNALS:
     // pass: index into the schedule; last: the schedule is done; seconds: since the request; serial: the
     // request the image is for (latestRequest() says whether a newer one was made since).
@@ -124,6 +132,8 @@ private:
         quint64 serial = 0;
     };
     void process(const Request& req, Progress& progress);
+    // placeViewFrame on m_frame under m_frameLock, remembering the eye.
+    void place(const Scene& scene, const glm::vec3& sun, int width, int height, int spp);
     bool interrupted() const { return m_restart.load() || m_abort.load(); }
 
     mutable QMutex m_mutex;
@@ -134,8 +144,11 @@ private:
     std::atomic<bool> m_restart{false}, m_abort{false}, m_gpu{false}, m_gpuForget{false};
     bool m_hasRequest = false;
 
-    // Worker-thread state.
+    // Worker-thread state. m_frame and m_placedAt change (on the worker thread) only under m_frameLock
+    // written; pick reads them under it read.
+    mutable QReadWriteLock m_frameLock;
     std::optional<ViewFrame> m_frame;
+    glm::dvec3 m_placedAt{0.0};          // the eye m_frame was last placed for (its camera-relative origin)
     std::vector<AssetsPtr> m_frameAssets;
     Relighting m_frameRelight;            // the relighting m_frame's lighting array holds (inactive: the assets')
     std::atomic<int> m_relitFrames{0};

@@ -2,6 +2,7 @@
 #include "studio/scatter_tool.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "studio/camera_nav.h"
 #include "studio/dialogs.h"
@@ -23,6 +24,9 @@ ScatterSpec ScatterTool::defaultScatter() const
     spec.height = s.ground.height;
     spec.scaleMin = 0.8f;
     spec.scaleMax = 1.2f;
+    spec.clearCentre = {s.camera.position.x, s.camera.position.z};
+    const Bounds3 box = m_speciesBox && spec.species < s.species.size() ? m_speciesBox(int(spec.species)) : Bounds3{};
+    spec.clearRadius = std::max(kDefaultClearance, crownReach(box) * double(spec.scaleMax));
     if (!s.instances.empty()) {
         glm::dvec2 lo(1e300), hi(-1e300);
         for (const InstanceDesc& in : s.instances) {
@@ -36,7 +40,15 @@ ScatterSpec ScatterTool::defaultScatter() const
     return spec;
 }
 
-bool ScatterTool::scatter(const ScatterSpec& spec)
+double ScatterTool::crownReach(const Bounds3& b)
+{
+    if (!b.valid()) return 0.0;
+    const double x = std::max(std::abs(double(b.lo.x)), std::abs(double(b.hi.x)));
+    const double z = std::max(std::abs(double(b.lo.z)), std::abs(double(b.hi.z)));
+    return std::sqrt(x * x + z * z);
+}
+
+bool ScatterTool::scatter(const ScatterSpec& spec, bool frame)
 {
     Scene s = m_doc->scene();
     if (spec.species >= s.species.size()) {
@@ -59,11 +71,18 @@ bool ScatterTool::scatter(const ScatterSpec& spec)
         b.extend({float(spec.max.x), float(spec.height) + 5.0f, float(spec.max.y)});
         s.camera = framingCamera(s.camera, b);
     }
-    m_doc->edit(s, tr("Scatter %n instance(s) of %1", nullptr, spec.count).arg(QString::fromStdString(s.species[spec.species].name)));
+    const int placed = int(added.size());
+    m_doc->edit(s, tr("Scatter %n instance(s) of %1", nullptr, placed).arg(QString::fromStdString(s.species[spec.species].name)));
     log(tr("scattered %1 instances of %2 (seed %3)")
-            .arg(spec.count)
+            .arg(placed)
             .arg(QString::fromStdString(s.species[spec.species].name))
             .arg(spec.seed));
+    if (placed < spec.count)
+        log(tr("%1 of the %2 instances found no place outside the %3 m kept clear around the camera and were left out")
+                .arg(spec.count - placed)
+                .arg(spec.count)
+                .arg(spec.clearRadius));
+    if (frame) Q_EMIT frameRequested();
     return true;
 }
 
@@ -77,7 +96,7 @@ void ScatterTool::scatterDialog()
     QStringList names;
     for (const SpeciesDesc& sp : s.species) names << QString::fromStdString(sp.name);
     ScatterDialog d(names, defaultScatter(), m_window);
-    if (d.exec() == QDialog::Accepted) scatter(d.spec());
+    if (d.exec() == QDialog::Accepted) scatter(d.spec(), d.frameResult());
 }
 
 } // namespace sylva

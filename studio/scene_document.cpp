@@ -168,6 +168,9 @@ bool SceneEditCommand::mergeWith(const QUndoCommand* other)
     const auto* o = static_cast<const SceneEditCommand*>(other);
     if (m_mergeKey == 0 || o->m_mergeKey != m_mergeKey || o->m_epoch != m_epoch) return false;
     m_after = o->m_after;
+    // A gesture that ends where it began (a drag back to its start) leaves no step: the stack drops it
+    // (and is clean again if it was before the gesture).
+    setObsolete(changedParts(m_before, m_after) == ScenePart::None);
     return true;
 }
 

@@ -17,6 +17,7 @@
 
 #include "studio/form_widgets.h"
 #include "studio/param_widgets.h"
+#include "studio/words.h"
 
 namespace sylva {
 using namespace widgets;
@@ -32,7 +33,6 @@ QSpinBox* intSpin(const QString& name, int lo, int hi)
     return s;
 }
 
-const char* kTracers[3] = {"lb", "single", "combined"};
 
 } // namespace
 
@@ -55,11 +55,9 @@ QWidget* SceneItemPages::buildTerrainPage()
     m_terrainInfo->setWordWrap(true);
     m_terrainInfo->setTextInteractionFlags(Qt::TextSelectableByMouse);
     m_snowLine = sceneSpin("terrain.snow_line", "terrain.snowLine", 1, 50.0);
-    m_snowLine->setToolTip(tr("World height above which the ground is snow (0: no snow)"));
     connect(m_snowLine, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { m_apply(m_snowLine, tr("Change snow line"), [&](Scene& s) { s.terrain.snowLine = float(v); }); });
     m_rockSlope = sceneSpin("terrain.rock_slope", "terrain.rockSlope", 1, 1.0);
-    m_rockSlope->setToolTip(tr("Slopes steeper than this (degrees) are rock"));
     connect(m_rockSlope, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { m_apply(m_rockSlope, tr("Change rock slope"), [&](Scene& s) { s.terrain.rockSlope = float(v); }); });
     form->addRow(m_terrainInfo);
@@ -73,7 +71,6 @@ QWidget* SceneItemPages::buildTilesPage()
     auto* page = new QWidget;
     m_plantForm = new QFormLayout(page);
     m_tileSize = sceneSpin("terrain.tiles.size", "tiles.size", 1, 10.0);
-    m_tileSize->setToolTip(tr("The side of a square tile of plants, metres (the cells stretch it over themselves)"));
     connect(m_tileSize, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { m_apply(m_tileSize, tr("Change tile size"), [&](Scene& s) { s.terrain.tiles.size = v; }); });
     m_tileSeed = sceneIntSpin("terrain.tiles.seed", "tiles.seed");   // the file's range, clamped to an int
@@ -93,6 +90,7 @@ void SceneItemPages::rebuildPlantRows(const Scene& scene)
         m_plantSpacing.clear();
         for (size_t i = 0; i < plants.size(); ++i) {
             QDoubleSpinBox* box = sceneSpin("terrain.tiles.plants[i].spacing", QStringLiteral("tiles.spacing.%1").arg(i), 2, 0.5);
+            box->setToolTip(controlToolTip(box->objectName()));
             connect(box, &QDoubleSpinBox::valueChanged, this, [this, box, i](double v) {
                 m_apply(box, tr("Change plant spacing"), [&](Scene& s) { s.terrain.tiles.plants.at(i).spacing = v; });
             });
@@ -197,8 +195,10 @@ QWidget* SceneItemPages::buildVolumePage()
     });
     m_volumeTracer = new QComboBox;
     m_volumeTracer->setObjectName("volume.tracer");
-    for (const char* t : kTracers) m_volumeTracer->addItem(QString::fromLatin1(t));
-    m_volumeTracer->setToolTip(tr("lb: the LB solution along camera rays; single: a shadow march to the sun; combined: both"));
+    // In the order of VolumeTracer (lb, single, combined): the index is the value.
+    m_volumeTracer->addItem(tr("Scattered light (lighting grid)"));
+    m_volumeTracer->addItem(tr("Sun shadow only"));
+    m_volumeTracer->addItem(tr("Both"));
     connect(m_volumeTracer, &QComboBox::currentIndexChanged, this, [this](int idx) {
         const int i = m_item.row;
         if (i < 0 || idx < 0) return;
@@ -235,8 +235,8 @@ QWidget* SceneItemPages::buildVolumePage()
         });
     });
     form->addRow(m_volumeInfo);
-    form->addRow(tr("Optics"), m_volumePreset);
-    form->addRow(tr("Tracer"), m_volumeTracer);
+    form->addRow(tr("Material"), m_volumePreset);
+    form->addRow(tr("Lit by"), m_volumeTracer);
     form->addRow(tr("Density scale"), m_volumeDensityScale);
     form->addRow(tr("Position (m)"), posRow);
     form->addRow(tr("Scale"), m_volumeScale);

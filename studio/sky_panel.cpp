@@ -27,9 +27,11 @@
 #include "core/base/error.h"
 #include "core/sky/sun_position.h"
 #include "studio/camera_nav.h"
+#include "studio/recent_files.h"
 
 #include "studio/form_widgets.h"
 #include "studio/param_widgets.h"
+#include "studio/words.h"
 
 namespace sylva {
 using namespace widgets;
@@ -50,7 +52,10 @@ sky::SunPlace placeOf(const Scene& s) { return s.sun.place ? *s.sun.place : sky:
 SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc(doc)
 {
     m_chooseMap = [this] {
-        return QFileDialog::getOpenFileName(this, tr("HDR Environment Map"), QString(), tr("HDR maps (*.exr *.hdr);;All files (*)"));
+        const QString path = QFileDialog::getOpenFileName(this, tr("HDR Environment Map"), lastFolder(QStringLiteral("maps")),
+                                                          tr("HDR maps (*.exr *.hdr);;All files (*)"));
+        rememberFolder(QStringLiteral("maps"), path);
+        return path;
     };
     auto* layout = new QVBoxLayout(this);
     layout->setContentsMargins(4, 4, 4, 4);
@@ -60,11 +65,18 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     auto* skyForm = new QFormLayout(skyBox);
     m_kind = new QComboBox;
     m_kind->setObjectName("sky.kind");
-    m_kind->addItem(tr("Constant colour"), int(sky::SkyKind::Constant));
-    m_kind->addItem(tr("Preetham (analytic)"), int(sky::SkyKind::Preetham));
-    m_kind->addItem(tr("HDR map"), int(sky::SkyKind::Map));
-    m_kind->addItem(tr("Uniform colour (lights the plants)"), int(sky::SkyKind::Uniform));
-    skyForm->addRow(tr("Model"), m_kind);
+    m_kind->addItem(tr("Colour backdrop (lights nothing)"), int(sky::SkyKind::Constant));
+    m_kind->addItem(tr("Clear sky (follows the sun)"), int(sky::SkyKind::Preetham));
+    m_kind->addItem(tr("Photographed sky (HDR map)"), int(sky::SkyKind::Map));
+    m_kind->addItem(tr("Even sky light (lights the plants)"), int(sky::SkyKind::Uniform));
+    m_kind->setItemData(0, tr("A plain colour behind the trees: it is seen, but lights nothing (the sun lights the scene)"), Qt::ToolTipRole);
+    m_kind->setItemData(1, tr("A clear daytime sky computed from the sun's position and the haze: it lights the plants "
+                              "and changes with the sun"), Qt::ToolTipRole);
+    m_kind->setItemData(2, tr("A photographed sky (an HDR panorama): seen behind the trees, and its light lights the plants"),
+                        Qt::ToolTipRole);
+    m_kind->setItemData(3, tr("A sky of one colour that shines evenly from every direction: unlike the colour backdrop, it "
+                              "lights the plants (an overcast day)"), Qt::ToolTipRole);
+    skyForm->addRow(tr("Sky"), m_kind);
     connect(m_kind, &QComboBox::currentIndexChanged, this, [this](int idx) {
         const auto kind = sky::SkyKind(m_kind->itemData(idx).toInt());
         if (kind == sky::SkyKind::Map && m_doc->scene().skyModel.path.empty()) {
@@ -77,7 +89,6 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
 
     m_preethamRows = new QWidget;
     m_turbidity = sceneSpin("sky.turbidity", "sky.turbidity", 2, 0.25);
-    m_turbidity->setToolTip(tr("Haze of the atmosphere: 2 a very clear sky, 10 a hazy one"));
     connect(m_turbidity, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         apply(m_turbidity, tr("Change turbidity"), [&](Scene& s) { s.skyModel.turbidity = v; });
     });
@@ -95,7 +106,6 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     mapForm->addRow(tr("Map file"), row({m_path, m_browse}));
     m_rotation = spin("sky.rotation", -360.0, 360.0, 1, 5.0);
     m_rotation->setWrapping(true);
-    m_rotation->setToolTip(tr("Turns the map about the up axis (adds to every azimuth)"));
     connect(m_rotation, &QDoubleSpinBox::valueChanged, this, [this](double v) {
         apply(m_rotation, tr("Rotate sky map"), [&](Scene& s) { s.skyModel.rotationDeg = float(v); });
     });
@@ -110,22 +120,18 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     m_lightRows = new QWidget;
     QFormLayout* lightForm = form(m_lightRows);
     m_lights = sceneIntSpin("sky.lights", "sky.lights");
-    m_lights->setToolTip(tr("Virtual directional lights the sky is split into (the sun is its own light)"));
     connect(m_lights, &QSpinBox::valueChanged, this, [this](int v) {
         apply(m_lights, tr("Change sky lights"), [&](Scene& s) { s.skyModel.lights = v; });
     });
-    lightForm->addRow(tr("Lights"), m_lights);
+    lightForm->addRow(tr("Sky samples"), m_lights);
     m_interleave = sceneIntSpin("sky.interleave", "sky.interleave");
-    m_interleave->setToolTip(tr("Subsets of the lights over neighbouring pixels and samples (interleaved sampling)"));
     connect(m_interleave, &QSpinBox::valueChanged, this, [this](int v) {
         apply(m_interleave, tr("Change sky interleave"), [&](Scene& s) { s.skyModel.interleave = v; });
     });
-    lightForm->addRow(tr("Interleave"), m_interleave);
+    lightForm->addRow(tr("Sky sample groups"), m_interleave);
     skyForm->addRow(m_lightRows);
-    m_lbSky = new QCheckBox(tr("Sky in the LB lighting"));
+    m_lbSky = new QCheckBox(tr("Skylight inside the crowns"));
     m_lbSky->setObjectName("lighting.boundary");
-    m_lbSky->setToolTip(tr("The LB boundary holds the sky as well as the sun, so leaves also get skylight scattered through the "
-                           "crown (lighting.boundary sun_sky; the species are lit again)"));
     connect(m_lbSky, &QCheckBox::toggled, this, [this](bool on) {
         apply(m_lbSky, tr("Change LB boundary"), [&](Scene& s) { s.lighting.boundary = on ? LbBoundary::SunSky : LbBoundary::Sun; });
     });
@@ -156,13 +162,8 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     m_elevation = sceneSpin("sun.elevation", "sun.elevation", 1, 1.0);
     m_azimuth = spin("sun.azimuth", 0.0, 360.0, 1, 1.0);
     m_azimuth->setWrapping(true);
-    m_dial = new QDial;
+    m_dial = new CompassDial;
     m_dial->setObjectName("sun.azimuthDial");
-    m_dial->setRange(0, 359);
-    m_dial->setWrapping(true);
-    m_dial->setNotchesVisible(true);
-    m_dial->setNotchTarget(15.0);
-    m_dial->setFixedSize(72, 72);
     auto setAngles = [this](QObject* editor, double elevation, double azimuth) {
         apply(editor, tr("Move sun"), [&](Scene& s) {
             s.sun.place.reset();
@@ -173,7 +174,7 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
             [this, setAngles](double v) { setAngles(m_elevation, v, m_azimuth->value()); });
     connect(m_azimuth, &QDoubleSpinBox::valueChanged, this,
             [this, setAngles](double v) { setAngles(m_azimuth, m_elevation->value(), v); });
-    // As the properties' dial: 0 at the bottom is azimuth 0 (+Z), clockwise as a compass seen from above.
+    // As the properties' dial: the value is the azimuth (0 south at the bottom, 90 east at the right: a map, north up).
     connect(m_dial, &QDial::valueChanged, this, [this, setAngles](int v) { setAngles(m_dial, m_elevation->value(), double(v)); });
     dialForm->addRow(tr("Elevation (deg)"), m_elevation);
     dialForm->addRow(tr("Azimuth (deg)"), row({m_dial, m_azimuth}));
@@ -206,12 +207,10 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     m_timeSlider->setRange(0, 24 * 60 - 1);   // minutes of the local day
     m_timeSlider->setSingleStep(5);
     m_timeSlider->setPageStep(60);
-    m_timeSlider->setToolTip(tr("Local clock time: drag to move the sun through the day"));
     connect(m_timeSlider, &QSlider::valueChanged, this, [this](int minutes) {
         applyPlace(m_timeSlider, [minutes](sky::SunPlace& p) { p.hour = minutes / 60.0; });
     });
     m_zone = sceneSpin("sun.timezone", "sun.timezone", 2, 0.5);
-    m_zone->setToolTip(tr("Hours of local time ahead of UTC (east +: 1 for CET, 2 for CEST)"));
     connect(m_zone, &QDoubleSpinBox::valueChanged, this,
             [this](double v) { applyPlace(m_zone, [v](sky::SunPlace& p) { p.timeZoneHours = v; }); });
     m_latitude = sceneSpin("sun.latitude", "sun.latitude", 4, 0.5);
@@ -238,6 +237,7 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     m_status->setStyleSheet("color: #b00020");
     layout->addWidget(m_status);
     layout->addStretch(1);
+    applyToolTips(this);   // the artists' words for every control (studio/words.cpp)
 
     connect(doc, &SceneDocument::changed, this, [this] {
         m_status->clear();

@@ -15,6 +15,7 @@
 #include "studio/camera_nav.h"
 #include "studio/dialogs.h"
 #include "studio/job_manager.h"
+#include "studio/recent_files.h"
 #include "studio/scene_document.h"
 
 namespace sylva {
@@ -125,8 +126,10 @@ void SpeciesImporter::growSpecies(const GrowSpec& spec)
 
 void SpeciesImporter::importDialog()
 {
-    const QString path = QFileDialog::getOpenFileName(m_window, tr("Import Mesh"), QString(), meshFilter());
-    if (!path.isEmpty()) importMesh(path);
+    const QString path = QFileDialog::getOpenFileName(m_window, tr("Import Mesh"), lastFolder(QStringLiteral("meshes")), meshFilter());
+    if (path.isEmpty()) return;
+    rememberFolder(QStringLiteral("meshes"), path);
+    importMesh(path);
 }
 
 void SpeciesImporter::growDialog()

@@ -1,6 +1,8 @@
-// Viewport: film texture on a quad, overlay text, mouse navigation feeding undoable camera edits.
+// Viewport: film texture on a quad, overlay text and selection, mouse navigation feeding undoable camera
+// edits, picking by one traced ray.
 #include "studio/viewport.h"
 
+#include <QApplication>
 #include <QDateTime>
 #include <QKeyEvent>
 #include <QMouseEvent>
@@ -16,6 +18,7 @@
 #include "studio/camera_nav.h"
 #include "studio/render_worker.h"
 #include "studio/scene_document.h"
+#include "studio/words.h"
 
 namespace sylva {
 namespace {
@@ -36,6 +39,10 @@ varying vec2 uv;
 void main() { gl_FragColor = vec4(texture2D(film, uv).rgb, 1.0); }
 )";
 
+// How long a pan or a wheel notch waits for the worker's frame to pick what is under the cursor (the worker
+// holds it only to build, update or re-place it): past that it goes by the target, the GUI does not stall.
+constexpr int kNavigationPickMs = 20;
+
 } // namespace
 
 Viewport::Viewport(QWidget* parent) : QOpenGLWidget(parent), m_worker(new RenderWorker(this)), m_quad(QOpenGLBuffer::VertexBuffer)
@@ -50,6 +57,7 @@ Viewport::Viewport(QWidget* parent) : QOpenGLWidget(parent), m_worker(new Render
     connect(m_worker, &RenderWorker::gpuFrameReady, this, [this](const GpuFramePtr& frame) {
         if (!m_interop || frame->assets != m_assets) return;   // stale: the assets changed again meanwhile
         m_gpuFrame = frame;
+        m_gpuPlacedAt = frame->built.camera.position;   // the worker placed it at the scene's camera
         m_gpuPass = 0;
         update();
     });
@@ -84,6 +92,11 @@ QSize Viewport::renderSize() const
 
 void Viewport::setScene(const Scene& scene, std::vector<AssetsPtr> assets, Relighting relight)
 {
+    if (assets != m_assets || m_speciesBoxes.size() != scene.species.size()) {
+        m_speciesBoxes.assign(scene.species.size(), Bounds3{});
+        for (size_t k = 0; k < assets.size() && k < m_speciesBoxes.size(); ++k)
+            if (assets[k]) m_speciesBoxes[k] = meshBounds(assets[k]->mesh);
+    }
     m_scene = scene;
     m_assets = std::move(assets);
     m_relight = std::move(relight);
@@ -112,11 +125,11 @@ void Viewport::requestRender()
         m_gpuPass = 0;
         if (!m_gpuFrame || m_gpuFrame->assets != m_assets || !viewFrameFits(m_gpuFrame->frame, m_scene) ||
             viewFrameUpdate(m_gpuFrame->built, m_scene).any())
-            m_worker->request(m_scene, m_assets, renderSize(), m_compare);
+            m_worker->request(viewScene(), m_assets, renderSize(), m_compare);
         update();
         return;
     }
-    m_worker->request(m_scene, m_assets, renderSize(), m_compare, m_relight);
+    m_worker->request(viewScene(), m_assets, renderSize(), m_compare, m_relight);
 }
 
 void Viewport::onImage(const QImage& image, int pass, bool last, double seconds, quint64 serial)
@@ -247,6 +260,8 @@ void Viewport::paintGL()
         m_imageDirty = false;
     }
     drawTexture();
+    drawCameraFrame();
+    drawSelection();
     if (m_compare && m_texture && m_texture->width() > 0) {
         // The split the renderer made (column width / 2 of the picture), and which mode is where.
         QPainter p(this);
@@ -254,8 +269,8 @@ void Viewport::paintGL()
         const int x = int(double(width()) * double(iw / 2) / double(iw));
         p.setPen(QColor(255, 255, 255, 200));
         p.drawLine(x, 0, x, height());
-        p.drawText(QRect(8, 8, x - 16, 20), Qt::AlignLeft | Qt::AlignTop, QString::fromLatin1(renderModeName(m_scene.render.mode)));
-        p.drawText(QRect(x + 8, 8, width() - x - 16, 20), Qt::AlignLeft | Qt::AlignTop, QString::fromLatin1(renderModeName(*m_compare)));
+        p.drawText(QRect(8, 8, x - 16, 20), Qt::AlignLeft | Qt::AlignTop, renderModeLabel(m_scene.render.mode));
+        p.drawText(QRect(x + 8, 8, width() - x - 16, 20), Qt::AlignLeft | Qt::AlignTop, renderModeLabel(*m_compare));
     }
     if (!m_status.isEmpty()) {
         QPainter p(this);
@@ -323,7 +338,8 @@ bool Viewport::paintGpu()
     }
     const size_t pass = m_gpuPass;
     const bool last = pass + 1 == spps.size();
-    placeViewFrame(m_gpuFrame->frame, m_scene, sunRadiance(m_scene.sun), w, h, spps[pass]);
+    placeViewFrame(m_gpuFrame->frame, viewScene(), sunRadiance(m_scene.sun), w, h, spps[pass]);
+    m_gpuPlacedAt = m_scene.camera.position;
     const uint32_t skyLights = rs.frame.sky.lightCount;
     if (refine.frames > 0 && !last) rs.frame.sky.lightCount = 0;   // moving: the sun alone
     m_gpuFrame->device->place(rs);
@@ -367,6 +383,15 @@ void Viewport::mousePressEvent(QMouseEvent* event)
     m_dragStart = event->position().toPoint();
     m_dragCamera = m_scene.camera;
     m_dragKey = SceneDocument::newMergeKey();
+    m_dragMoved = false;
+    m_panDepth = 0.0;
+    if (pan) {
+        // Grab what is under the cursor: it follows the cursor at its own depth (the target's without a hit).
+        if (const std::optional<ViewPick> hit = pickAt(event->position(), kNavigationPickMs); hit && hit->kind != SurfaceKind::None) {
+            const glm::dvec3 view = m_scene.camera.target - m_scene.camera.position;
+            if (glm::length(view) > 0.0) m_panDepth = glm::dot(hit->point - m_scene.camera.position, glm::normalize(view));
+        }
+    }
     event->accept();
 }
 
@@ -374,11 +399,21 @@ void Viewport::mouseMoveEvent(QMouseEvent* event)
 {
     if (m_drag == Drag::None) return;
     const QPoint d = event->position().toPoint() - m_dragStart;
+    // A press is a click until the cursor has moved the platform's drag distance: a click changes no camera.
+    if (!m_dragMoved && d.manhattanLength() < QApplication::startDragDistance()) return;
+    m_dragMoved = true;
     CameraDesc c;
     switch (m_drag) {
     case Drag::Orbit: c = orbitCamera(m_dragCamera, -0.4 * d.x(), 0.4 * d.y()); break;
     case Drag::Look: c = flyLook(m_dragCamera, 0.3 * d.x(), -0.3 * d.y()); break;
-    default: c = panCamera(m_dragCamera, d.x(), d.y(), height()); break;
+    default: {
+        // At the viewport's field of view (the grabbed point follows the cursor); the scene's is kept.
+        CameraDesc seen = m_dragCamera;
+        seen.fovY = viewCamera().fovY;
+        c = panCamera(seen, d.x(), d.y(), height(), m_panDepth);
+        c.fovY = m_dragCamera.fovY;
+        break;
+    }
     }
     Q_EMIT cameraEdited(c, m_dragKey);
     event->accept();
@@ -388,7 +423,13 @@ void Viewport::mouseReleaseEvent(QMouseEvent* event)
 {
     if (m_drag == Drag::None) return;
     mouseMoveEvent(event);
+    const Drag drag = m_drag;
     m_drag = Drag::None;
+    if (m_dragMoved || drag == Drag::Pan || event->button() != Qt::LeftButton) return;
+    // A click: select what is under the cursor (nothing: clear the selection).
+    const std::optional<ViewPick> hit = pickAt(event->position());
+    if (!hit) return;   // no frame yet to pick in
+    Q_EMIT instancePicked(hit->instance);
 }
 
 void Viewport::wheelEvent(QWheelEvent* event)
@@ -399,8 +440,160 @@ void Viewport::wheelEvent(QWheelEvent* event)
     const qint64 now = QDateTime::currentMSecsSinceEpoch();
     if (m_wheelKey == 0 || now - m_lastWheelMs > 500) m_wheelKey = SceneDocument::newMergeKey();
     m_lastWheelMs = now;
-    Q_EMIT cameraEdited(zoomCamera(m_scene.camera, steps), m_wheelKey);
+    // Toward what is under the cursor (its distance sets the step), else toward the target.
+    const std::optional<ViewPick> hit = pickAt(event->position(), kNavigationPickMs);
+    const CameraDesc c = hit && hit->kind != SurfaceKind::None ? zoomCameraAbout(m_scene.camera, steps, hit->point)
+                                                              : zoomCamera(m_scene.camera, steps);
+    Q_EMIT cameraEdited(c, m_wheelKey);
     event->accept();
+}
+
+std::optional<ViewPick> Viewport::pickAt(QPointF pos, int waitMs) const
+{
+    const QSize size = renderSize();
+    const QPointF pixel(pos.x() * double(size.width()) / double(std::max(1, width())),
+                        pos.y() * double(size.height()) / double(std::max(1, height())));
+    if (m_interop && m_gpuFrame) {
+        try {
+            return pickViewFrame(m_gpuFrame->frame, m_gpuPlacedAt, viewCamera(), size.width(), size.height(), pixel.x(), pixel.y());
+        } catch (const std::exception&) {
+            return std::nullopt;
+        }
+    }
+    return m_worker->pick(viewCamera(), size, pixel, waitMs);
+}
+
+void Viewport::setSelectedInstance(int instance)
+{
+    if (m_selected == instance) return;
+    m_selected = instance;
+    update();   // the overlay only: the picture is not traced again
+}
+
+Bounds3 Viewport::selectionBounds() const
+{
+    if (m_selected < 0 || size_t(m_selected) >= m_scene.instances.size()) return {};
+    const InstanceDesc& in = m_scene.instances[size_t(m_selected)];
+    if (in.group != kNoGroup || in.species >= m_speciesBoxes.size() || !m_speciesBoxes[in.species].valid()) return {};
+    return instanceBounds(m_scene, in, m_speciesBoxes[in.species]);
+}
+
+QRectF Viewport::selectionRect() const
+{
+    const Bounds3 b = selectionBounds();
+    if (!b.valid()) return {};
+    double x0 = 1e300, y0 = 1e300, x1 = -1e300, y1 = -1e300;
+    for (int k = 0; k < 8; ++k) {
+        glm::dvec2 px;
+        const glm::dvec3 corner((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
+        if (!projectToView(viewCamera(), width(), height(), corner, &px)) return {};
+        x0 = std::min(x0, px.x);
+        y0 = std::min(y0, px.y);
+        x1 = std::max(x1, px.x);
+        y1 = std::max(y1, px.y);
+    }
+    return QRectF(QPointF(x0, y0), QPointF(x1, y1));
+}
+
+void Viewport::drawSelection()
+{
+    const Bounds3 b = selectionBounds();
+    if (!b.valid()) return;
+    // The box's twelve edges, each drawn when both its ends are in front of the eye.
+    glm::dvec2 px[8];
+    bool front[8];
+    for (int k = 0; k < 8; ++k) {
+        const glm::dvec3 corner((k & 1) ? b.hi.x : b.lo.x, (k & 2) ? b.hi.y : b.lo.y, (k & 4) ? b.hi.z : b.lo.z);
+        front[k] = projectToView(viewCamera(), width(), height(), corner, &px[k]);
+    }
+    QPainter p(this);
+    p.setRenderHint(QPainter::Antialiasing, false);
+    p.setPen(QPen(QColor(255, 160, 32), 2.0));   // Blender's selection orange
+    for (int k = 0; k < 8; ++k)
+        for (int bit = 1; bit < 8; bit <<= 1) {
+            const int j = k | bit;
+            if (j == k || !front[k] || !front[j]) continue;
+            p.drawLine(QPointF(px[k].x, px[k].y), QPointF(px[j].x, px[j].y));
+        }
+}
+
+bool Viewport::frameBox(const Bounds3& box)
+{
+    if (!box.valid()) return false;
+    // Into the render's frame when it is shown (what is exported is framed), else the viewport.
+    const double aspect = m_cameraFrame ? double(std::max(1, m_scene.render.width)) / double(std::max(1, m_scene.render.height))
+                                        : double(std::max(1, width())) / double(std::max(1, height()));
+    const CameraDesc c = frameBoxCamera(m_scene.camera, box, aspect);
+    Q_EMIT cameraEdited(c, SceneDocument::newMergeKey());
+    return true;
+}
+
+void Viewport::setCameraFrame(bool on)
+{
+    if (m_cameraFrame == on) return;
+    m_cameraFrame = on;
+    requestRender();   // the field of view may change
+    update();
+}
+
+CameraDesc Viewport::viewCamera() const
+{
+    CameraDesc c = m_scene.camera;
+    if (!m_cameraFrame || width() <= 0 || height() <= 0 || m_scene.render.width <= 0 || m_scene.render.height <= 0) return c;
+    const double render = double(m_scene.render.width) / double(m_scene.render.height);
+    const double view = double(width()) / double(height());
+    if (render <= view) return c;
+    constexpr double kDegToRad = 3.14159265358979323846 / 180.0;
+    const double tanY = std::tan(double(c.fovY) * 0.5 * kDegToRad) * render / view;
+    c.fovY = float(2.0 * std::atan(tanY) / kDegToRad);
+    return c;
+}
+
+Scene Viewport::viewScene() const
+{
+    Scene s = m_scene;
+    s.camera = viewCamera();
+    return s;
+}
+
+QRectF Viewport::cameraFrameRect() const
+{
+    if (!m_cameraFrame || m_scene.render.width <= 0 || m_scene.render.height <= 0 || width() <= 0 || height() <= 0) return {};
+    const double render = double(m_scene.render.width) / double(m_scene.render.height);
+    const double w = width(), h = height();
+    if (render <= w / h) return QRectF(0.5 * (w - h * render), 0.0, h * render, h);   // the full height
+    return QRectF(0.0, 0.5 * (h - w / render), w, w / render);                        // the full width
+}
+
+void Viewport::drawCameraFrame()
+{
+    const QRectF frame = cameraFrameRect();
+    if (frame.isEmpty()) return;
+    QPainter p(this);
+    const QColor shade(0, 0, 0, 120);
+    const QRectF all(rect());
+    p.fillRect(QRectF(all.left(), all.top(), all.width(), frame.top() - all.top()), shade);
+    p.fillRect(QRectF(all.left(), frame.bottom(), all.width(), all.bottom() + 1.0 - frame.bottom()), shade);
+    p.fillRect(QRectF(all.left(), frame.top(), frame.left() - all.left(), frame.height()), shade);
+    p.fillRect(QRectF(frame.right(), frame.top(), all.right() + 1.0 - frame.right(), frame.height()), shade);
+    p.setPen(QPen(QColor(255, 255, 255, 140), 1.0));
+    p.drawRect(frame.adjusted(0.5, 0.5, -0.5, -0.5));
+}
+
+bool Viewport::frameAll() { return frameBox(sceneBounds(m_scene, m_speciesBoxes)); }
+
+bool Viewport::frameSelected()
+{
+    if (m_selected < 0 || size_t(m_selected) >= m_scene.instances.size()) return false;
+    Bounds3 b = selectionBounds();
+    if (!b.valid()) {
+        // The species is not loaded yet: its position, a metre around it.
+        const InstanceDesc& in = m_scene.instances[size_t(m_selected)];
+        b = instanceBounds(m_scene, in, Bounds3{});
+        b.lo -= glm::vec3(1.0f);
+        b.hi += glm::vec3(1.0f);
+    }
+    return frameBox(b);
 }
 
 } // namespace sylva

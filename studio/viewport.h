@@ -65,12 +65,50 @@ public:
     // Metres per key press (flyStepFor): over a terrain 0.5% of its size, else 5% of the eye-target distance.
     double flyStep() const;
 
+    // Picking: what the camera ray through widget position `pos` (logical pixels) hits, traced in the frame
+    // the picture is drawn from (the worker's on the CPU, the viewport's on the GPU); nothing before a frame
+    // exists, or when the worker holds its frame to write it for longer than waitMs. A click (press and release
+    // of the left button without a drag) picks and emits instancePicked.
+    std::optional<ViewPick> pickAt(QPointF pos, int waitMs = 200) const;
+
+    // The selected instance (index into Scene::instances; -1: none), outlined over the picture by its box's
+    // twelve edges projected with the scene's camera (an overlay: the render does not restart).
+    void setSelectedInstance(int instance);
+    int selectedInstance() const { return m_selected; }
+    // The selected instance's world box (invalid: none, or its species' mesh is not loaded yet) and the
+    // bounding rectangle of its projected corners in widget pixels (empty when a corner is behind the eye).
+    Bounds3 selectionBounds() const;
+    QRectF selectionRect() const;
+    // The species' mesh boxes (species frame) from the assets the viewport draws (invalid until loaded).
+    const std::vector<Bounds3>& speciesBoxes() const { return m_speciesBoxes; }
+
+    // The render camera's frame (View > Camera Frame): the part of the viewport that the render (render.width x
+    // render.height) shows, the rest darkened. On, the viewport's camera is the scene's with its field of view
+    // widened when the render is wider than the viewport (viewCamera), so the whole rendered picture lies
+    // inside the viewport, centred: what is exported is what is framed. Off (the default), the viewport
+    // shows the scene's camera at its own aspect.
+    void setCameraFrame(bool on);
+    bool cameraFrame() const { return m_cameraFrame; }
+    // The render's frame in widget pixels (empty when the camera frame is off).
+    QRectF cameraFrameRect() const;
+    // The camera the viewport traces, picks and projects with: the scene's, its vertical field of view
+    // widened by the render's aspect over the viewport's when the camera frame is on and the render is wider.
+    CameraDesc viewCamera() const;
+
+    // View > Frame All / Frame Selected: the scene's box (sceneBounds) or the selected instance's, framed
+    // from the current view direction (frameBoxCamera); one camera edit. false (nothing edited) when there is
+    // nothing to frame.
+    bool frameAll();
+    bool frameSelected();
+
 Q_SIGNALS:
     // Navigation changed the camera; consecutive events of one gesture share mergeKey.
     void cameraEdited(const sylva::CameraDesc& camera, int mergeKey);
     void imageShown(int pass, bool last, double seconds);
     void renderFailed(const QString& message);
     void flyModeChanged(bool on);
+    // A click picked this instance (index into Scene::instances), or -1: the sky, the ground, the terrain.
+    void instancePicked(int instance);
     // The GPU path was switched off (why); rendering goes on on the CPU.
     void gpuDisabled(const QString& message);
 
@@ -91,10 +129,16 @@ private:
     void setupGpu();
     bool paintGpu();   // false: no GPU frame to show yet
     void disableGpu(const QString& why);
+    void drawSelection();
+    bool frameBox(const Bounds3& box);
+    void drawCameraFrame();
+    Scene viewScene() const;   // m_scene with viewCamera()
 
     RenderWorker* m_worker;
     Scene m_scene;
     std::vector<AssetsPtr> m_assets;
+    std::vector<Bounds3> m_speciesBoxes;   // meshBounds of m_assets' meshes
+    int m_selected = -1;
     Relighting m_relight;
     QString m_status;
 
@@ -108,12 +152,15 @@ private:
     // navigation
     enum class Drag { None, Orbit, Pan, Look };
     Drag m_drag = Drag::None;
+    bool m_dragMoved = false;   // past the drag distance: a drag, not a click
+    double m_panDepth = 0.0;    // metres along the view to what the pan grabbed (0: the target's distance)
     QPoint m_dragStart;
     CameraDesc m_dragCamera;
     int m_dragKey = 0;
     int m_wheelKey = 0;
     qint64 m_lastWheelMs = 0;
     bool m_fly = false;
+    bool m_cameraFrame = false;
     std::optional<RenderMode> m_compare;
     int m_flyKey = 0;
     qint64 m_lastFlyMs = 0;
@@ -127,6 +174,7 @@ private:
     // GPU path: the device's display (null: CPU path)
     std::unique_ptr<DeviceDisplay> m_interop;
     GpuFramePtr m_gpuFrame;
+    glm::dvec3 m_gpuPlacedAt{0.0};   // the eye m_gpuFrame was last placed for
     GLuint m_pbo = 0;
     QSize m_pboSize;
     size_t m_gpuPass = 0;   // index into the full-size passes of the worker's schedule

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "core/render/shade.h"
+#include "core/render/trace.h"
 #include "pipeline/lighting_job.h"
 #include "pipeline/render/frame_build.h"
 
@@ -111,6 +113,26 @@ bool viewFrameFits(const ViewFrame& frame, const Scene& scene) { return hasLevel
 void placeViewFrame(ViewFrame& frame, const Scene& scene, const glm::vec3& sunRadiance, int width, int height, int spp)
 {
     placeTopLevel(frame.rs, scene, sunRadiance, width, height, spp);
+}
+
+ViewPick pickViewFrame(const ViewFrame& frame, const glm::dvec3& placedAt, const CameraDesc& camera, int width, int height,
+                       double x, double y)
+{
+    ViewPick out;
+    if (width <= 0 || height <= 0 || frame.rs.frame.width <= 0) return out;
+    RenderView v = frame.rs.view();
+    v.camera = makeCamera(camera, width, height);
+    v.width = width;
+    v.height = height;
+    Ray ray = cameraRay(v, float(x), float(y));
+    ray.org = glm::vec3(camera.position - placedAt);   // the frame's origin is the eye it was placed for
+    Hit hit{};
+    if (!traceScene<false>(v, ray, hit)) return out;
+    out.kind = hitKind(hit);
+    if (out.kind == SurfaceKind::Instances && hit.inst != kNoHit) out.instance = int(hit.inst);
+    out.distance = double(hit.t) * double(glm::length(ray.dir));
+    out.point = placedAt + glm::dvec3(ray.org) + double(hit.t) * glm::dvec3(ray.dir);
+    return out;
 }
 
 } // namespace sylva

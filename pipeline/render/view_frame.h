@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/render/render_scene.h"
+#include "core/render/surfaces/surface_list.h"
 #include "core/scene/scene.h"
 
 namespace sylva {
@@ -27,6 +28,19 @@ bool viewFrameFits(const ViewFrame& frame, const Scene& scene);
 // frame was built with. Costs O(instances); throws Error on a degenerate camera, a missing species, or a
 // frame that does not fit (viewFrameFits).
 void placeViewFrame(ViewFrame& frame, const Scene& scene, const glm::vec3& sunRadiance, int width, int height, int spp);
+
+// What one camera ray hits: the ray through image position (x, y) (pixels, y down) of a width x height
+// picture of `camera` (cameraRay's ray, traced by traceScene as the renderer traces a pixel's first hit) in a
+// frame last placed (placeViewFrame) for a camera at `placedAt` (the frame is camera-relative to that eye;
+// `camera` may have moved since, the instances must not). kind None: the ray left the scene (the sky).
+struct ViewPick {
+    SurfaceKind kind = SurfaceKind::None;
+    int instance = -1;            // kind Instances: the index into Scene::instances of the top-level instance hit
+    double distance = 0.0;        // metres from the eye along the ray
+    glm::dvec3 point{0.0};        // world metres
+};
+ViewPick pickViewFrame(const ViewFrame& frame, const glm::dvec3& placedAt, const CameraDesc& camera, int width, int height,
+                       double x, double y);
 
 // Parts of two scenes that the frame's camera-independent build reads (what placeViewFrame does not redo).
 bool sameTerrainHeights(const TerrainDesc& a, const TerrainDesc& b);      // DEM, its heights, origin, spacing, scale

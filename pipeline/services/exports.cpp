@@ -36,13 +36,20 @@ void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, 
     if (progress && progress->isCancelled()) traceProgress.cancel();
     const Film film = backend ? backend->render(rs, &traceProgress) : renderFilm(rs.view(), &traceProgress);
     if (progress) progress->report(0.96, "writing");
+    writeRenderFilm(path, film, scene, passes);
+    if (progress) progress->report(1.0, "written");
+}
+
+void writeRenderFilm(const std::string& path, const Film& film, const Scene& scene, bool passes)
+{
+    if (passes && lowerExtension(path) != ".exr")
+        throw Error(path + ": render passes are written as a multi-layer OpenEXR file (use .exr)");
     if (passes) {
         writeRenderPasses(path, renderPasses(film, scene.render.mode, composeSky(scene)));
     } else {
         const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, composeSky(scene));
         writeRender(path, linear, film.width, film.height, scene.render.exposureKey);
     }
-    if (progress) progress->report(1.0, "written");
 }
 
 std::string gridFileBase(const std::string& speciesName)

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/base/progress.h"
+#include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/scene/scene.h"
 #include "pipeline/io/grid_file.h"
@@ -27,6 +28,11 @@ std::vector<std::string> speciesLogLines(const std::string& species, const JobLo
 // instead (one multi-layer EXR: .exr only). Throws Error (bad extension, unwritable file) or Cancelled.
 void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, const std::string& path,
                   Backend* backend = nullptr, Progress* progress = nullptr, bool passes = false);
+
+// The file exportRender writes, for a film of `scene` already traced (the studio's render window saves
+// its finished render with it): `scene`'s mode, sky and exposure key; .png/.tif/.tiff tone-mapped 8-bit,
+// .exr linear, or with `passes` the multi-layer EXR. Throws Error (bad extension, unwritable file).
+void writeRenderFilm(const std::string& path, const Film& film, const Scene& scene, bool passes = false);
 
 // A file name base for a species' grids: ASCII letters, digits, '.', '-' and '_' kept, any other
 // character '_' ("Tree 1 (2)/x" -> "Tree_1__2__x"); "species" for an empty name.

@@ -68,6 +68,9 @@ inline void isolate(const QTemporaryDir& dir)
     QApplication::setOrganizationName("SylvaTest");
     QApplication::setApplicationName("sylva-studio-test");
     QSettings().clear();   // test mode keeps its files between runs (~/.qttest)
+    // The viewport at its own aspect (View > Camera Frame off): the tests compare its pictures with headless
+    // renders of the scene's camera at the viewport's size; tst_studio_artist tests the camera frame.
+    QSettings().setValue("view/cameraFrame", false);
     // No crash recovery left over from an earlier run (its question would block the test).
     QDir(QFileInfo(AutosaveController::recoveryFilePath()).absolutePath()).removeRecursively();
     qputenv("XDG_CACHE_HOME", dir.filePath("cache").toLocal8Bit());

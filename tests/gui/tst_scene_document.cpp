@@ -11,10 +11,13 @@
 #include <QTemporaryDir>
 #include <QTest>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/base/error.h"
 #include "core/lb/lb_params.h"
+#include "core/render/render_scene.h"
+#include "core/render/shade.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/camera_nav.h"
 #include "studio/outliner_model.h"
@@ -252,6 +255,103 @@ private Q_SLOTS:
         double el = 0.0, az = 0.0;
         sunAngles(sunDirection(35.0, 250.0), &el, &az);
         QVERIFY(std::abs(el - 35.0) < 1e-4 && std::abs(az - 250.0) < 1e-4);
+    }
+
+    // No movement is no change (bit for bit: a click must not become a camera edit); zoom about a point keeps
+    // it on its pixel; a pan at a depth carries a point at that depth with the cursor; framing puts the box's
+    // farthest projected corner at `fill`; projectToView inverts the renderer's cameraRay; instance boxes.
+    void navigationAboutPoints()
+    {
+        CameraDesc c;
+        c.position = {3.0, 4.0, -12.0};
+        c.target = {0.5, 2.0, 1.0};
+        auto same = [](const CameraDesc& a, const CameraDesc& b) { return a.position == b.position && a.target == b.target; };
+        QVERIFY(same(orbitCamera(c, 0.0, 0.0), c));
+        QVERIFY(same(flyLook(c, 0.0, 0.0), c));
+        QVERIFY(same(panCamera(c, 0.0, 0.0, 360.0, 7.0), c));
+        QVERIFY(same(zoomCameraAbout(c, 0.0, {1.0, 1.0, 1.0}), c));
+
+        const double w = 640.0, h = 360.0;
+        // projectToView against the renderer's own camera ray through a pixel (core/render/shade.h).
+        RenderView v{};
+        v.camera = makeCamera(c, int(w), int(h));
+        v.width = int(w);
+        v.height = int(h);
+        for (const glm::dvec2 px : {glm::dvec2(10.5, 20.5), glm::dvec2(320.0, 180.0), glm::dvec2(600.25, 300.75)}) {
+            const Ray r = cameraRay(v, float(px.x), float(px.y));
+            glm::dvec2 back;
+            QVERIFY(projectToView(c, w, h, c.position + 25.0 * glm::dvec3(r.dir), &back));
+            QVERIFY2(glm::length(back - px) < 1e-3, qPrintable(QString("%1 %2 vs %3 %4").arg(back.x).arg(back.y).arg(px.x).arg(px.y)));
+        }
+        glm::dvec2 behind;
+        QVERIFY(!projectToView(c, w, h, c.position - (c.target - c.position), &behind));
+
+        // Zoom about a point off the axis: it stays on its pixel, 0.85x as far; the view direction stays.
+        const glm::dvec3 p(-2.0, 1.0, 3.0);
+        glm::dvec2 before, after;
+        QVERIFY(projectToView(c, w, h, p, &before));
+        const CameraDesc z = zoomCameraAbout(c, 1.0, p);
+        QVERIFY(projectToView(z, w, h, p, &after));
+        QVERIFY(glm::length(after - before) < 1e-9);
+        QVERIFY(std::abs(glm::length(z.position - p) - 0.85 * glm::length(c.position - p)) < 1e-9);
+        QVERIFY(glm::length(glm::normalize(z.target - z.position) - glm::normalize(c.target - c.position)) < 1e-12);
+        const CameraDesc zt = zoomCameraAbout(c, 2.0, c.target), zz = zoomCamera(c, 2.0);
+        QVERIFY(glm::length(zt.position - zz.position) < 1e-12 && zt.target == zz.target);
+
+        // Pan at p's depth: p moves with the cursor.
+        const double depth = glm::dot(p - c.position, glm::normalize(c.target - c.position));
+        const CameraDesc pan = panCamera(c, 40.0, -25.0, h, depth);
+        QVERIFY(projectToView(pan, w, h, p, &after));
+        QVERIFY2(glm::length(after - (before + glm::dvec2(40.0, -25.0))) < 1e-6, qPrintable(QString("%1 %2").arg(after.x).arg(after.y)));
+
+        // Framing a box: every corner inside, the farthest at 90% of the half-size, the direction kept.
+        Bounds3 box;
+        box.extend({-4.0f, 0.0f, 2.0f});
+        box.extend({6.0f, 3.0f, 5.0f});
+        const CameraDesc f = frameBoxCamera(c, box, w / h);
+        QVERIFY(glm::length(glm::normalize(f.target - f.position) - glm::normalize(c.target - c.position)) < 1e-12);
+        double edge = 0.0;
+        for (int k = 0; k < 8; ++k) {
+            const glm::dvec3 q((k & 1) ? box.hi.x : box.lo.x, (k & 2) ? box.hi.y : box.lo.y, (k & 4) ? box.hi.z : box.lo.z);
+            glm::dvec2 at;
+            QVERIFY(projectToView(f, w, h, q, &at));
+            edge = std::max({edge, std::abs(2.0 * at.x / w - 1.0), std::abs(2.0 * at.y / h - 1.0)});
+        }
+        QVERIFY2(std::abs(edge - 0.9) < 1e-6, qPrintable(QString::number(edge)));
+
+        // An instance turned 90 degrees about y (x -> -z), scaled 2, at (10, 0, 0).
+        Bounds3 mesh;
+        mesh.extend({-1.0f, 0.0f, -0.5f});
+        mesh.extend({1.0f, 4.0f, 0.5f});
+        InstanceDesc in;
+        in.position = {10.0, 0.0, 0.0};
+        in.rotationDeg = {0.0f, 90.0f, 0.0f};
+        in.scale = 2.0f;
+        const Bounds3 b = instanceBounds(Scene{}, in, mesh);
+        QVERIFY(glm::length(b.lo - glm::vec3(9.0f, 0.0f, -2.0f)) < 1e-5f && glm::length(b.hi - glm::vec3(11.0f, 8.0f, 2.0f)) < 1e-5f);
+        Scene two;
+        two.instances = {in, InstanceDesc{}};
+        const Bounds3 all = sceneBounds(two, {mesh});
+        QVERIFY(glm::length(all.lo - glm::vec3(-1.0f, 0.0f, -2.0f)) < 1e-5f && glm::length(all.hi - glm::vec3(11.0f, 8.0f, 2.0f)) < 1e-5f);
+    }
+
+    // A gesture of merged edits that ends where it began leaves no undo step, and a clean document clean.
+    void gestureBackToStartLeavesNoStep()
+    {
+        SceneDocument doc;
+        Scene s;
+        s.camera.position = {0.0, 2.0, -10.0};
+        doc.reset(s, QString());
+        const int key = SceneDocument::newMergeKey();
+        Scene moved = s;
+        moved.camera.position.x = 3.0;
+        doc.edit(moved, "Navigate", key);
+        QCOMPARE(doc.undoStack()->count(), 1);
+        QVERIFY(doc.isModified());
+        doc.edit(s, "Navigate", key);
+        QCOMPARE(doc.undoStack()->count(), 0);
+        QVERIFY(!doc.isModified());
+        QCOMPARE(doc.scene().camera.position, s.camera.position);
     }
 
     // Fly navigation: looking turns the view about a fixed eye, moving carries eye and target along

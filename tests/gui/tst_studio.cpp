@@ -443,7 +443,8 @@ private Q_SLOTS:
         QVERIFY(waitForFinalImage(v, 60000));
         const QImage full = v->lastImage();
         QComboBox* mode = m_win->modeSelector();
-        const int lb = mode->findText("lb");
+        const int lb = mode->findText(QStringLiteral("Bounce only"));   // the lb mode, in the toolbar's words
+        QCOMPARE(mode->itemData(lb).toInt(), int(RenderMode::Lb));
         QVERIFY(lb >= 0);
         mode->setCurrentIndex(lb);
         Q_EMIT mode->activated(lb);
@@ -452,7 +453,7 @@ private Q_SLOTS:
         QVERIFY(v->lastImage() != full);
         action("actionUndo")->trigger();
         QCOMPARE(scene().render.mode, RenderMode::Full);
-        QCOMPARE(mode->currentText(), QStringLiteral("full"));
+        QCOMPARE(mode->currentText(), QStringLiteral("All"));
 
         // The path tracer from the toolbar: another picture of the same scene, one undo step back to the LB model.
         QVERIFY(waitForFinalImage(v, 60000));

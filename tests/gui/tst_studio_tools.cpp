@@ -350,7 +350,8 @@ private Q_SLOTS:
 
         const int steps = w->document()->undoStack()->index();
         QVERIFY(!w->compareSelector()->isEnabled());
-        QCOMPARE(w->compareSelector()->currentText(), QStringLiteral("lb"));
+        QCOMPARE(w->compareSelector()->currentText(), QStringLiteral("Bounce only"));
+        QCOMPARE(w->compareSelector()->currentData().toInt(), int(RenderMode::Lb));
         w->compareToggle()->setChecked(true);
         QVERIFY(w->compareSelector()->isEnabled());
         QCOMPARE(v->compare(), std::optional<RenderMode>(RenderMode::Lb));
