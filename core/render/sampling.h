@@ -7,18 +7,14 @@
 #include <glm/glm.hpp>
 
 #include "core/base/defines.h"
+#include "core/base/hash.h"
 
 namespace sylva {
 
 // A hash-based random number in [0,1) (deterministic per pixel, sample and dimension).
 SYLVA_HD SYLVA_INLINE float hashToUnit(uint32_t a, uint32_t b, uint32_t c)
 {
-    uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u) * 0x85EBCA77u ^ (c + 0x165667B1u) * 0xC2B2AE3Du;
-    h ^= h >> 16;
-    h *= 0x7FEB352Du;
-    h ^= h >> 15;
-    h *= 0x846CA68Bu;
-    h ^= h >> 16;
+    const uint32_t h = hashFinalize(a * 0x9E3779B1u ^ (b + 0x7F4A7C15u) * 0x85EBCA77u ^ (c + 0x165667B1u) * 0xC2B2AE3Du);
     return float(h >> 8) * (1.0f / 16777216.0f);
 }
 
@@ -62,13 +58,7 @@ SYLVA_HD SYLVA_INLINE uint32_t sobolSecond(uint32_t i)
 
 SYLVA_HD SYLVA_INLINE uint32_t mix(uint32_t a, uint32_t b)
 {
-    uint32_t h = a * 0x9E3779B1u ^ (b + 0x7F4A7C15u) * 0x85EBCA77u;
-    h ^= h >> 16;
-    h *= 0x7FEB352Du;
-    h ^= h >> 15;
-    h *= 0x846CA68Bu;
-    h ^= h >> 16;
-    return h;
+    return hashFinalize(a * 0x9E3779B1u ^ (b + 0x7F4A7C15u) * 0x85EBCA77u);
 }
 
 SYLVA_HD SYLVA_INLINE float toUnit(uint32_t x) { return float(x >> 8) * (1.0f / 16777216.0f); }

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/base/error.h"
+#include "core/base/hash.h"
 
 namespace sylva {
 
@@ -15,15 +16,7 @@ namespace {
 
 constexpr float kPi = 3.14159265358979f;
 
-uint32_t hash32(uint32_t x)
-{
-    x ^= x >> 16;
-    x *= 0x7feb352dU;
-    x ^= x >> 15;
-    x *= 0x846ca68bU;
-    x ^= x >> 16;
-    return x;
-}
+uint32_t hash32(uint32_t x) { return hashFinalize(x); }
 
 // Lattice value in [0,1) for integer cell (x, y), wrapped to a px x py period.
 float latticeValue(int x, int y, int px, int py, uint32_t salt)
