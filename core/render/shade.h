@@ -46,13 +46,14 @@ SYLVA_HD inline void volumeStage(const RenderView& v, const Ray& ray, float tEnd
 }
 
 // Stage 4, background and lights: a ray that hit nothing sees the environment (the constant sky through
-// skyCover, a Preetham or map sky's radiance toward the ray in `background`); a surface gets each light of the
+// skyCover, a Preetham or map sky's radiance toward the ray in `background`, a map filtered to the sample's
+// footprint: lights/sky_radiance.h viewSkyBackground); a surface gets each light of the
 // list (core/render/lights.h: the sun with a shadow ray, the sky's virtual lights of its interleaved subset)
 // and its own indirect light (LB on meshes).
 SYLVA_HD SYLVA_INLINE SampleParts backgroundStage(const RenderView& v, const Ray& ray)
 {
     SampleParts out{glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f), 1.0f, glm::vec3(0.0f), kSkyDepth, glm::vec3(0.0f)};
-    if (v.sky.model.kind != sky::SkyKind::Constant) out.background = viewSkyRadiance(v, ray.dir);
+    if (v.sky.model.kind != sky::SkyKind::Constant) out.background = viewSkyBackground(v, ray.dir);
     return out;
 }
 

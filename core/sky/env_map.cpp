@@ -238,6 +238,36 @@ EnvMapView envMapView(const EnvMap& map, float rotationDeg, float intensity)
     return v;
 }
 
+std::vector<float> envMapMipChain(const EnvMap& map, int& levels)
+{
+    checkEnvMapShape(map.width, map.height, "sky map");
+    std::vector<float> out(map.rgb.begin(), map.rgb.end());
+    levels = 1;
+    size_t at = 0;   // the level being halved
+    int w = map.width, h = map.height;
+    while (h % 2 == 0) {
+        const int w2 = w / 2, h2 = h / 2;
+        std::vector<float> next(size_t(w2) * size_t(h2) * 3);
+        for (int y = 0; y < h2; ++y) {
+            // the two fine rows' solid angles (per pixel; the columns of a row have the same)
+            const double a0 = envMapPixelSolidAngle(w, h, 2 * y), a1 = envMapPixelSolidAngle(w, h, 2 * y + 1);
+            const double norm = 1.0 / (2.0 * (a0 + a1));
+            for (int x = 0; x < w2; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    auto fine = [&](int fx, int fy) { return double(out[at + (size_t(fy) * size_t(w) + size_t(fx)) * 3 + size_t(c)]); };
+                    const double sum = a0 * (fine(2 * x, 2 * y) + fine(2 * x + 1, 2 * y)) + a1 * (fine(2 * x, 2 * y + 1) + fine(2 * x + 1, 2 * y + 1));
+                    next[(size_t(y) * size_t(w2) + size_t(x)) * 3 + size_t(c)] = float(sum * norm);
+                }
+        }
+        at = out.size();
+        out.insert(out.end(), next.begin(), next.end());
+        w = w2;
+        h = h2;
+        ++levels;
+    }
+    return out;
+}
+
 EnvMap renderSkyToMap(const SkyView& sky, int width)
 {
     if (width < 2 || width % 2 != 0) throw Error("sky map: the width must be even and at least 2, got " + std::to_string(width));

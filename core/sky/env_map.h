@@ -81,6 +81,12 @@ FoundSun extractSun(EnvMap& map, const SunFindSettings& settings = {});
 // The per-ray view of a map (pointer into `map`, which must outlive it), rotated about +Y and scaled.
 EnvMapView envMapView(const EnvMap& map, float rotationDeg, float intensity);
 
+// The map and its coarser levels for filtered lookups (envMapFiltered, core/sky/sky.h), one after another:
+// level k + 1 is half of level k each way, each texel the solid-angle-weighted mean of the 2 x 2 below it, so
+// every level keeps the map's integral over the sphere; the chain stops at a level of odd height (a 2 x 1
+// level at the end for power-of-two maps). Sets `levels` to their number (>= 1).
+std::vector<float> envMapMipChain(const EnvMap& map, int& levels);
+
 // An analytic sky sampled at pixel centres (without its sun), as a width x width/2 map. width >= 2, even.
 EnvMap renderSkyToMap(const SkyView& sky, int width);
 

@@ -127,10 +127,12 @@ SYLVA_HD inline glm::vec3 preethamRadiance(const PreethamSky& p, glm::vec3 d)
 // the rotation's cosine and sine, and an intensity. Piecewise constant: a direction reads the pixel it
 // falls in (the same function the map's integrals and virtual lights use).
 struct EnvMapView {
-    const float* rgb = nullptr;              // width x height x 3, row-major
+    const float* rgb = nullptr;              // width x height x 3, row-major; then the coarser levels, if any
     int width = 0, height = 0;
     float cosRot = 1.0f, sinRot = 0.0f;      // of the rotation about +Y
     float intensity = 1.0f;
+    int levels = 1;                          // mip levels in rgb (envMapMipChain, core/sky/env_map.h): level k is
+                                             // (width >> k) x (height >> k), stored after level k - 1
 };
 
 SYLVA_HD inline glm::vec3 envMapRadiance(const EnvMapView& m, glm::vec3 d)
@@ -141,6 +143,54 @@ SYLVA_HD inline glm::vec3 envMapRadiance(const EnvMapView& m, glm::vec3 d)
     const int y = glm::min(glm::max(int(uv.y * float(m.height)), 0), m.height - 1);
     const float* p = m.rgb + (size_t(y) * size_t(m.width) + size_t(x)) * 3;
     return glm::vec3(p[0], p[1], p[2]) * m.intensity;
+}
+
+// Texel (x, y) of level `level` of a map's mip chain (level 0: the map).
+SYLVA_HD inline glm::vec3 envMapTexel(const EnvMapView& m, int level, int x, int y)
+{
+    const float* p = m.rgb;
+    int w = m.width, h = m.height;
+    for (int k = 0; k < level; ++k) {
+        p += size_t(w) * size_t(h) * 3;
+        w >>= 1;
+        h >>= 1;
+    }
+    p += (size_t(y) * size_t(w) + size_t(x)) * 3;
+    return glm::vec3(p[0], p[1], p[2]);
+}
+
+// Level `level` of the chain at map coordinates uv, interpolated bilinearly between texel centres (u wraps
+// around the azimuth, v holds the first and last rows' values toward the poles); without the intensity.
+SYLVA_HD inline glm::vec3 envMapBilinear(const EnvMapView& m, int level, glm::vec2 uv)
+{
+    const int w = m.width >> level, h = m.height >> level;
+    const float fx = uv.x * float(w) - 0.5f, fy = uv.y * float(h) - 0.5f;
+    const float x0f = floorf(fx), y0f = floorf(fy);
+    const float ax = fx - x0f, ay = fy - y0f;
+    int x0 = int(x0f) % w;
+    if (x0 < 0) x0 += w;
+    const int x1 = x0 + 1 == w ? 0 : x0 + 1;
+    const int y0 = glm::min(glm::max(int(y0f), 0), h - 1), y1 = glm::min(glm::max(int(y0f) + 1, 0), h - 1);
+    const glm::vec3 top = envMapTexel(m, level, x0, y0) * (1.0f - ax) + envMapTexel(m, level, x1, y0) * ax;
+    const glm::vec3 bottom = envMapTexel(m, level, x0, y1) * (1.0f - ax) + envMapTexel(m, level, x1, y1) * ax;
+    return top * (1.0f - ay) + bottom * ay;
+}
+
+// The map as a camera sees it behind everything: the bilinear map of the mip level whose texels (pi / height
+// x 2^level radians) match `footprint`, the angle one camera sample covers, blended linearly between the two
+// nearest levels (trilinear filtering); below one texel the full map, bilinear. envMapRadiance (piecewise
+// constant) stays the sky's light: its integrals, virtual lights and sampling table are of that function.
+SYLVA_HD inline glm::vec3 envMapFiltered(const EnvMapView& m, glm::vec3 d, float footprint)
+{
+    if (!m.rgb || m.width <= 0 || m.height <= 0) return glm::vec3(0.0f);
+    const glm::vec2 uv = equirectUv(rotateAzimuth(d, m.cosRot, -m.sinRot));
+    const float texel = kPi / float(m.height);
+    const float lod = footprint > texel ? fminf(log2f(footprint / texel), float(m.levels - 1)) : 0.0f;
+    const int l0 = int(lod);
+    const float f = lod - float(l0);
+    glm::vec3 c = envMapBilinear(m, l0, uv);
+    if (f > 0.0f && l0 + 1 < m.levels) c = c * (1.0f - f) + envMapBilinear(m, l0 + 1, uv) * f;
+    return c * m.intensity;
 }
 
 // Uniform: the scene level only (SkyDesc), the constant colour lighting like a map: loadSceneSky builds it as a

@@ -2,13 +2,16 @@
 // else renders albedo / pi x the map's upper-hemisphere irradiance (integrated here over the map's pixels);
 // a uniform map gives the closed form L; interleaved subsets accumulated over samples equal / converge to
 // the all-lights picture; plants shade the floor under the sky lights; camera rays that leave the scene see
-// the map; `sky.kind` uniform lights like a map of its colour; a Preetham sky renders finite and lit; old constant-sky files keep their meaning; bad sky keys
+// the map, filtered: the bilinear map integrated over each pixel, magnified and minified (its mip chain keeps
+// the map's integral); `sky.kind` uniform lights like a map of its colour; a Preetham sky renders finite and lit; old constant-sky files keep their meaning; bad sky keys
 // are refused.
 #include <QDir>
 #include <QTemporaryDir>
 #include <QTest>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -17,6 +20,7 @@
 #include "core/lb/lb_solver.h"
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
+#include "core/sky/env_map.h"
 #include "core/sky/sky_light.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/io/env_map_io.h"
@@ -114,6 +118,32 @@ double relativeError(const std::vector<glm::vec3>& a, const std::vector<glm::vec
         sum += luminance(glm::dvec3(b[i]));
     }
     return diff / sum;
+}
+
+// The map as a continuous function, written here: bilinear between texel centres (u wraps, v clamps at the
+// poles), at a unit direction (the equirectangular convention of core/sky/sky.h, unrotated).
+glm::dvec3 bilinearMap(const sky::EnvMap& m, const glm::dvec3& d)
+{
+    double u = 0.5 * (1.0 - std::atan2(d.x, d.z) / kPi);
+    u -= std::floor(u);
+    const double v = std::acos(std::clamp(d.y, -1.0, 1.0)) / kPi;
+    const double fx = u * m.width - 0.5, fy = v * m.height - 0.5;
+    const double x0 = std::floor(fx), y0 = std::floor(fy), ax = fx - x0, ay = fy - y0;
+    auto at = [&](double x, double y) {
+        const int xi = ((int(x) % m.width) + m.width) % m.width, yi = std::clamp(int(y), 0, m.height - 1);
+        return glm::dvec3(m.at(xi, yi));
+    };
+    return (at(x0, y0) * (1.0 - ax) + at(x0 + 1, y0) * ax) * (1.0 - ay) + (at(x0, y0 + 1) * (1.0 - ax) + at(x0 + 1, y0 + 1) * ax) * ay;
+}
+
+// The direction through image position (x, y) of the scene's pinhole camera (square pixels), computed here.
+glm::dvec3 imageDirection(const Scene& s, double x, double y)
+{
+    const glm::dvec3 f = glm::normalize(s.camera.target - s.camera.position);
+    const glm::dvec3 right = glm::normalize(glm::cross(f, glm::dvec3(0.0, 1.0, 0.0)));
+    const glm::dvec3 up = glm::cross(right, f);
+    const double ty = std::tan(double(s.camera.fovY) * kPi / 360.0), tx = ty * s.render.width / s.render.height;
+    return glm::normalize(f + (2.0 * x / s.render.width - 1.0) * tx * right + (1.0 - 2.0 * y / s.render.height) * ty * up);
 }
 
 } // namespace
@@ -539,6 +569,87 @@ private Q_SLOTS:
 
     // Old files: a sky block with only `color` is the constant sky, written back without the new keys, and
     // renders no background part (the constant sky composes as skyCover x colour, as before).
+    // The mip chain of a map keeps its integral over the sphere at every level (the solid-angle weights).
+    void mipChainKeepsTheIntegral()
+    {
+        sky::EnvMap m;
+        m.width = 128;
+        m.height = 64;
+        m.rgb.resize(size_t(m.width) * size_t(m.height) * 3);
+        for (size_t k = 0; k < m.rgb.size(); ++k) m.rgb[k] = float((k * 2654435761u) % 1000) / 250.0f;
+        int levels = 0;
+        const std::vector<float> chain = sky::envMapMipChain(m, levels);
+        QCOMPARE(levels, 7);   // 128 x 64 .. 2 x 1
+        const glm::dvec3 whole = sky::envMapIntegral(m);
+        size_t at = 0;
+        for (int k = 0; k < levels; ++k) {
+            sky::EnvMap level;
+            level.width = m.width >> k;
+            level.height = m.height >> k;
+            const size_t n = size_t(level.width) * size_t(level.height) * 3;
+            level.rgb.assign(chain.begin() + std::ptrdiff_t(at), chain.begin() + std::ptrdiff_t(at + n));
+            at += n;
+            const glm::dvec3 e = sky::envMapIntegral(level);
+            for (int c = 0; c < 3; ++c) QVERIFY2(std::abs(e[c] - whole[c]) < 1e-5 * whole[c], qPrintable(QString("level %1").arg(k)));
+        }
+        QCOMPARE(at, chain.size());
+    }
+
+    // The background of a map sky is the bilinear map integrated over each pixel (64 x 64 points a pixel in the
+    // test) at 1 sample a pixel: magnified (a 16 x 8 map, 22.5-degree texels, through 0.8-degree pixels: no hard
+    // squares) and minified (a 1024 x 512 one-texel checkerboard through 7-degree pixels: grey, no aliasing).
+    // The piecewise-constant lookup the sky's light uses (the pixel-centre texel) is far off in both.
+    void backgroundIsTheMapOverEachPixel()
+    {
+        struct Case {
+            const char* name;
+            int mapWidth;
+            float fovY;
+            int pixels;
+            double filteredBound, nearestAbove;
+        };
+        for (const Case& c : {Case{"magnified", 16, 40.0f, 48, 5e-4, 0.1}, Case{"minified", 1024, 90.0f, 16, 5e-3, 0.5}}) {
+            sky::EnvMap m;
+            m.width = c.mapWidth;
+            m.height = c.mapWidth / 2;
+            m.rgb.resize(size_t(m.width) * size_t(m.height) * 3);
+            for (int y = 0; y < m.height; ++y)
+                for (int x = 0; x < m.width; ++x)
+                    for (int k = 0; k < 3; ++k)
+                        m.ptr(x, y)[k] = c.mapWidth > 64 ? float(((x + y) % 2) * 2)
+                                                         : 0.2f + float(((unsigned(x * 7 + y * 13 + k * 5) * 2654435761u) >> 8) % 1000) / 1000.0f;
+            Scene s = openGround();
+            s.ground.enabled = false;
+            s.camera.position = {0.0, 5.0, 0.0};
+            s.camera.target = {3.0, 7.0, 10.0};
+            s.camera.fovY = c.fovY;
+            s.render.width = s.render.height = c.pixels;
+            s.render.spp = 1;
+            s.skyModel = SkyDesc{};
+            s.skyModel.kind = sky::SkyKind::Map;
+            s.skyModel.path = "synthetic.exr";
+            s.skyModel.built = std::make_shared<const sky::Sky>(sky::mapSky(m, 0.0f, 1.0f, false));
+            const Film f = film(s, m_shrub);
+            std::vector<glm::vec3> got, want, nearest;
+            const sky::EnvMapView view = sky::envMapView(m, 0.0f, 1.0f);
+            const int n = 64;
+            for (int py = 0; py < c.pixels; ++py)
+                for (int px = 0; px < c.pixels; ++px) {
+                    glm::dvec3 sum(0.0);
+                    for (int j = 0; j < n; ++j)
+                        for (int i = 0; i < n; ++i) sum += bilinearMap(m, imageDirection(s, px + (i + 0.5) / n, py + (j + 0.5) / n));
+                    want.push_back(glm::vec3(sum / double(n * n)));
+                    got.push_back(f.pixels[size_t(py) * size_t(c.pixels) + size_t(px)].background);
+                    nearest.push_back(sky::envMapRadiance(view, glm::vec3(imageDirection(s, px + 0.5, py + 0.5))));
+                }
+            const double e = relativeError(got, want), en = relativeError(nearest, want);
+            qInfo("%s: filtered background %.3f%% from the map integrated over each pixel, the pixel-centre texel %.1f%%", c.name, 100.0 * e,
+                  100.0 * en);
+            QVERIFY2(e < c.filteredBound, c.name);
+            QVERIFY2(en > c.nearestAbove, c.name);
+        }
+    }
+
     void constantSkyAsBefore()
     {
         QTemporaryDir dir;

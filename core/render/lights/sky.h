@@ -5,19 +5,9 @@
 // core/render/lights.h.
 #pragma once
 
-namespace sylva {
+#include "core/render/lights/sky_radiance.h"
 
-// Radiance of the view's Preetham or map sky (without its sun) toward unit direction d; the map's pixels
-// are the skyMap array (on the device too).
-SYLVA_HD inline glm::vec3 viewSkyRadiance(const RenderView& v, const glm::vec3& d)
-{
-    if (v.sky.model.kind == sky::SkyKind::Map) {
-        sky::EnvMapView m = v.sky.model.map;
-        m.rgb = v.skyMap;
-        return sky::envMapRadiance(m, d);
-    }
-    return sky::skyRadiance(v.sky.model, d);
-}
+namespace sylva {
 
 // Irradiance / pi at camera-relative point p (offset already) with unit normal n from the virtual sky
 // lights of the subset pixel (px, py) uses for its sample s (interleaved sampling, core/sky/
