@@ -275,8 +275,9 @@ void setFrameSky(RenderScene& rs, const SkyDesc& d, bool groundPlane)
     if (d.interleave < 1) throw Error("render: sky.interleave must be >= 1");
     const sky::Sky& built = *d.built;
     sky::SkyView v = built.view();
-    if (built.kind == sky::SkyKind::Map && built.map) rs.skyMap = built.map->rgb;
-    v.map.rgb = nullptr;   // the frame's skyMap array (host or device) is read instead
+    v.map.levels = 1;
+    if (built.kind == sky::SkyKind::Map && built.map) rs.skyMap = sky::envMapMipChain(*built.map, v.map.levels);
+    v.map.rgb = nullptr;   // the frame's skyMap array (host or device: the map and its coarser levels) is read instead
     rs.frame.sky.model = v;
     rs.skyLights = sky::skyLights(built, d.lights, 512, groundPlane);
     rs.frame.sky.lightCount = uint32_t(rs.skyLights.size());
@@ -452,6 +453,7 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     b.integrator = scene.render.integrator;
     b.maxBounces = scene.render.maxBounces;
     b.lightingBounces = scene.lighting.bounces;
+    b.atmosphere = scene.skyModel.aerialPerspective ? makeAtmosphere(scene.skyModel.turbidity, origin.y) : AtmosphereRecord{};
     placeVolumes(rs, scene, scene.camera.position);
     countFrameBytes(rs);
 }

@@ -230,6 +230,7 @@ struct RenderView {
     SpheresRecord spheres;
     LandscapeRecord landscape;
     VolumesRecord volumes;
+    AtmosphereRecord atmosphere;
 
     // the environment, and the unit of the LB grids
     SkyRecord sky;

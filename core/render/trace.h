@@ -2,6 +2,7 @@
 // order below the closest hit so far, and what the media let through (host and device).
 #pragma once
 
+#include "core/render/surfaces/atmosphere_trace.h"
 #include "core/render/surfaces/ground_trace.h"
 #include "core/render/surfaces/instances_trace.h"
 #include "core/render/surfaces/landscape_trace.h"

@@ -15,9 +15,9 @@ const std::vector<QualityPreset>& qualityPresets()
     // boundary is within the references' noise of converged Cycles on all four scenes, at 64 spp 1.5-3.8% from
     // it; after 1 bounce the same at 1 spp (the noise dominates there); reference: the path tracer.
     static const std::vector<QualityPreset> presets{
-        {"preview", 32, "half", true, 1, 25.0f, 0.0f, Integrator::Lb, 1, DirectLight::Once, LbBoundary::SunSky},
-        {"final", 64, "half", true, 64, 0.0f, 0.0f, Integrator::Lb, 2, DirectLight::Once, LbBoundary::SunSky},
-        {"reference", 128, "half", true, 256, 0.0f, 0.0f, Integrator::Path, 0, DirectLight::Once, LbBoundary::SunSky},
+        {"preview", 32, "half", true, 1, 25.0f, 0.0f, Integrator::Lb, 1, DirectLight::Once, LbBoundary::SunSky, true},
+        {"final", 64, "half", true, 64, 0.0f, 0.0f, Integrator::Lb, 2, DirectLight::Once, LbBoundary::SunSky, true},
+        {"reference", 128, "half", true, 256, 0.0f, 0.0f, Integrator::Path, 0, DirectLight::Once, LbBoundary::SunSky, true},
     };
     return presets;
 }
@@ -34,7 +34,8 @@ std::string qualityPresetSettings(const QualityPreset& q)
     auto dist = [](float m) { return m > 0.0f ? std::to_string(int(m)) + " m" : std::string("off"); };
     return "grid " + std::to_string(q.grid) + ", " + q.steps + ", " + (q.fp16 ? "fp16" : "fp32") + ", " + std::to_string(q.spp) +
            " spp, alpha " + dist(q.alphaDistance) + ", prune " + dist(q.pruneDistance) + ", " + integratorName(q.integrator) + ", " +
-           std::to_string(q.bounces) + " bounces, direct " + directLightName(q.direct) + ", boundary " + lbBoundaryName(q.boundary);
+           std::to_string(q.bounces) + " bounces, direct " + directLightName(q.direct) + ", boundary " + lbBoundaryName(q.boundary) +
+           (q.aerialPerspective ? ", aerial perspective on terrains" : "");
 }
 
 void applyQualityLighting(const QualityPreset& preset, lb::LbParams& params)
@@ -63,6 +64,7 @@ void applyQuality(Scene& scene, const QualityPreset& preset)
     scene.lighting.bounces = preset.bounces;
     scene.lighting.direct = preset.direct;
     scene.lighting.boundary = preset.boundary;
+    if (scene.terrain.enabled()) scene.skyModel.aerialPerspective = preset.aerialPerspective;
 }
 
 } // namespace sylva

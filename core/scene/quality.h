@@ -23,6 +23,7 @@ struct QualityPreset {
     int bounces;                        // lighting.bounces: the LB grid as a radiance cache after that many bounces
     DirectLight direct;                 // lighting.direct
     LbBoundary boundary;                // lighting.boundary
+    bool aerialPerspective;             // sky.aerial_perspective on scenes with a terrain (elsewhere the air is too thin to see)
 };
 const std::vector<QualityPreset>& qualityPresets();
 const QualityPreset* findQualityPreset(const std::string& name);
@@ -34,7 +35,8 @@ std::string qualityPresetSettings(const QualityPreset& preset);
 // unknown steps label.
 void applyQualityLighting(const QualityPreset& preset, lb::LbParams& params);
 // The preset on a whole scene: every species' grid, steps and storage; spp, alpha and prune distances; the
-// integrator and the lighting block's direct light, boundary and bounces (whatever the scene file held).
+// integrator and the lighting block's direct light, boundary and bounces, and the aerial perspective of a scene with
+// a terrain (whatever the scene file held).
 void applyQuality(Scene& scene, const QualityPreset& preset);
 
 } // namespace sylva

@@ -138,6 +138,8 @@ struct SkyDesc {
     int lights = 32;                     // N virtual lights (default measured: docs/ACCURACY.md "Sky light")
     int interleave = 16;                 // K subsets: N / K shadow rays per pixel and sample
     bool sunFromMap = true;              // map: its sun found, taken out and made the sun (replacing `sun`)
+    bool aerialPerspective = false;      // the air between the camera and what it sees, hazed by `turbidity`
+                                         // (core/render/surfaces/atmosphere.h); off in files without the key
     // The built sky (pipeline/io/env_map_io: loadSceneSky), shared by the scene's copies; not in the file.
     std::shared_ptr<const sky::Sky> built;
     // Lit through virtual lights (shadow rays) with its own background: every kind but Constant.

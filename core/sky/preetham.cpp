@@ -105,14 +105,18 @@ PreethamSky makePreetham(const PreethamParams& params)
 
 double sunTransmittance(double lambdaNm, double turbidity, double thetaSunDeg)
 {
-    const double um = lambdaNm / 1000.0;
     const double cosT = std::cos(thetaSunDeg * kPiD / 180.0);
     const double base = std::max(93.885 - thetaSunDeg, 1e-6);   // the formula's pole lies past the horizon
     const double m = 1.0 / (std::max(cosT, 0.0) + 0.15 * std::pow(base, -1.253));
+    return std::exp(-rayleighOpticalDepth(lambdaNm) * m) * std::exp(-aerosolOpticalDepth(lambdaNm, turbidity) * m);
+}
+
+double rayleighOpticalDepth(double lambdaNm) { return 0.008735 * std::pow(lambdaNm / 1000.0, -4.08); }
+
+double aerosolOpticalDepth(double lambdaNm, double turbidity)
+{
     const double beta = 0.04608 * turbidity - 0.04586;
-    const double rayleigh = std::exp(-0.008735 * std::pow(um, -4.08) * m);
-    const double aerosol = std::exp(-beta * std::pow(um, -1.3) * m);
-    return rayleigh * aerosol;
+    return beta * std::pow(lambdaNm / 1000.0, -1.3);
 }
 
 SkySun preethamSun(const PreethamParams& params, const CieTable& cie)

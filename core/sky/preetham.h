@@ -52,6 +52,13 @@ PreethamSky makePreetham(const PreethamParams& params);
 // ozone, mixed-gas and water-vapour terms (tabulated absorption bands) are left out.
 double sunTransmittance(double lambdaNm, double turbidity, double thetaSunDeg);
 
+// The vertical optical depths of the whole atmosphere at sea level (relative optical mass 1) that
+// sunTransmittance scales by the optical mass: Rayleigh 0.008735 lambda_um^-4.08 and aerosol
+// beta lambda_um^-1.3 (beta = 0.04608 T - 0.04586). The aerial perspective's extinction is built from them
+// (core/render/surfaces/atmosphere.h), so distant slopes fade with the same air the sun's colour comes through.
+double rayleighOpticalDepth(double lambdaNm);
+double aerosolOpticalDepth(double lambdaNm, double turbidity);
+
 // Extraterrestrial solar illuminance at normal incidence, klux (the IES solar illuminance constant).
 inline constexpr double kSolarIlluminanceKlux = 127.5;
 // Angular radius of the sun's disc, degrees (solid angle 6.8e-5 sr).

@@ -559,8 +559,9 @@ const Table<Scene>& skyTable()
             .writtenIf([](const Scene& s) { return s.skyModel.hasColor(); })
             .summarized([](const Scene& s) { return s.skyModel.hasColor() ? "radiance " + human3(s.sky) : std::string(); });
         b.number("turbidity", [](auto& s) -> auto& { return s.skyModel.turbidity; }, Bounds{.lo = sky::kMinTurbidity, .hi = sky::kMaxTurbidity})
-            .doc("number", "`preetham`: atmospheric turbidity, 2 .. 10")
-            .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Preetham; })
+            .doc("number", "`preetham` or with `aerial_perspective`: atmospheric turbidity, 2 (clear) .. 10 (hazy): the sky's and sun's colour, "
+                           "and the haze of the distance")
+            .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Preetham || s.skyModel.aerialPerspective; })
             .summarized([](const Scene& s) {
                 return s.skyModel.kind == sky::SkyKind::Preetham ? "turbidity " + human(s.skyModel.turbidity) : std::string();
             });
@@ -586,6 +587,13 @@ const Table<Scene>& skyTable()
                  "`hdri`: the map's sun (its brightest compact region) is taken out of the map and replaces `sun` (direction and "
                  "radiance, x `sun.intensity`); false: the map lights as it is and `sun` stays")
             .writtenIf([](const Scene& s) { return s.skyModel.kind == sky::SkyKind::Map; });
+        b.boolean("aerial_perspective", [](auto& s) -> auto& { return s.skyModel.aerialPerspective; })
+            .doc("bool",
+                 "any sky: the air between the camera and what it sees, Rayleigh and aerosol (`turbidity`) thinning with height: distant "
+                 "surfaces fade toward the sky at the horizon ([RENDERING.md](RENDERING.md) \"Aerial perspective\"); false (the default: files "
+                 "without the key keep their picture) or true; the quality presets turn it on for scenes with a terrain")
+            .writtenIf([](const Scene& s) { return s.skyModel.aerialPerspective; })
+            .summarized([](const Scene& s) { return s.skyModel.aerialPerspective ? std::string("aerial perspective") : std::string(); });
         b.integer("lights", [](auto& s) -> auto& { return s.skyModel.lights; }, sky::kMinVirtualLights, sky::kMaxVirtualLights)
             .doc("integer",
                  "`preetham`, `hdri`, `uniform`: virtual directional lights the sky is split into (equal power; with the ground plane the upper hemisphere only), 1 .. 65536; the default 32 with `interleave` 16 (2 shadow rays a sample) on the default forest under a Preetham sky and two maps: at most 1.96% light error at 16 spp and 8% at 1 spp, at 1.8x-2.0x the sun-only frame's time ([ACCURACY.md](ACCURACY.md) \"Sky light\"; 64 lights: 1.35% at 2.5x-3.0x)")
@@ -606,7 +614,8 @@ const Table<Scene>& skyTable()
                     r.fail(path.field(key), std::string("only with kind ") + kinds + " (the sky is " + skyKindName(d.kind) + ")");
             };
             only("color", d.hasColor(), "constant or uniform");
-            only("turbidity", d.kind == sky::SkyKind::Preetham, "preetham");
+            if (o.contains(QLatin1String("turbidity")) && d.kind != sky::SkyKind::Preetham && !d.aerialPerspective)
+                r.fail(path.field("turbidity"), std::string("only with kind preetham or aerial_perspective true (the sky is ") + skyKindName(d.kind) + ")");
             only("scale", d.kind == sky::SkyKind::Preetham, "preetham");
             only("path", d.kind == sky::SkyKind::Map, "hdri");
             only("rotation_deg", d.kind == sky::SkyKind::Map, "hdri");

@@ -28,6 +28,7 @@
 
 #include <cstdint>
 
+#include "core/render/surfaces/atmosphere.h"
 #include "core/render/surfaces/ground.h"
 #include "core/render/surfaces/landscape.h"
 #include "core/render/surfaces/sphere.h"
@@ -40,7 +41,8 @@
     S(Spheres)                    \
     S(Landscape)                  \
     S(Instances)                  \
-    M(Volumes)
+    M(Volumes)                    \
+    M(Atmosphere)
 
 // The expander for the kinds a use of the list leaves out (the media where rays are traced, the surfaces
 // where segments are crossed).
