@@ -34,6 +34,34 @@ CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg)
     return c;
 }
 
+CameraDesc orbitCameraAbout(const CameraDesc& camera, double yawDeg, double pitchDeg, const glm::dvec3& pivot)
+{
+    if (yawDeg == 0.0 && pitchDeg == 0.0) return camera;
+    const glm::dvec3 view = camera.target - camera.position;
+    const double dist = glm::length(view);
+    if (!(dist > 0.0)) return camera;
+    // The camera's frame before (its own up) and after (orbitCamera's view direction, up +Y), as the renderer
+    // builds it: right = forward x up, up' = right x forward.
+    auto frame = [](const glm::dvec3& forward, const glm::dvec3& up, glm::dmat3* m) {
+        const glm::dvec3 f = glm::normalize(forward);
+        const glm::dvec3 x = glm::cross(f, up);
+        if (!(glm::length(x) > 1e-12)) return false;
+        const glm::dvec3 r = glm::normalize(x);
+        *m = glm::dmat3(r, glm::cross(r, f), f);   // columns
+        return true;
+    };
+    const CameraDesc turnedCam = orbitCamera(camera, yawDeg, pitchDeg);
+    glm::dmat3 before, after;
+    if (!frame(view, glm::dvec3(camera.up), &before) || !frame(turnedCam.target - turnedCam.position, glm::dvec3(0.0, 1.0, 0.0), &after))
+        return turnedCam;
+    const glm::dmat3 turn = after * glm::transpose(before);   // the old frame onto the new
+    CameraDesc c = camera;
+    c.position = pivot + turn * (camera.position - pivot);
+    c.target = c.position + turn * view;
+    c.up = glm::vec3(0.0f, 1.0f, 0.0f);
+    return c;
+}
+
 CameraDesc panCamera(const CameraDesc& camera, double dx, double dy, double viewHeight, double depth)
 {
     CameraDesc c = camera;
@@ -102,7 +130,7 @@ CameraDesc flyMove(const CameraDesc& camera, double right, double up, double for
     return c;
 }
 
-double flyStepFor(const Scene& scene)
+double flyStepFor(const Scene& scene, const std::vector<Bounds3>& speciesBoxes)
 {
     const TerrainDesc& t = scene.terrain;
     if (t.enabled() && t.field) {
@@ -110,7 +138,12 @@ double flyStepFor(const Scene& scene)
         const double side = std::max(double(L.nx - 1) * double(L.dx), double(L.nz - 1) * double(L.dz));
         return std::max(0.05, 0.005 * side);
     }
-    return std::max(0.05, 0.05 * glm::length(scene.camera.target - scene.camera.position));
+    double step = 0.05 * glm::length(scene.camera.target - scene.camera.position);
+    if (const Bounds3 b = sceneBounds(scene, speciesBoxes); b.valid()) {
+        const glm::vec3 e = b.extent();
+        step = std::max(step, 0.005 * double(std::max({e.x, e.y, e.z})));
+    }
+    return std::max(0.05, step);
 }
 
 Bounds3 instanceBounds(const Scene& scene, const InstanceDesc& instance, const Bounds3& speciesBox)

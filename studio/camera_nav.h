@@ -1,6 +1,8 @@
 // Viewport navigation on a scene camera: orbit about the target, pan in the image plane, dolly zoom, fly, framing.
 #pragma once
 
+#include <vector>
+
 #include "core/mesh/triangle_mesh.h"
 #include "core/scene/scene.h"
 
@@ -9,6 +11,12 @@ namespace sylva {
 // Rotates the eye about the target: yaw about world +Y, pitch about the camera's right axis (degrees),
 // pitch kept within 1 degree of the poles. The target stays put.
 CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg);
+
+// Orbit about a point (what was under the cursor when the drag began): the view turns as orbitCamera turns it
+// (yaw about world +Y, pitch about the camera's right axis, kept short of the poles), and eye and target move
+// with it rigidly about `pivot`, so the pivot keeps its place in the camera's frame and stays on the same pixel.
+// Up becomes world +Y. No turn (0, 0) returns the camera unchanged.
+CameraDesc orbitCameraAbout(const CameraDesc& camera, double yawDeg, double pitchDeg, const glm::dvec3& pivot);
 
 // Moves eye and target together by (dx, dy) pixels of an image `viewHeight` pixels tall, so a point at
 // `depth` metres ahead of the eye (along the view axis; 0: the target's distance) follows the cursor: grab
@@ -36,8 +44,9 @@ CameraDesc flyMove(const CameraDesc& camera, double right, double up, double for
 
 // Metres a fly key press moves in `scene`: over a terrain 0.5% of its longer side (100 m over a 20 km DEM,
 // so crossing it takes a couple of hundred presses, or a fifth with Shift's 5x), else 5% of the eye-target
-// distance; at least 5 cm.
-double flyStepFor(const Scene& scene);
+// distance but at least 0.5% of the longest side of the plants' box (sceneBounds with the species' mesh boxes:
+// a forest 2 km wide is crossed in 200 presses however close the target is); at least 5 cm.
+double flyStepFor(const Scene& scene, const std::vector<Bounds3>& speciesBoxes = {});
 
 // A camera that shows world box b whole, from the front-left and a little above (current's field of
 // view; up is world +Y): what the studio frames the first instances of a scene with.

@@ -18,6 +18,8 @@
 #include <QFileDialog>
 #include <QHeaderView>
 #include <QLabel>
+#include <QScrollArea>
+#include <QSpinBox>
 #include <QMenuBar>
 #include <QMimeData>
 #include <QPlainTextEdit>
@@ -108,9 +110,19 @@ MainWindow::MainWindow(QWidget* parent)
     m_compareBox->setCurrentIndex(m_compareBox->findData(int(RenderMode::Lb)));
     m_compareBox->setEnabled(false);
     bar->addWidget(m_compareBox);
+    bar->addSeparator();
+    bar->addWidget(new QLabel(tr(" Viewport samples: ")));
+    m_sampleLimitBox = new QSpinBox;
+    m_sampleLimitBox->setObjectName("viewportSamples");
+    m_sampleLimitBox->setRange(0, kMaxViewportSamples);
+    m_sampleLimitBox->setSpecialValueText(tr("as the render"));
+    m_sampleLimitBox->setKeyboardTracking(false);
+    bar->addWidget(m_sampleLimitBox);
     applyToolTips(bar);
     cl->addWidget(bar);
     m_viewport = new Viewport;
+    m_sampleLimitBox->setValue(m_viewport->sampleLimit());
+    connect(m_sampleLimitBox, &QSpinBox::valueChanged, this, [this](int v) { m_viewport->setSampleLimit(v); });
     cl->addWidget(m_viewport, 1);
     setCentralWidget(centre);
     connect(m_modeBox, &QComboBox::activated, this, [this](int index) {
@@ -141,9 +153,10 @@ MainWindow::MainWindow(QWidget* parent)
         }
     });
     connect(m_viewport, &Viewport::imageShown, this, [this](int pass, bool last, double seconds) {
-        statusBar()->showMessage(tr("Viewport: pass %1%2, %3 s after the change")
+        statusBar()->showMessage(tr("Viewport: pass %1%2, %3, %4 s after the change")
                                      .arg(pass + 1)
                                      .arg(last ? tr(" (final)") : QString())
+                                     .arg(m_viewport->sampleCounterText())
                                      .arg(seconds, 0, 'f', 3));
     });
     connect(m_viewport, &Viewport::renderFailed, this, [this](const QString& m) { appendLog(tr("viewport: %1").arg(m)); });
@@ -257,7 +270,12 @@ void MainWindow::buildDocks()
     m_skyPanel = new SkyPanel(m_doc);
     auto* skyDock = new QDockWidget(tr("Sky"), this);
     skyDock->setObjectName("skyDock");
-    skyDock->setWidget(m_skyPanel);
+    // Scrolled: the panel is taller than the Properties beside it, and the docks' column must not grow the window.
+    auto* skyScroll = new QScrollArea;
+    skyScroll->setWidgetResizable(true);
+    skyScroll->setFrameShape(QFrame::NoFrame);
+    skyScroll->setWidget(m_skyPanel);
+    skyDock->setWidget(skyScroll);
     connect(m_doc, &SceneDocument::editRefused, this,
             [this](const QString& text, const QString& why) { appendLog(tr("%1 refused: %2").arg(text, why)); });
 
@@ -419,6 +437,18 @@ void MainWindow::buildActions()
     });
     cameraFrame->setChecked(QSettings().value(QStringLiteral("view/cameraFrame"), true).toBool());
     m_viewport->setCameraFrame(cameraFrame->isChecked());
+    // The refinement's sample counter and progress bar over the picture (remembered; on at first).
+    QAction* counter = m_viewMenu->addAction(tr("&Sample Counter"));
+    counter->setObjectName("actionSampleCounter");
+    counter->setCheckable(true);
+    counter->setToolTip(tr("Show how many samples the viewport has added up, and a progress bar toward its limit, at the "
+                           "bottom of the picture"));
+    connect(counter, &QAction::toggled, this, [this](bool on) {
+        m_viewport->setSampleCounter(on);
+        QSettings().setValue(QStringLiteral("view/sampleCounter"), on);
+    });
+    counter->setChecked(QSettings().value(QStringLiteral("view/sampleCounter"), true).toBool());
+    m_viewport->setSampleCounter(counter->isChecked());
     // F in the viewport toggles it too (a window-wide F shortcut would eat the key in text fields).
     QAction* fly = m_viewMenu->addAction(tr("&Fly Navigation (F in the viewport)"));
     fly->setObjectName("actionFly");

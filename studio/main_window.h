@@ -20,6 +20,7 @@ class QComboBox;
 class QDockWidget;
 class QMenu;
 class QPlainTextEdit;
+class QSpinBox;
 class QTreeView;
 
 namespace sylva {
@@ -75,6 +76,8 @@ public:
     // Side-by-side compare: the toggle and the second mode (the right half of the viewport).
     QCheckBox* compareToggle() const { return m_compareToggle; }
     QComboBox* compareSelector() const { return m_compareBox; }
+    // The viewport's sample limit (Viewport::setSampleLimit; 0 shows "as the render").
+    QSpinBox* sampleLimitBox() const { return m_sampleLimitBox; }
     VolumeInspector* inspector() const { return m_inspector; }
     QDockWidget* inspectorDock() const { return m_inspectorDock; }
     QString logText() const;
@@ -171,6 +174,7 @@ private:
     QComboBox* m_integratorBox;
     QCheckBox* m_compareToggle;
     QComboBox* m_compareBox;
+    QSpinBox* m_sampleLimitBox;
     VolumeInspector* m_inspector = nullptr;
     QDockWidget* m_inspectorDock = nullptr;
     QMenu* m_viewMenu = nullptr;

@@ -1,6 +1,7 @@
 // RenderWorker: progressive passes with restart, the species part of the frame kept across camera moves.
 #include "studio/render_worker.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -11,6 +12,7 @@
 #include "core/base/error.h"
 #include "core/base/parallel.h"
 #include "core/render/tonemap_film.h"
+#include "core/scene/quality.h"
 #include "pipeline/backend_select.h"
 #include "pipeline/render/render_job.h"
 #include "studio/background_priority.h"
@@ -35,12 +37,43 @@ QImage compareImage(const Film& film, RenderMode left, RenderMode right, const g
     return out;
 }
 
+QImage heldExposureImage(const Film& film, const Film& exposure, RenderMode left, RenderMode right, const glm::vec3& sky,
+                         float exposureKey, float* scaleOut)
+{
+    if (film.width <= 0 || film.height <= 0) return {};
+    if (!std::isfinite(exposureKey) || !(exposureKey > 0.0f))
+        throw Error("tone map key " + std::to_string(exposureKey) + " must be finite and > 0");
+    // toneMapFilm's reductions over the exposure's film, its per-pixel pass over this film.
+    const HostExec exec;
+    double acc[kToneSums] = {};
+    const size_t ne = size_t(exposure.width) * size_t(exposure.height);
+    const bool ambient = left == RenderMode::Ambient || right == RenderMode::Ambient;
+    exec.sum<2>(ambient ? ne : 0, tone_detail::AmbientTerms{exposure.pixels.data()}, acc);
+    exec.sum<2>(ne, tone_detail::LogTerms{exposure.pixels.data(), left, sky, acc}, acc + 2);
+    exec.sum<2>(right != left ? ne : 0, tone_detail::LogTerms{exposure.pixels.data(), right, sky, acc}, acc + 4);
+    QImage out(film.width, film.height, QImage::Format_RGBX8888);   // bytes R, G, B, 255, rows packed
+    exec.forEach(size_t(film.width) * size_t(film.height),
+                 tone_detail::MapPixel{film.pixels.data(), film.width, left, right, sky, exposureKey, acc,
+                                       reinterpret_cast<uint32_t*>(out.bits())});
+    if (scaleOut) *scaleOut = exposureScale(exposureKey, logAverageOf(acc[2], acc[3]));
+    return out;
+}
+
+int finalPresetSamples()
+{
+    const QualityPreset* q = findQualityPreset("final");
+    return q ? q->spp : 64;
+}
+
 namespace {
 
-QImage picture(const Film& film, const Scene& scene, const std::optional<RenderMode>& compare)
+// The picture of `film` for the request's scene; exposed as `exposure` (steady) or as itself.
+QImage picture(const Film& film, const Film& exposure, const Scene& scene, const std::optional<RenderMode>& compare,
+               float* scale)
 {
-    return compare ? compareImage(film, scene.render.mode, *compare, composeSky(scene), scene.render.exposureKey)
-                   : filmImage(film, scene.render.mode, composeSky(scene), scene.render.exposureKey);
+    const RenderMode left = scene.render.mode, right = compare ? *compare : left;
+    return heldExposureImage(film, exposure.width > 0 ? exposure : film, left, right, composeSky(scene), scene.render.exposureKey,
+                             scale);
 }
 
 } // namespace
@@ -72,6 +105,18 @@ std::vector<RenderPass> RenderWorker::passes() const
 {
     QMutexLocker lock(&m_mutex);
     return m_passes;
+}
+
+void RenderWorker::setRefineSettings(RefineSettings settings)
+{
+    QMutexLocker lock(&m_mutex);
+    m_refine = settings;
+}
+
+RefineSettings RenderWorker::refineSettings() const
+{
+    QMutexLocker lock(&m_mutex);
+    return m_refine;
 }
 
 void RenderWorker::request(const Scene& scene, std::vector<AssetsPtr> assets, QSize size, std::optional<RenderMode> compare,
@@ -145,9 +190,11 @@ void RenderWorker::process(const Request& req, Progress& progress)
                     std::to_string(scene.species.size()) + " species");
     const int w = std::max(1, req.size.width()), h = std::max(1, req.size.height());
     std::vector<RenderPass> passes;
+    RefineSettings refineSettings;
     {
         QMutexLocker lock(&m_mutex);
         passes = m_passes;
+        refineSettings = m_refine;
     }
     auto elapsed = [this] {
         QMutexLocker lock(&m_mutex);
@@ -186,9 +233,11 @@ void RenderWorker::process(const Request& req, Progress& progress)
         }
     }
 
-    // A change of mode, compare mode or exposure alone: the film already holds every mode's parts.
+    // A change of mode, compare mode or exposure alone (the refinement's settings unchanged): the film already holds
+    // every mode's parts, and a steady picture keeps its exposure film.
     if (m_lastScene && m_frameAssets == req.assets && m_frameRelight == req.relight && m_lastSize == req.size &&
-        m_lastPass == int(passes.size()) - 1) {
+        m_lastPass == int(passes.size()) - 1 && m_lastRefine.sampleLimit == refineSettings.sampleLimit &&
+        m_lastRefine.steady == refineSettings.steady) {
         Scene a = *m_lastScene, b = scene;
         a.render.mode = b.render.mode;
         a.render.exposureKey = b.render.exposureKey;
@@ -199,9 +248,10 @@ void RenderWorker::process(const Request& req, Progress& progress)
             if (m_frame && !viewFrameUpdate(m_frameScene, scene).any() && viewFrameFits(*m_frame, scene))
                 place(scene, sunRadiance(scene.sun), std::max(1, req.size.width()), std::max(1, req.size.height()),
                       passes.empty() ? 1 : passes.back().spp);
-            const QImage img = picture(m_lastFilm, scene, req.compare);
+            float scale = 0.0f;
+            const QImage img = picture(m_lastFilm, m_exposureFilm, scene, req.compare, &scale);
             m_lastScene = scene;
-            Q_EMIT imageReady(img, m_lastPass, true, elapsed(), req.serial);
+            Q_EMIT imageReady(img, m_lastPass, true, elapsed(), req.serial, m_lastSamples, m_lastTarget, scale);
             return;
         }
     }
@@ -257,13 +307,17 @@ void RenderWorker::process(const Request& req, Progress& progress)
     // Progressive refinement: the schedule's frames (while the camera moves every request
     // restarts them) light with the sun's one shadow ray alone; then, at full size, frames of new sample
     // positions and sky-light subsets are accumulated up to the samples `sylva render` traces.
+    // Steady: every pass lit alike (the sky's lights too) and exposed as the first.
     const Refinement refine = refinementFor(m_frame->rs.view(),   // the sky's lights are the frame's (built, not placed)
-                                             scene.render.spp, passes.empty() ? 0 : passes.back().spp);
+                                             scene.render.spp, passes.empty() ? 0 : passes.back().spp, refineSettings.sampleLimit);
+    const bool steady = refineSettings.steady;
+    const int target = refine.frames > 0 ? refine.samples : passes.empty() ? 0 : passes.back().spp;
+    bool exposureSet = false;   // m_exposureFilm is this request's (set with its first picture)
     for (size_t p = 0; p < passes.size(); ++p) {
         const int pw = std::max(1, w / passes[p].divisor), ph = std::max(1, h / passes[p].divisor);
         place(scene, sun, pw, ph, passes[p].spp);
         RenderView view = m_frame->rs.view();
-        if (refine.frames > 0) view.sky.lightCount = 0;   // moving: the sun alone
+        if (refine.frames > 0 && !steady) view.sky.lightCount = 0;   // moving: the sun alone
         // The first pass of a relit frame runs to its end even when the next sun is already asked for:
         // a sun drag shows every relit sun it can (one preview each) instead of restarting before any.
         const bool shield = relit && p == 0;
@@ -271,13 +325,21 @@ void RenderWorker::process(const Request& req, Progress& progress)
         Film film = renderFilm(view, &progress);
         m_shieldPass = false;
         if (m_abort.load() || (interrupted() && !shield)) throw Cancelled();
-        const QImage img = picture(film, scene, req.compare);
+        if (!exposureSet) {
+            m_exposureFilm = steady ? film : Film{};
+            exposureSet = true;
+        }
+        float scale = 0.0f;
+        const QImage img = picture(film, m_exposureFilm, scene, req.compare, &scale);
         const bool last = p + 1 == passes.size() && refine.frames == 0;
         m_lastFilm = std::move(film);
         m_lastScene = scene;
         m_lastSize = req.size;
         m_lastPass = last ? int(passes.size()) - 1 : -1;
-        Q_EMIT imageReady(img, int(p), last, elapsed(), req.serial);
+        m_lastSamples = passes[p].spp;
+        m_lastTarget = target;
+        m_lastRefine = refineSettings;
+        Q_EMIT imageReady(img, int(p), last, elapsed(), req.serial, passes[p].spp, target, scale);
     }
     if (refine.frames == 0) return;
     place(scene, sun, w, h, refine.samples);
@@ -292,12 +354,20 @@ void RenderWorker::process(const Request& req, Progress& progress)
         accumulateFilm(sum, done, part, view.sampleEnd - view.sampleBegin);
         done = view.sampleEnd;
         const bool last = done >= refine.samples;
-        const QImage img = picture(sum, scene, req.compare);
+        if (!exposureSet) {
+            m_exposureFilm = steady ? sum : Film{};
+            exposureSet = true;
+        }
+        float scale = 0.0f;
+        const QImage img = picture(sum, m_exposureFilm, scene, req.compare, &scale);
         m_lastFilm = sum;
         m_lastScene = scene;
         m_lastSize = req.size;
         m_lastPass = last ? int(passes.size()) - 1 : -1;
-        Q_EMIT imageReady(img, int(passes.size()) + f, last, elapsed(), req.serial);
+        m_lastSamples = done;
+        m_lastTarget = target;
+        m_lastRefine = refineSettings;
+        Q_EMIT imageReady(img, int(passes.size()) + f, last, elapsed(), req.serial, done, target, scale);
     }
 }
 
@@ -321,13 +391,14 @@ std::optional<ViewPick> RenderWorker::pick(const CameraDesc& camera, QSize size,
     return hit;
 }
 
-Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp)
+Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp, int sampleLimit)
 {
     Refinement r;
-    if (view.sky.lightCount == 0 && sceneSpp <= lastPassSpp) return r;   // the constant sky: the schedule as before
+    const int want = std::clamp(sampleLimit > 0 ? sampleLimit : sceneSpp, 1, kMaxViewportSamples);
+    if (view.sky.lightCount == 0 && want <= lastPassSpp) return r;   // the constant sky: the schedule as before
     const int subsets = std::max(1, view.sky.interleave.subsets);
-    r.samples = std::max(sceneSpp, subsets);
-    r.perFrame = subsets;
+    r.samples = std::max(want, subsets);
+    r.perFrame = subsets * std::max(1, (std::max(1, lastPassSpp) + subsets - 1) / subsets);
     r.frames = (r.samples + r.perFrame - 1) / r.perFrame;
     return r;
 }

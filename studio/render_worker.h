@@ -33,14 +33,30 @@ struct RenderPass {
     int spp;
 };
 
-// The viewport's refinement once the schedule is done: `frames` full-size frames of
-// `perFrame` samples each (one cycle of the K sky-light subsets), accumulated (accumulateFilm) into the
-// frame of `samples` samples per pixel, the scene's spp (at least K), which is `sylva render`'s picture.
-// None (frames 0) for a constant sky whose spp the schedule's last pass already reaches.
+// The viewport's refinement once the schedule is done: `frames` full-size frames of `perFrame` samples each
+// (whole cycles of the K sky-light subsets, at least the schedule's last pass's samples, so no frame shows
+// more noise than the pass before it), accumulated (accumulateFilm) into the frame of `samples` samples per
+// pixel: the sample limit (0: the scene's spp; then it is `sylva render`'s picture), at least K, at most
+// kMaxViewportSamples. None (frames 0) for a constant sky whose samples the schedule's last pass already reaches.
 struct Refinement {
     int samples = 0, perFrame = 0, frames = 0;
 };
-Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp);
+Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp, int sampleLimit = 0);
+inline constexpr int kMaxViewportSamples = 4096;   // render.spp's bound
+
+// How the viewport refines a view that stays still (RenderWorker::setRefineSettings).
+struct RefineSettings {
+    // Samples per pixel the refinement accumulates to while nothing changes; 0: the scene's render.spp.
+    int sampleLimit = 0;
+    // One exposure for every picture of a request: the tone map's log-average (and the flat-ambient constant)
+    // taken from the request's first pass and kept for its later passes and recompositions, and every pass lit
+    // by the sky's lights (no sun-only preview), so refinement only removes noise. Off: each picture is exposed
+    // as its own film (filmImage) and the schedule's passes light with the sun alone while a sky is refined.
+    bool steady = false;
+};
+
+// The samples per pixel of the `final` quality preset (core/scene/quality.h): the viewport's default limit.
+int finalPresetSamples();
 
 // Tone-mapped sRGB picture of a film in a render mode (composeMode + toneMapped), as a QImage.
 QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float exposureKey);
@@ -49,6 +65,12 @@ QImage filmImage(const Film& film, RenderMode mode, const glm::vec3& sky, float 
 // of one film: columns [0, width/2) from filmImage(film, left), the rest from filmImage(film, right); each half
 // is exactly that mode's own picture.
 QImage compareImage(const Film& film, RenderMode left, RenderMode right, const glm::vec3& sky, float exposureKey);
+
+// compareImage of `film` exposed as `exposure` is: the log-average luminance of each half's mode (and the flat
+// ambient constant) read from the film `exposure`, not from `film` (the viewport's one exposure for all passes of
+// a view; `exposure` may have another size). scaleOut (optional): the left mode's exposure scale, key / log-average.
+QImage heldExposureImage(const Film& film, const Film& exposure, RenderMode left, RenderMode right, const glm::vec3& sky,
+                         float exposureKey, float* scaleOut = nullptr);
 
 // The GPU viewport's frame: the species part built and uploaded on the worker thread, then handed to
 // the viewport, which re-places it for every camera move (placeViewFrame, DeviceFrame::place).
@@ -73,6 +95,10 @@ public:
     static std::vector<RenderPass> defaultPasses();
     void setPasses(std::vector<RenderPass> passes);
     std::vector<RenderPass> passes() const;
+    // How a still view refines (RefineSettings; default: to the scene's spp, each picture its own exposure).
+    // Takes effect with the next request.
+    void setRefineSettings(RefineSettings settings);
+    RefineSettings refineSettings() const;
 
     // Renders `scene` with `assets` (one per species, in order) at `size` pixels. Cancels the frame in
     // progress. Same assets as the last request: only the top level is re-placed (fast); a change of
@@ -110,9 +136,12 @@ public:
     std::optional<ViewPick> pick(const CameraDesc& camera, QSize size, QPointF pixel, int waitMs = 200) const;
 
 Q_SIGNALS:
-    // pass: index into the schedule; last: the schedule is done; seconds: since the request; serial: the
-    // request the image is for (latestRequest() says whether a newer one was made since).
-    void imageReady(const QImage& image, int pass, bool last, double seconds, quint64 serial);
+    // pass: index into the schedule (then the refinement's frames); last: the refinement is done; seconds: since the
+    // request; serial: the request the image is for (latestRequest() says whether a newer one was made since);
+    // samples: per pixel in this image; target: what the view settles at; exposure: the tone map's scale (key /
+    // log-average luminance) of the image's (left) mode.
+    void imageReady(const QImage& image, int pass, bool last, double seconds, quint64 serial, int samples, int target,
+                    double exposure);
     void failed(const QString& message);
     // GPU mode: the frame for the requested assets is on the device.
     void gpuFrameReady(const sylva::GpuFramePtr& frame);
@@ -140,6 +169,7 @@ private:
     QWaitCondition m_condition;
     Request m_request;
     std::vector<RenderPass> m_passes;
+    RefineSettings m_refine;
     QElapsedTimer m_sinceRequest;
     std::atomic<bool> m_restart{false}, m_abort{false}, m_gpu{false}, m_gpuForget{false};
     bool m_hasRequest = false;
@@ -159,7 +189,10 @@ private:
     std::optional<Scene> m_lastScene;     // what m_lastFilm shows
     QSize m_lastSize;
     Film m_lastFilm;
+    Film m_exposureFilm;                  // steady: the first pass of m_lastFilm's request (its exposure)
     int m_lastPass = -1;
+    int m_lastSamples = 0, m_lastTarget = 0;
+    RefineSettings m_lastRefine;          // what m_lastFilm was refined with
     std::vector<AssetsPtr> m_gpuAssets;   // what the last GPU frame was built from
     Scene m_gpuScene;                     // ... and for which scene
     bool m_gpuPruned = false;             // ... and whether with every level of detail (the scene pruned)

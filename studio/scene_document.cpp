@@ -67,7 +67,7 @@ ScenePart changedParts(const Scene& a, const Scene& b)
     if (ca.position != cb.position || ca.target != cb.target || ca.up != cb.up || ca.fovY != cb.fovY) p = p | ScenePart::Camera;
     const RenderSettings &ra = a.render, &rb = b.render;
     if (ra.width != rb.width || ra.height != rb.height || ra.spp != rb.spp || ra.mode != rb.mode || ra.accel != rb.accel ||
-        ra.shadows != rb.shadows || ra.indirectScale != rb.indirectScale || ra.exposureKey != rb.exposureKey ||
+        ra.shadows != rb.shadows || ra.indirectScale != rb.indirectScale || ra.exposureKey != rb.exposureKey || ra.leafTint != rb.leafTint ||
         ra.integrator != rb.integrator || ra.maxBounces != rb.maxBounces || a.version != b.version)
         p = p | ScenePart::Render;
     return p;

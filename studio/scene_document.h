@@ -21,7 +21,7 @@ enum class ScenePart : unsigned {
     Sun = 1u << 3,
     Sky = 1u << 4,
     Camera = 1u << 5,
-    Render = 1u << 6,      // render settings (mode, size, spp, exposure)
+    Render = 1u << 6,      // render settings (mode, size, spp, exposure, leaf tint)
     Terrain = 1u << 7,     // the terrain: DEM, its colours, cells, tiles, tiling, density
     Volumes = 1u << 8,     // the volume list or a volume's grid, optics or placements
     All = 0x1ffu,

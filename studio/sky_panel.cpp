@@ -47,6 +47,9 @@ QFormLayout* form(QWidget* w)
 
 sky::SunPlace placeOf(const Scene& s) { return s.sun.place ? *s.sun.place : sky::SunPlace{}; }
 
+// The key of exposure 0 EV: Reinhard's middle grey, the render's default key.
+constexpr double kMiddleGrey = 0.18;
+
 } // namespace
 
 SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc(doc)
@@ -231,6 +234,28 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     sunLayout->addWidget(m_sunInfo);
     layout->addWidget(sunBox);
 
+    // The look: exposure, leaf tint, ground colour.
+    auto* lookBox = new QGroupBox(tr("Look"));
+    auto* lookForm = new QFormLayout(lookBox);
+    m_exposure = spin("render.exposure", -10.0, 10.0, 2, 0.25);
+    connect(m_exposure, &QDoubleSpinBox::valueChanged, this, [this](double ev) {
+        apply(m_exposure, tr("Change exposure"), [&](Scene& s) { s.render.exposureKey = float(kMiddleGrey * std::exp2(ev)); });
+    });
+    lookForm->addRow(tr("Exposure (EV)"), m_exposure);
+    for (int c = 0; c < 3; ++c) {
+        m_leafTint[size_t(c)] = spin(QStringLiteral("render.leafTint.%1").arg(c), 0.0, 2.0, 2, 0.05);
+        connect(m_leafTint[size_t(c)], &QDoubleSpinBox::valueChanged, this, [this, c](double v) {
+            apply(m_leafTint[size_t(c)], tr("Change leaf tint"), [&](Scene& s) { s.render.leafTint[c] = float(v); });
+        });
+        m_groundColor[size_t(c)] = spin(QStringLiteral("ground.color.%1").arg(c), 0.0, 1.0, 3, 0.05);
+        connect(m_groundColor[size_t(c)], &QDoubleSpinBox::valueChanged, this, [this, c](double v) {
+            apply(m_groundColor[size_t(c)], tr("Change ground colour"), [&](Scene& s) { s.ground.color[c] = float(v); });
+        });
+    }
+    lookForm->addRow(tr("Leaf tint (R G B)"), row({m_leafTint[0], m_leafTint[1], m_leafTint[2]}));
+    lookForm->addRow(tr("Ground colour (R G B)"), row({m_groundColor[0], m_groundColor[1], m_groundColor[2]}));
+    layout->addWidget(lookBox);
+
     m_status = new QLabel;
     m_status->setObjectName("sky.status");
     m_status->setWordWrap(true);
@@ -329,6 +354,11 @@ void SkyPanel::refresh()
     m_mapRows->setVisible(d.kind == sky::SkyKind::Map);
     m_lightRows->setVisible(d.analytic());
     m_sunPages->setCurrentIndex(s.sun.place ? 1 : 0);
+    setValue(m_exposure, std::log2(double(s.render.exposureKey) / kMiddleGrey));
+    for (int c = 0; c < 3; ++c) {
+        setValue(m_leafTint[size_t(c)], double(s.render.leafTint[c]));
+        setValue(m_groundColor[size_t(c)], double(s.ground.color[c]));
+    }
 }
 
 } // namespace sylva

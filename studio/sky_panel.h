@@ -1,9 +1,11 @@
 // The sky panel: the sky model (constant, Preetham, HDR map) with its turbidity, map
 // file, rotation and intensity, the virtual lights and their interleaving, the sky in the LB boundary, and the sun by dial (elevation,
-// azimuth) or by date, time, time zone and place with a time slider. Every change is an undoable edit
+// azimuth) or by date, time, time zone and place with a time slider; the look of the picture: exposure (stops
+// over the render's key), leaf tint and ground colour. Every change is an undoable edit
 // of the document (edits of one control less than a second apart merge into one step).
 #pragma once
 
+#include <array>
 #include <functional>
 #include <map>
 
@@ -57,6 +59,11 @@ public:
     QDoubleSpinBox* timeZone() const { return m_zone; }
     QDoubleSpinBox* latitude() const { return m_latitude; }
     QDoubleSpinBox* longitude() const { return m_longitude; }
+    // Exposure in stops (EV): the render's key is 0.18 x 2^EV (render.key), so +1 doubles the exposure scale.
+    QDoubleSpinBox* exposure() const { return m_exposure; }
+    // Leaf tint (render.leaf_tint) and ground colour (ground.color), channel c = 0, 1, 2 (red, green, blue).
+    QDoubleSpinBox* leafTint(int c) const { return m_leafTint[size_t(c)]; }
+    QDoubleSpinBox* groundColor(int c) const { return m_groundColor[size_t(c)]; }
     // The last refused edit's reason (a map that cannot be read, a sun the model refuses), or empty.
     QString status() const;
 
@@ -85,6 +92,8 @@ private:
     QSlider* m_timeSlider;
     QDoubleSpinBox *m_zone, *m_latitude, *m_longitude;
     QLabel* m_sunInfo;
+    QDoubleSpinBox* m_exposure;
+    std::array<QDoubleSpinBox*, 3> m_leafTint{}, m_groundColor{};
     QLabel* m_status;
     QWidget *m_preethamRows, *m_mapRows, *m_lightRows;
 

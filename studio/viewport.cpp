@@ -2,6 +2,9 @@
 // edits, picking by one traced ray.
 #include "studio/viewport.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <QApplication>
 #include <QDateTime>
 #include <QKeyEvent>
@@ -10,6 +13,7 @@
 #include <QOpenGLShaderProgram>
 #include <QOpenGLTexture>
 #include <QPainter>
+#include <QSettings>
 #include <QWheelEvent>
 
 #include "core/backend/backend.h"
@@ -49,6 +53,8 @@ Viewport::Viewport(QWidget* parent) : QOpenGLWidget(parent), m_worker(new Render
 {
     setFocusPolicy(Qt::StrongFocus);
     setMinimumSize(160, 90);
+    m_sampleLimit = std::max(0, QSettings().value("viewport/sampleLimit", finalPresetSamples()).toInt());
+    m_worker->setRefineSettings({m_sampleLimit, true});
     connect(m_worker, &RenderWorker::imageReady, this, &Viewport::onImage);
     connect(m_worker, &RenderWorker::failed, this, [this](const QString& message) {
         setStatus(message);
@@ -132,8 +138,61 @@ void Viewport::requestRender()
     m_worker->request(viewScene(), m_assets, renderSize(), m_compare, m_relight);
 }
 
-void Viewport::onImage(const QImage& image, int pass, bool last, double seconds, quint64 serial)
+void Viewport::setSampleLimit(int samples)
 {
+    samples = std::clamp(samples, 0, kMaxViewportSamples);
+    QSettings().setValue("viewport/sampleLimit", samples);
+    if (samples == m_sampleLimit) return;
+    m_sampleLimit = samples;
+    m_worker->setRefineSettings({m_sampleLimit, true});
+    requestRender();
+}
+
+void Viewport::setSampleCounter(bool on)
+{
+    if (m_sampleCounter == on) return;
+    m_sampleCounter = on;
+    update();
+}
+
+QString Viewport::sampleCounterText() const
+{
+    if (m_samplesShown <= 0) return QString();
+    return tr("Samples %1 / %2").arg(m_samplesShown).arg(std::max(m_samplesShown, m_sampleTarget));
+}
+
+QRectF Viewport::progressBarRect() const
+{
+    if (m_samplesShown <= 0) return {};
+    const double f = m_sampleTarget > 0 ? std::min(1.0, double(m_samplesShown) / double(m_sampleTarget)) : 1.0;
+    const double h = 3.0;
+    return {0.0, double(height()) - h, std::round(f * double(width())), h};
+}
+
+void Viewport::drawProgress()
+{
+    const QString text = sampleCounterText();
+    if (!m_sampleCounter || text.isEmpty()) return;
+    QPainter p(this);
+    const QRectF bar = progressBarRect();
+    p.fillRect(QRectF(0.0, bar.top(), double(width()), bar.height()), QColor(0, 0, 0, 140));   // the track
+    p.fillRect(bar, progressBarColor());
+    QFont f = p.font();
+    f.setPixelSize(11);
+    p.setFont(f);
+    const QRect box = p.fontMetrics().boundingRect(text).adjusted(-4, -2, 4, 2);
+    const QRect at(6, int(bar.top()) - 4 - box.height(), box.width(), box.height());
+    p.fillRect(at, QColor(0, 0, 0, 120));
+    p.setPen(QColor(235, 235, 235));
+    p.drawText(at, Qt::AlignCenter, text);
+}
+
+void Viewport::onImage(const QImage& image, int pass, bool last, double seconds, quint64 serial, int samples, int target,
+                       double exposure)
+{
+    m_samplesShown = samples;
+    m_sampleTarget = target;
+    m_exposureShown = exposure;
     // An image queued before a newer request (an edit while its signal waited in the event loop) is
     // shown, so a drag still moves the picture, but it is not the current scene's final image.
     if (serial != m_worker->latestRequest()) last = false;
@@ -262,6 +321,7 @@ void Viewport::paintGL()
     drawTexture();
     drawCameraFrame();
     drawSelection();
+    drawProgress();
     if (m_compare && m_texture && m_texture->width() > 0) {
         // The split the renderer made (column width / 2 of the picture), and which mode is where.
         QPainter p(this);
@@ -359,6 +419,8 @@ bool Viewport::paintGpu()
 
     const double seconds = m_sinceRequest.isValid() ? double(m_sinceRequest.nsecsElapsed()) * 1e-9 : 0.0;
     if (last) m_image = picture;
+    m_samplesShown = spps[pass];
+    m_sampleTarget = spps.back();
     m_lastPass = int(pass);
     m_lastFinal = last;
     if (m_awaitingFirst) {
@@ -385,6 +447,12 @@ void Viewport::mousePressEvent(QMouseEvent* event)
     m_dragKey = SceneDocument::newMergeKey();
     m_dragMoved = false;
     m_panDepth = 0.0;
+    m_orbitPivot.reset();
+    if (m_drag == Drag::Orbit) {
+        // Orbit about what is under the cursor (the target without a hit).
+        if (const std::optional<ViewPick> hit = pickAt(event->position(), kNavigationPickMs); hit && hit->kind != SurfaceKind::None)
+            m_orbitPivot = hit->point;
+    }
     if (pan) {
         // Grab what is under the cursor: it follows the cursor at its own depth (the target's without a hit).
         if (const std::optional<ViewPick> hit = pickAt(event->position(), kNavigationPickMs); hit && hit->kind != SurfaceKind::None) {
@@ -404,7 +472,10 @@ void Viewport::mouseMoveEvent(QMouseEvent* event)
     m_dragMoved = true;
     CameraDesc c;
     switch (m_drag) {
-    case Drag::Orbit: c = orbitCamera(m_dragCamera, -0.4 * d.x(), 0.4 * d.y()); break;
+    case Drag::Orbit:
+        c = m_orbitPivot ? orbitCameraAbout(m_dragCamera, -0.4 * d.x(), 0.4 * d.y(), *m_orbitPivot)
+                         : orbitCamera(m_dragCamera, -0.4 * d.x(), 0.4 * d.y());
+        break;
     case Drag::Look: c = flyLook(m_dragCamera, 0.3 * d.x(), -0.3 * d.y()); break;
     default: {
         // At the viewport's field of view (the grabbed point follows the cursor); the scene's is kept.
@@ -615,7 +686,7 @@ void Viewport::setCompare(std::optional<RenderMode> mode)
     requestRender();
 }
 
-double Viewport::flyStep() const { return flyStepFor(m_scene); }
+double Viewport::flyStep() const { return flyStepFor(m_scene, m_speciesBoxes); }
 
 void Viewport::keyPressEvent(QKeyEvent* event)
 {

@@ -42,6 +42,23 @@ public:
     bool lastImageFinal() const { return m_lastFinal; }
     // Seconds from the request to its first image, for the latest request that produced one.
     double firstImageSeconds() const { return m_firstImageSeconds; }
+
+    // Progressive refinement: while nothing changes the viewport accumulates samples per pixel up to its sample
+    // limit (setting viewport/sampleLimit; default finalPresetSamples(), the `final` quality preset's; 0: the
+    // scene's render.spp, the picture `sylva render` gives), every pass at one exposure (RefineSettings::steady).
+    // The count is drawn over the picture's lower left corner ("Samples 12 / 64", sampleCounterText) above a
+    // progress bar along its lower edge (progressBarRect: the filled part, samples / target of the width).
+    void setSampleLimit(int samples);
+    int sampleLimit() const { return m_sampleLimit; }
+    int samplesShown() const { return m_samplesShown; }   // per pixel in the picture shown (0: none yet)
+    int sampleTarget() const { return m_sampleTarget; }   // what it settles at
+    double exposureShown() const { return m_exposureShown; }   // the tone map's scale of the picture shown
+    // View > Sample Counter: the counter and the bar drawn (on by default; sampleCounterText() says the count either way).
+    void setSampleCounter(bool on);
+    bool sampleCounter() const { return m_sampleCounter; }
+    QString sampleCounterText() const;
+    QRectF progressBarRect() const;
+    static QColor progressBarColor() { return {90, 170, 255}; }
     // Render size in pixels (widget size x device pixel ratio).
     QSize renderSize() const;
     RenderWorker* worker() const { return m_worker; }
@@ -58,11 +75,14 @@ public:
     void setCompare(std::optional<RenderMode> mode);
     std::optional<RenderMode> compare() const { return m_compare; }
 
+    // Orbit (left drag): about the surface under the cursor when the drag began (it stays on its pixel,
+    // orbitCameraAbout), or about the target when the cursor is over the sky.
     // Fly navigation (toggle: F in the viewport): W/S forward/back, A/D left/right, Q/E down/up, each
     // press flyStep() metres (Shift: 5x); left drag looks around the eye. Off: left drag orbits.
     bool flyMode() const { return m_fly; }
     void setFlyMode(bool on);
-    // Metres per key press (flyStepFor): over a terrain 0.5% of its size, else 5% of the eye-target distance.
+    // Metres per key press (flyStepFor): over a terrain 0.5% of its size, else 5% of the eye-target distance but at
+    // least 0.5% of the plants' extent.
     double flyStep() const;
 
     // Picking: what the camera ray through widget position `pos` (logical pixels) hits, traced in the frame
@@ -125,7 +145,9 @@ protected:
 private:
     void cleanupGL();
     void requestRender();
-    void onImage(const QImage& image, int pass, bool last, double seconds, quint64 serial);
+    void onImage(const QImage& image, int pass, bool last, double seconds, quint64 serial, int samples, int target,
+                 double exposure);
+    void drawProgress();
     void setupGpu();
     bool paintGpu();   // false: no GPU frame to show yet
     void disableGpu(const QString& why);
@@ -148,12 +170,17 @@ private:
     bool m_lastFinal = false;
     double m_firstImageSeconds = -1.0;
     bool m_awaitingFirst = false;
+    int m_sampleLimit = 0;
+    bool m_sampleCounter = true;
+    int m_samplesShown = 0, m_sampleTarget = 0;
+    double m_exposureShown = 0.0;
 
     // navigation
     enum class Drag { None, Orbit, Pan, Look };
     Drag m_drag = Drag::None;
     bool m_dragMoved = false;   // past the drag distance: a drag, not a click
     double m_panDepth = 0.0;    // metres along the view to what the pan grabbed (0: the target's distance)
+    std::optional<glm::dvec3> m_orbitPivot;   // what the orbit drag turns about (none: the target)
     QPoint m_dragStart;
     CameraDesc m_dragCamera;
     int m_dragKey = 0;

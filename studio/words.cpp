@@ -27,6 +27,9 @@ const QHash<QString, QString>& tips()
         {"compareToggle", tr("Split the viewport: the left half shows the light chosen on the left, the right half the "
                              "light chosen here, from one render")},
         {"compareMode", tr("The light shown in the right half of the split viewport")},
+        {"viewportSamples", tr("How many samples per pixel the viewport adds up while the view stays still: more is "
+                               "smoother and takes longer (the counter and the bar at the bottom of the viewport show how "
+                               "far it is). The lowest setting stops where the finished render would")},
         // Instance
         {"instance.species", tr("The species this tree is an instance of")},
         {"instance.position", tr("Where the tree stands, metres: x (east), y (up), z (south)")},
@@ -74,6 +77,12 @@ const QHash<QString, QString>& tips()
         {"sky.interleave", tr("Sky sample groups: the sky samples are split into this many groups that take turns "
                               "over neighbouring pixels and passes, so each pass is faster; the picture evens out "
                               "as passes add up")},
+        // Look
+        {"render.exposure", tr("Brightness of the picture in stops: +1 lets in twice the light, -1 half (0: the "
+                               "automatic exposure). The rendered image uses it too")},
+        {"render.leafTint", tr("Colours the leaves of every tree: red, green and blue multiply the leaves' own colour "
+                               "(1 1 1: as modelled; lower green and blue for autumn yellows)")},
+        {"ground.color", tr("Colour of the ground: how much red, green and blue light it reflects (0 to 1)")},
         {"lighting.boundary", tr("Let skylight, not only sunlight, scatter through the crowns (the species are lit again)")},
         // Terrain and landscape
         {"terrain.snowLine", tr("Height above which the ground is snow, metres (0: no snow)")},

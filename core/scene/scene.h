@@ -206,6 +206,8 @@ struct RenderSettings {
     bool shadows = true;
     float indirectScale = 1.0f;          // weight of the LB indirect light (1 = as solved, normalized to open sky)
     float exposureKey = 0.18f;           // Reinhard key value a
+    glm::vec3 leafTint{1.0f};            // multiplies every leaf material's diffuse colour (what leaves reflect and,
+                                         // with the path tracer, transmit); each in [0, 2], 1 = as modelled
     float alphaDistance = 0.0f;          // metres; beyond it from the camera leaf cut-outs are not tested
                                          // (cards count as opaque; Geist & Steele, "A Lighting Model for Fast
                                          // Rendering of Forest Ecosystems", section 2.1); 0 = off

@@ -92,7 +92,7 @@ ViewFrameUpdate viewFrameUpdate(const Scene& built, const Scene& next)
     const bool sameSky = ka.kind == kb.kind && ka.built == kb.built && ka.lights == kb.lights && ka.interleave == kb.interleave &&
                          (!kb.analytic() || groundPlaneShown(built) == groundPlaneShown(next));
     u.rebuild = !sameTerrainHeights(built.terrain, next.terrain) || built.groups.size() != next.groups.size() || !sameSky ||
-                built.render.accel != next.render.accel;
+                built.render.accel != next.render.accel || built.render.leafTint != next.render.leafTint;
     if (u.rebuild) return u;
     u.landscape = !sameLandscapeTiles(built.terrain, next.terrain);
     u.density = !u.landscape && !sameLandscapeDensity(built.terrain, next.terrain);

@@ -50,8 +50,8 @@ bool sameVolumes(const std::vector<VolumeDesc>& a, const std::vector<VolumeDesc>
 
 // What a frame built for `built` needs to show `next` (same species assets), cheapest first: nothing
 // (placeViewFrame re-places the top level: camera, instances, sun, colours), the density rule's fields,
-// the landscape's arrays, the volumes' arrays, or a whole build (terrain heights, groups, sky lights or
-// acceleration kind changed). Pruning is viewFrameFits' question.
+// the landscape's arrays, the volumes' arrays, or a whole build (terrain heights, groups, sky lights,
+// acceleration kind or leaf tint changed). Pruning is viewFrameFits' question.
 struct ViewFrameUpdate {
     bool density = false, landscape = false, volumes = false, rebuild = false;
     bool any() const { return density || landscape || volumes || rebuild; }

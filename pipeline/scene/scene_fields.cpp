@@ -749,6 +749,11 @@ const Table<RenderSettings>& renderTable()
         b.number("key", &RenderSettings::exposureKey, above(0.0)).doc("number", "Reinhard key value, > 0").summarized([](const RenderSettings& r) {
             return "key " + human(r.exposureKey);
         });
+        b.color("leaf_tint", &RenderSettings::leafTint, 0.0f, 2.0f)
+            .doc("`[r, g, b]`", "multiplies every leaf material's diffuse colour (what leaves reflect and, with `path`, transmit), "
+                                "each in [0, 2]; 1 = as modelled")
+            .writtenIf([](const RenderSettings& r) { return r.leafTint != glm::vec3(1.0f); })
+            .summarized([](const RenderSettings& r) { return r.leafTint != glm::vec3(1.0f) ? "leaf tint " + human3(r.leafTint) : std::string(); });
         b.number("alpha_distance", &RenderSettings::alphaDistance, atLeast(0.0, " (metres; 0 = off)"))
             .doc("number",
                  "metres, >= 0; beyond it from the camera leaf cut-outs are not tested (cards opaque); 0 = off "

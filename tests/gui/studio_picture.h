@@ -27,23 +27,38 @@ inline std::vector<SpeciesAssets> assetCopies(const std::vector<AssetsPtr>& held
     return out;
 }
 
+// The film of the viewport's first pass for `scene` at `size`, traced headless: the schedule's first pass (a
+// quarter-size frame at its samples, every light on), whose exposure the viewport keeps for all its pictures
+// of a view (RefineSettings::steady).
+inline Film firstPassFilm(Scene scene, const std::vector<SpeciesAssets>& assets, QSize size)
+{
+    const RenderPass first = RenderWorker::defaultPasses().front();
+    scene.render.width = std::max(1, size.width() / first.divisor);
+    scene.render.height = std::max(1, size.height() / first.divisor);
+    scene.render.spp = first.spp;
+    return renderFilm(buildRenderScene(scene, assets, sunRadiance(scene.sun)).view());
+}
+
 // The settled picture of the CPU viewport for `scene` at `size`, traced headless: the frame `sylva render`
 // builds for the scene's camera at that size, at the samples the viewport ends on (the schedule's last
-// pass, or the refinement's accumulated samples for a sky with virtual lights: refinementFor), through the
-// viewport's tone map (filmImage).
-inline QImage settledPicture(Scene scene, const std::vector<SpeciesAssets>& assets, QSize size)
+// pass, or the refinement's accumulated samples for a sky with virtual lights or a sample limit above the last
+// pass's: refinementFor), tone-mapped at the viewport's exposure, the first pass's (heldExposureImage of
+// firstPassFilm). sampleLimit: the viewport's (0: the scene's spp, what the tests' settings hold).
+inline QImage settledPicture(Scene scene, const std::vector<SpeciesAssets>& assets, QSize size, int sampleLimit = 0)
 {
+    const Film exposure = firstPassFilm(scene, assets, size);
     scene.render.width = size.width();
     scene.render.height = size.height();
     const int sceneSpp = scene.render.spp, lastPass = RenderWorker::defaultPasses().back().spp;
     scene.render.spp = lastPass;
     RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
-    const Refinement r = refinementFor(rs.view(), sceneSpp, lastPass);
+    const Refinement r = refinementFor(rs.view(), sceneSpp, lastPass, sampleLimit);
     if (r.frames > 0 && r.samples != lastPass) {
         scene.render.spp = r.samples;
         rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
     }
-    return filmImage(renderFilm(rs.view()), scene.render.mode, composeSky(scene), scene.render.exposureKey);
+    return heldExposureImage(renderFilm(rs.view()), exposure, scene.render.mode, scene.render.mode, composeSky(scene),
+                             scene.render.exposureKey);
 }
 
 // Each pixel's largest channel difference between two pictures of one size, in 8-bit steps.

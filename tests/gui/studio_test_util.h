@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <optional>
 
 #include <QApplication>
 #include <QDir>
@@ -18,6 +19,7 @@
 #include "core/lb/lb_params.h"
 #include "core/scene/scene.h"
 #include "studio/autosave_controller.h"
+#include "studio/camera_nav.h"
 #include "studio/export_controller.h"
 #include "studio/inspector_controller.h"
 #include "studio/job_manager.h"
@@ -71,6 +73,12 @@ inline void isolate(const QTemporaryDir& dir)
     // The viewport at its own aspect (View > Camera Frame off): the tests compare its pictures with headless
     // renders of the scene's camera at the viewport's size; tst_studio_artist tests the camera frame.
     QSettings().setValue("view/cameraFrame", false);
+    // The viewport refines to the scene's samples (its sample limit 0, not the final preset's 64): the tests
+    // compare its settled pictures with renders at the scene's samples; tst_studio_progressive tests the limit.
+    QSettings().setValue("viewport/sampleLimit", 0);
+    // No sample counter over the picture: the tests compare the framebuffer with the picture (tst_studio_progressive
+    // turns it on).
+    QSettings().setValue("view/sampleCounter", false);
     // No crash recovery left over from an earlier run (its question would block the test).
     QDir(QFileInfo(AutosaveController::recoveryFilePath()).absolutePath()).removeRecursively();
     qputenv("XDG_CACHE_HOME", dir.filePath("cache").toLocal8Bit());
@@ -124,6 +132,20 @@ inline bool waitForJob(Job* job, int timeoutMs, Job::State* stateOut = nullptr)
     if (!done) QObject::disconnect(c);
     if (stateOut) *stateOut = state;
     return done && state == Job::State::Succeeded;
+}
+
+// An orbit drag that began at widget pixel `from`, where the viewport picked `pressPick`, turned the camera
+// from `before` to `after` about that point (orbitCameraAbout: the point back on `from` within 0.75 px) or, when
+// the press was over the sky, about the target (kept exactly). Empty when it did; else what is wrong.
+inline QString orbitPivotProblem(const Viewport* v, const std::optional<ViewPick>& pressPick, const CameraDesc& before,
+                                 const CameraDesc& after, QPoint from)
+{
+    if (!pressPick || pressPick->kind == SurfaceKind::None)
+        return after.target == before.target ? QString() : QStringLiteral("an orbit over the sky moved the target");
+    glm::dvec2 px;
+    if (!projectToView(after, v->width(), v->height(), pressPick->point, &px)) return QStringLiteral("the pivot went behind the eye");
+    if (std::abs(px.x - from.x()) < 0.75 && std::abs(px.y - from.y()) < 0.75) return QString();
+    return QStringLiteral("the pivot picked at %1, %2 is at %3, %4 after the orbit").arg(from.x()).arg(from.y()).arg(px.x).arg(px.y);
 }
 
 // Waits until the viewport shows the last pass of its schedule.

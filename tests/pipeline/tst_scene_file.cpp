@@ -230,7 +230,7 @@ Scene fullScene(const QString& sceneDir)
     s.sun = {{-0.2f, 0.9f, 0.1f}, 5200.5, 3.25f, {}};
     s.sky = {0.1f, 0.2f, 1.7f};
     s.camera = {{10.5, 3.25, -40.0}, {1.0, 4.0, 2.0}, {0.0f, 1.0f, 0.1f}, 33.3f};
-    s.render = {1920, 1080, 64, RenderMode::Lb, AccelKind::KdTree, false, 0.75f, 0.3f, 87.5f, 33.25f};
+    s.render = {1920, 1080, 64, RenderMode::Lb, AccelKind::KdTree, false, 0.75f, 0.3f, {0.8f, 1.25f, 0.5f}, 87.5f, 33.25f};
     return s;
 }
 

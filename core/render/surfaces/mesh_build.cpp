@@ -280,8 +280,9 @@ void appendShadingArrays(RenderScene& rs, const TriangleMesh& m)
         rs.triMaterial.push_back(matBase + (m.triangleMaterial.empty() ? 0u : m.triangleMaterial[t]));
 }
 
-// A species' materials with their textures and cut-outs (one default material when the mesh names none).
-void appendMaterials(RenderScene& rs, const SpeciesAssets& a)
+// A species' materials with their textures and cut-outs (one default material when the mesh names none); the
+// leaves' diffuse colour times the scene's leaf tint.
+void appendMaterials(RenderScene& rs, const SpeciesAssets& a, const glm::vec3& leafTint)
 {
     const TriangleMesh& m = a.mesh;
     const size_t nm = std::max<size_t>(1, m.materials.size());
@@ -289,7 +290,7 @@ void appendMaterials(RenderScene& rs, const SpeciesAssets& a)
         MaterialRecord r{};
         const Material def;
         const Material& mat = i < m.materials.size() ? m.materials[i] : def;
-        r.diffuse = mat.diffuse;
+        r.diffuse = mat.isLeaf ? mat.diffuse * leafTint : mat.diffuse;
         r.specular = mat.specular;
         r.shininess = mat.shininess;
         r.isLeaf = mat.isLeaf ? 1u : 0u;
@@ -341,7 +342,7 @@ std::vector<uint32_t> appendSpecies(RenderScene& rs, const Scene& scene, const s
         const TriangleMesh& m = a.mesh;
         triBase[s] = uint32_t(rs.triVerts.size());
         appendShadingArrays(rs, m);
-        appendMaterials(rs, a);
+        appendMaterials(rs, a, scene.render.leafTint);
         GeometryRecord gr{};
         gr.kind = GeometryKind::Mesh;
         gr.species = uint32_t(s);
