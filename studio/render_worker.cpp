@@ -15,6 +15,7 @@
 #include "pipeline/render/render_job.h"
 #include "studio/background_priority.h"
 #include "studio/scene_document.h"
+#include "studio/view_transform.h"
 
 namespace sylva {
 
@@ -39,8 +40,7 @@ namespace {
 
 QImage picture(const Film& film, const Scene& scene, const std::optional<RenderMode>& compare)
 {
-    return compare ? compareImage(film, scene.render.mode, *compare, composeSky(scene), scene.render.exposureKey)
-                   : filmImage(film, scene.render.mode, composeSky(scene), scene.render.exposureKey);
+    return scenePicture(film, scene, compare);   // through the scene's view (view_transform.h)
 }
 
 } // namespace
@@ -186,12 +186,14 @@ void RenderWorker::process(const Request& req, Progress& progress)
         }
     }
 
-    // A change of mode, compare mode or exposure alone: the film already holds every mode's parts.
+    // A change of mode, compare mode, exposure or view alone: the film already holds every mode's parts.
     if (m_lastScene && m_frameAssets == req.assets && m_frameRelight == req.relight && m_lastSize == req.size &&
         m_lastPass == int(passes.size()) - 1) {
         Scene a = *m_lastScene, b = scene;
         a.render.mode = b.render.mode;
         a.render.exposureKey = b.render.exposureKey;
+        a.render.view = b.render.view;
+        a.render.display = b.render.display;
         if (changedParts(a, b) == ScenePart::None) {
             // A request cancelled since may have re-placed the frame for its own scene (an instance deleted, then
             // the delete undone before its first picture): the frame is placed for this scene again, as what the
