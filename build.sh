@@ -21,7 +21,9 @@ PACKAGES=(cmake ninja-build ccache g++ pkg-config
   # sylva study draws the plots of docs/ACCURACY.md
   gnuplot-nox
   # sylva render --mpi and its tests, see docs/DISTRIBUTED.md
-  libopenmpi-dev openmpi-bin)
+  libopenmpi-dev openmpi-bin
+  # OpenColorIO's display transforms (render --view); its tools check them in the tests
+  libopencolorio-dev opencolorio-tools)
 
 install_missing() {
   local missing=()

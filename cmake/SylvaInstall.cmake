@@ -21,10 +21,12 @@ install(TARGETS sylva sylva-studio RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 # OpenImageIO's module (pipeline/io/image_module.h), found relative to the programs' folder.
 install(TARGETS sylva_oiio LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}/sylva)
 # The programs carry their resources inside (Qt resources, ":/sylva/..."); the copies here are for
-# people: the default scene to start a scene file from, the colour table with its licence.
+# people: the default scene to start a scene file from, the colour table with its licence, the OpenColorIO config.
 install(FILES ${CMAKE_SOURCE_DIR}/resources/default_forest.sylva.json ${CMAKE_SOURCE_DIR}/resources/README.md
   DESTINATION ${CMAKE_INSTALL_DATADIR}/sylva)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/resources/color DESTINATION ${CMAKE_INSTALL_DATADIR}/sylva)
+# The OpenColorIO config of the views (built in too), for $OCIO and other OpenColorIO tools to show Sylva's EXRs.
+install(DIRECTORY ${CMAKE_SOURCE_DIR}/resources/ocio DESTINATION ${CMAKE_INSTALL_DATADIR}/sylva)
 # The user documents, which the studio's Help > Manual shows (from ../share/doc/sylva beside the program).
 install(FILES ${CMAKE_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/sylva)
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/sylva/docs FILES_MATCHING PATTERN "*.md")

@@ -49,6 +49,7 @@
 #include "studio/render_window.h"
 #include "studio/scatter_tool.h"
 #include "studio/species_importer.h"
+#include "studio/view_transform.h"
 #include "studio/viewport.h"
 #include "studio/volume_dialogs.h"
 #include "studio/volume_inspector.h"
@@ -461,6 +462,9 @@ void MainWindow::buildActions()
                                     : tr("Orbit: drag to orbit, Shift+drag or middle drag to pan, wheel to zoom, click to select"),
                                  on ? 0 : 4000);
     });
+
+    m_viewMenu->addSeparator();
+    m_viewMenu->addMenu(new ViewTransformMenu(m_doc, m_viewMenu));
 
     QMenu* help = menuBar()->addMenu(tr("&Help"));
     add(help, tr("&Manual"), "actionManual", QKeySequence(Qt::Key_F1), [this] { showManual(); });

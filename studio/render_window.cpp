@@ -20,6 +20,7 @@
 #include "studio/recent_files.h"
 #include "studio/render_worker.h"
 #include "studio/scene_document.h"
+#include "studio/view_transform.h"
 
 namespace sylva {
 
@@ -150,7 +151,7 @@ Job* RenderWindow::render()
     const Scene scene = m_scene;
     Job* job = m_exporter->renderImage(scene, [this, scene](const Film& film, int samples) {
         // On the job's thread: the picture as the export writes it (composeMode, the tone map), then to the window.
-        const QImage image = filmImage(film, scene.render.mode, composeSky(scene), scene.render.exposureKey);
+        const QImage image = scenePicture(film, scene);
         QMetaObject::invokeMethod(this, [this, image, film, samples]() { showPass(image, film, samples); }, Qt::QueuedConnection);
     });
     m_job = job;

@@ -17,6 +17,7 @@
 #include "pipeline/render/render_job.h"
 #include "studio/background_priority.h"
 #include "studio/scene_document.h"
+#include "studio/view_transform.h"
 
 namespace sylva {
 
@@ -71,6 +72,9 @@ namespace {
 QImage picture(const Film& film, const Film& exposure, const Scene& scene, const std::optional<RenderMode>& compare,
                float* scale)
 {
+    // The scene's view (view_transform.h): Sylva Reinhard at the held exposure; an OpenColorIO view exposed by
+    // its own film (its scale not reported).
+    if (!viewTransformOf(scene).isReinhard()) return scenePicture(film, scene, compare);
     const RenderMode left = scene.render.mode, right = compare ? *compare : left;
     return heldExposureImage(film, exposure.width > 0 ? exposure : film, left, right, composeSky(scene), scene.render.exposureKey,
                              scale);
@@ -233,14 +237,16 @@ void RenderWorker::process(const Request& req, Progress& progress)
         }
     }
 
-    // A change of mode, compare mode or exposure alone (the refinement's settings unchanged): the film already holds
-    // every mode's parts, and a steady picture keeps its exposure film.
+    // A change of mode, compare mode, exposure or view alone (the refinement's settings unchanged): the film already
+    // holds every mode's parts, and a steady picture keeps its exposure film.
     if (m_lastScene && m_frameAssets == req.assets && m_frameRelight == req.relight && m_lastSize == req.size &&
         m_lastPass == int(passes.size()) - 1 && m_lastRefine.sampleLimit == refineSettings.sampleLimit &&
         m_lastRefine.steady == refineSettings.steady) {
         Scene a = *m_lastScene, b = scene;
         a.render.mode = b.render.mode;
         a.render.exposureKey = b.render.exposureKey;
+        a.render.view = b.render.view;
+        a.render.display = b.render.display;
         if (changedParts(a, b) == ScenePart::None) {
             // A request cancelled since may have re-placed the frame for its own scene (an instance deleted, then
             // the delete undone before its first picture): the frame is placed for this scene again, as what the

@@ -68,7 +68,8 @@ ScenePart changedParts(const Scene& a, const Scene& b)
     const RenderSettings &ra = a.render, &rb = b.render;
     if (ra.width != rb.width || ra.height != rb.height || ra.spp != rb.spp || ra.mode != rb.mode || ra.accel != rb.accel ||
         ra.shadows != rb.shadows || ra.indirectScale != rb.indirectScale || ra.exposureKey != rb.exposureKey || ra.leafTint != rb.leafTint ||
-        ra.integrator != rb.integrator || ra.maxBounces != rb.maxBounces || a.version != b.version)
+        ra.integrator != rb.integrator || ra.maxBounces != rb.maxBounces || ra.view != rb.view || ra.display != rb.display ||
+        a.version != b.version)
         p = p | ScenePart::Render;
     return p;
 }

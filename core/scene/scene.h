@@ -215,6 +215,10 @@ struct RenderSettings {
                                          // instance at distance d keeps about start / d of them; 0 = off
     Integrator integrator = Integrator::Lb;
     int maxBounces = 64;                 // path: bounces after the camera's hit, 0 .. kMaxPathBounces (Russian roulette from the 4th)
+    // The picture's display transform (pipeline/render/display_view.h): a view of an OpenColorIO display,
+    // or the in-house Reinhard curve, "Sylva Reinhard", the picture of files written without the key.
+    std::string view = "Sylva Reinhard";
+    std::string display;                 // empty: the OpenColorIO config's default display
 };
 
 struct Scene {

@@ -10,6 +10,7 @@
 #include "pipeline/io/image_module.h"
 #include "pipeline/io/output_path.h"
 #include "pipeline/lighting_job.h"
+#include "pipeline/render/display_view.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/render/render_passes.h"
 #include "pipeline/scene/scene_file.h"
@@ -91,6 +92,8 @@ Scene sceneForArgs(const Args& args, std::string* stem)
         if (m < 0.0 || m > 1e30) throw UsageError(std::string("option ") + option + ": expected metres >= 0 (0: off), got " + args.get(option));
         *field = float(m);
     }
+    if (args.has("--view")) r.view = args.get("--view");
+    if (args.has("--display")) r.display = args.get("--display");
     if (args.has("--volume-tracer")) {
         VolumeTracer t;
         if (!parseVolumeTracer(args.get("--volume-tracer"), &t))
@@ -142,6 +145,10 @@ bool writesPicture(bool useMpi)
 
 int runRender(const Args& args)
 {
+    if (args.has("--list-views")) {
+        std::fputs(describeViews(colorConfig()).c_str(), stdout);
+        return kOk;
+    }
     const bool useMpi = args.has("--mpi");
 #if SYLVA_HAVE_MPI
     if (useMpi && !mpi::launchedByMpi())
@@ -171,6 +178,19 @@ int runRender(const Args& args)
     if (passes && ext != ".exr")
         throw UsageError("option --passes: the passes are layers of one multi-layer EXR; use -o NAME.exr, not " + out);
     if (passes && args.has("--band-rows")) throw UsageError("option --passes: a frame in bands cannot be written with passes; drop --band-rows");
+    // The view is found before any work: an unknown name (the option's a usage error) lists the views there are.
+    DisplayTransform display;
+    const bool viewOption = args.has("--view") || args.has("--display");
+    if (viewOption || (ext != ".exr" && !passes)) {
+        try {
+            display = displayTransformOf(r);
+        } catch (const Error& e) {
+            if (viewOption) throw UsageError(std::string("option --view/--display: ") + e.what());
+            throw;
+        }
+        if (viewOption && ext == ".exr")
+            std::fprintf(stderr, "note: %s stays scene-linear (Rec.709); the view applies to .png and .tif pictures\n", out.c_str());
+    }
     const bool writer = writesPicture(useMpi);
     if (writer) {
         requireReplaceableFile(out);
@@ -224,7 +244,7 @@ int runRender(const Args& args)
                 ambient = layers.ambient;
             } else {
                 const std::vector<glm::vec3> linear = composeMode(result.film, r.mode, composeSky(scene), &ambient);
-                writeRender(out, linear, r.width, r.height, r.exposureKey);
+                writeRender(out, linear, r.width, r.height, r.exposureKey, display);
             }
             st = result.stats;
             timings = result.timings;
@@ -303,6 +323,11 @@ Command renderCommand()
              {"--volume-tracer", "lb|single|combined", "every volume's tracer, replacing its scene's `tracer` (default lb, the "
                                                        "accuracy study's pick: docs/ACCURACY.md \"Volumes\"); single: sun single "
                                                        "scattering with shadow marches, combined: single + the LB's multiple scattering"},
+             {"--view", "NAME", "the picture's display transform (default: the scene's render.view, \"Sylva Reinhard\": the seed's Reinhard "
+                                "curve); or a view of the OpenColorIO config, $OCIO's when set, else the bundled one's: Standard, \"ACES 1.0 "
+                                "SDR-video\", \"Sylva Filmic\" (docs/RENDERING.md \"Display transforms\"); .exr stays scene-linear"},
+             {"--display", "NAME", "the OpenColorIO display of --view (default: the scene's render.display, else the config's default display)"},
+             {"--list-views", "", "print the OpenColorIO config's displays and their views (and where the config comes from), then exit"},
              kBackend,
              {"--band-rows", "N", "trace and write the frame in bands of N rows (default: only when the whole frame does not fit in memory)"},
              {"--passes", "", "write one multi-layer EXR (32-bit float) of the render passes: Combined, DiffDir, DiffInd, DiffCol, Env, Normal, Depth, Alpha (docs/RENDERING.md); default output NAME.exr"},

@@ -74,10 +74,13 @@ namespace {
 void writePixels(const std::string& path, int width, int height, int channels, const std::vector<std::string>* names,
                  image_module::SampleType stored, int alphaChannel, const float* data)
 {
+    // Float files hold Sylva's scene-linear Rec.709 radiance (renders, passes, sky maps): the header says so.
+    const bool isFloat = stored == image_module::SampleType::Half || stored == image_module::SampleType::Float;
+    const image_module::ColorSpace space = isFloat ? image_module::ColorSpace::LinearRec709 : image_module::ColorSpace::Unnamed;
     AtomicFile file(path, AtomicFile::Sync::No, "image");
     const std::string& temp = file.pathForWriter();
     std::string error;
-    auto out = image_module::Writer::open(temp, width, height, channels, names, stored, alphaChannel, error);
+    auto out = image_module::Writer::open(temp, width, height, channels, names, stored, alphaChannel, space, error);
     if (!out) throw Error(path + ": " + error);
     if (!out->writeImage(data, error) || !out->close(error)) throw Error(path + ": cannot write image (" + error + ")");
     file.commit();
@@ -131,7 +134,8 @@ RowImageWriter::RowImageWriter(const std::string& path, int width, int height) :
     m->height = height;
     std::string error;
     m->out = image_module::Writer::open(m->file.pathForWriter(), width, height, 3, nullptr,
-                                        m->isFloat ? image_module::SampleType::Half : image_module::SampleType::UInt8, -1, error);
+                                        m->isFloat ? image_module::SampleType::Half : image_module::SampleType::UInt8, -1,
+                                        m->isFloat ? image_module::ColorSpace::LinearRec709 : image_module::ColorSpace::Unnamed, error);
     if (!m->out) throw Error(path + ": " + error);
     m->open = true;
 }

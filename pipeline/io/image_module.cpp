@@ -137,7 +137,7 @@ bool Reader::read(int channels, std::vector<float>& out, std::string& error)
 }
 
 std::unique_ptr<Writer> Writer::open(const std::string& path, int width, int height, int channels, const std::vector<std::string>* names,
-                                     SampleType stored, int alphaChannel, std::string& error)
+                                     SampleType stored, int alphaChannel, ColorSpace colorSpace, std::string& error)
 {
     const Table& t = table();
     if (names && int(names->size()) != channels) {
@@ -146,7 +146,7 @@ std::unique_ptr<Writer> Writer::open(const std::string& path, int width, int hei
     }
     std::unique_ptr<Writer> w(new Writer);
     w->m_table = &t;
-    w->m_output = t.openWrite(path.c_str(), width, height, channels, names ? names->data() : nullptr, stored, alphaChannel, &error);
+    w->m_output = t.openWrite(path.c_str(), width, height, channels, names ? names->data() : nullptr, stored, alphaChannel, colorSpace, &error);
     if (!w->m_output) return nullptr;
     return w;
 }

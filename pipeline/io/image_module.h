@@ -15,6 +15,10 @@ namespace sylva::image_module {
 // How a file stores its samples (readers normalize integer types to [0, 1] when reading as float).
 enum class SampleType : int { UInt8, UInt16, Int16, UInt32, Int32, Half, Float, Other };
 
+// What a float file's colour channels hold, named in its header by the module (OpenEXR: the chromaticities
+// of the primaries and white, and the colour interop ID). Sylva's float pictures are scene-linear Rec.709.
+enum class ColorSpace : int { Unnamed, LinearRec709 };
+
 struct Info {
     int width = 0, height = 0, channels = 0;
     int alphaChannel = -1;               // as the file's header says (-1: none named)
@@ -31,14 +35,14 @@ struct Table {
     void (*closeRead)(void* input);
     // names: null for the format's defaults, else `channels` names (alpha and depth then unnamed);
     // alphaChannel >= 0 marks that channel straight (unassociated) alpha. The message says which step
-    // failed: "no image writer for this extension (...)" or "cannot write image (...)".
+    // failed: "no image writer for this extension (...)" or "cannot write image (...)". colorSpace: named in the header.
     void* (*openWrite)(const char* path, int width, int height, int channels, const std::string* names, SampleType stored,
-                       int alphaChannel, std::string* error);
+                       int alphaChannel, ColorSpace colorSpace, std::string* error);
     int (*writeImage)(void* output, const float* data, std::string* error);             // every row
     int (*writeRows)(void* output, int y0, int y1, const float* data, std::string* error);
     int (*closeWrite)(void* output, std::string* error);   // frees the output, also when closing fails
 };
-constexpr int kAbi = 1;
+constexpr int kAbi = 2;
 
 // The module, loaded on the first call (thread-safe). Throws Error when it cannot be found or loaded:
 // SYLVA_IMAGE_MODULE names it, else it is looked for beside the executable, then installed (BINDIR/../LIBDIR/
@@ -75,7 +79,7 @@ private:
 class Writer {
 public:
     static std::unique_ptr<Writer> open(const std::string& path, int width, int height, int channels, const std::vector<std::string>* names,
-                                        SampleType stored, int alphaChannel, std::string& error);
+                                        SampleType stored, int alphaChannel, ColorSpace colorSpace, std::string& error);
     ~Writer();   // closes a file not yet closed (its caller removes it)
     Writer(const Writer&) = delete;
     Writer& operator=(const Writer&) = delete;

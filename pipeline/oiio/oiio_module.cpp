@@ -9,6 +9,7 @@
 
 namespace {
 
+using sylva::image_module::ColorSpace;
 using sylva::image_module::Info;
 using sylva::image_module::SampleType;
 using sylva::image_module::Table;
@@ -87,7 +88,7 @@ void closeRead(void* input)
 }
 
 void* openWrite(const char* path, int width, int height, int channels, const std::string* names, SampleType stored, int alphaChannel,
-                std::string* error)
+                ColorSpace colorSpace, std::string* error)
 {
     try {
         auto out = OIIO::ImageOutput::create(path);
@@ -104,6 +105,14 @@ void* openWrite(const char* path, int width, int height, int channels, const std
         if (alphaChannel >= 0) {
             spec.alpha_channel = alphaChannel;
             spec.attribute("oiio:UnassociatedAlpha", 1);   // the pixels are straight (unassociated) RGBA
+        }
+        if (colorSpace == ColorSpace::LinearRec709) {
+            // OpenEXR's standard attribute: the Rec.709 primaries and the D65 white, CIE xy; the colour interop ID
+            // of scene-linear Rec.709; and OpenImageIO's own name for readers that keep it.
+            static const float kRec709[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+            spec.attribute("chromaticities", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8), kRec709);
+            spec.attribute("colorInteropID", "lin_rec709_scene");
+            spec.attribute("oiio:ColorSpace", "lin_rec709");
         }
         if (!out->open(path, spec)) {
             *error = "cannot write image (" + out->geterror() + ")";

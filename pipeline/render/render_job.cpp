@@ -317,6 +317,7 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
     if (ext != ".png" && ext != ".tif" && ext != ".tiff" && ext != ".exr")
         throw Error(outPath + ": unknown image extension '" + ext + "' (use .png, .tif, .tiff or .exr)");
     const bool linearOut = ext == ".exr";
+    const DisplayTransform display = linearOut ? DisplayTransform() : displayTransformOf(r);   // an unknown view fails before the work
     const bool ambientMode = r.mode == RenderMode::Ambient;
     // Between the passes each pixel waits on disk: its composed linear RGB, or for ambient (whose
     // constant needs the whole frame) local, albedo and sky cover.
@@ -442,7 +443,7 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
             writer.writeRows(rgb.data(), int(pixels / width));
         } else {
             mapped.resize(pixels * 3);
-            toneMapScaled(rgb.data(), pixels, mapped.data(), scale);
+            display.apply(rgb.data(), pixels, mapped.data(), scale);
             writer.writeRows(mapped.data(), int(pixels / width));
         }
         writePart.report(double(b + 1) / double(bands), "writing");
@@ -453,17 +454,23 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
 
 ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key)
 {
+    return toneMapped(linear, width, height, key, DisplayTransform());
+}
+
+ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key, const DisplayTransform& view)
+{
     std::vector<float> srgb(linear.size() * 3);
-    ToneMapParams tp;
-    tp.key = key;
-    toneMapToSrgb(reinterpret_cast<const float*>(linear.data()), linear.size(), srgb.data(), tp);
+    displayEncode(reinterpret_cast<const float*>(linear.data()), linear.size(), srgb.data(), key, view);
     ImageRgba img(width, height, glm::vec4(1.0f));
     for (size_t p = 0; p < linear.size(); ++p)
         for (int c = 0; c < 3; ++c) img.pixels[p * 4 + size_t(c)] = srgb[p * 3 + size_t(c)];
     return img;
 }
 
-void writeRender(const std::string& path, const std::vector<glm::vec3>& linear, int width, int height, float key)
+DisplayTransform displayTransformOf(const RenderSettings& r) { return DisplayTransform::find(r.display, r.view); }
+
+void writeRender(const std::string& path, const std::vector<glm::vec3>& linear, int width, int height, float key,
+                 const DisplayTransform& view)
 {
     std::string ext = std::filesystem::path(path).extension().string();
     for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
@@ -473,7 +480,7 @@ void writeRender(const std::string& path, const std::vector<glm::vec3>& linear, 
             for (int c = 0; c < 3; ++c) img.pixels[p * 4 + size_t(c)] = linear[p][c];
         writeImage(path, img, 3);
     } else if (ext == ".png" || ext == ".tif" || ext == ".tiff") {
-        writeImage(path, toneMapped(linear, width, height, key), 3);
+        writeImage(path, toneMapped(linear, width, height, key, view), 3);
     } else {
         throw Error(path + ": unknown image extension '" + ext + "' (use .png, .tif, .tiff or .exr)");
     }

@@ -12,6 +12,7 @@
 #include "core/render/render_scene.h"
 #include "core/scene/scene.h"
 #include "pipeline/lighting_job.h"
+#include "pipeline/render/display_view.h"
 
 namespace sylva {
 
@@ -113,7 +114,7 @@ struct BandedRender {
     int bands = 0, bandRows = 0;
 };
 // A frame too large to hold whole, traced on the CPU in bands of bandRows rows and written to outPath
-// (.png/.tif/.tiff tone-mapped, .exr linear) band by band: memory holds one band, and between the
+// (.png/.tif/.tiff through the scene's view, .exr linear) band by band: memory holds one band, and between the
 // passes the pixels wait in an unlinked temporary file beside outPath (12 bytes per pixel, 28 in
 // ambient mode; refused up front, naming the sizes, when the disk lacks the room). The picture is
 // exactly the one renderScene + composeMode + writeRender produce: the ambient constant and the
@@ -125,10 +126,18 @@ BandedRender renderSceneInBands(const Scene& scene, const std::string& outPath, 
                                 Progress* progress = nullptr, JobLog* log = nullptr, Backend* backend = nullptr,
                                 const FilmRowsTracer& tracer = {});
 
-// Tone-mapped (Reinhard, log-average key) sRGB picture of linear RGB pixels, alpha 1.
+// Tone-mapped (Reinhard, log-average key) sRGB picture of linear RGB pixels, alpha 1; with a view, the picture
+// exposed with the key through that display transform (displayEncode).
 ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key);
+ImageRgba toneMapped(const std::vector<glm::vec3>& linear, int width, int height, float key, const DisplayTransform& view);
 
-// Writes a render: .png/.tif/.tiff tone-mapped 8-bit sRGB, .exr linear half float. Error on other extensions.
-void writeRender(const std::string& path, const std::vector<glm::vec3>& linear, int width, int height, float key);
+// The display transform of a scene's render settings (render.display, render.view): DisplayTransform::find.
+DisplayTransform displayTransformOf(const RenderSettings& r);
+
+// Writes a render: .png/.tif/.tiff 8-bit through the view (default: Sylva Reinhard, the tone-mapped sRGB picture),
+// .exr linear half float, its header naming the colour space (scene-linear Rec.709: chromaticities, colorInteropID
+// lin_rec709_scene). Error on other extensions.
+void writeRender(const std::string& path, const std::vector<glm::vec3>& linear, int width, int height, float key,
+                 const DisplayTransform& view = DisplayTransform());
 
 } // namespace sylva

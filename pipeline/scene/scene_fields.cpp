@@ -16,6 +16,7 @@
 #include "core/sky/virtual_lights.h"
 #include "core/terrain/height_field.h"
 #include "pipeline/grow/tree_grower.h"
+#include "pipeline/render/display_view.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/scene/scene_species.h"
 #include "pipeline/scene/scene_volumes.h"
@@ -746,7 +747,8 @@ const Table<RenderSettings>& renderTable()
         b.number("indirect", &RenderSettings::indirectScale, atLeast(0.0))
             .doc("number", "weight of the LB indirect light, >= 0")
             .summarized([](const RenderSettings& r) { return "indirect " + human(r.indirectScale); });
-        b.number("key", &RenderSettings::exposureKey, above(0.0)).doc("number", "Reinhard key value, > 0").summarized([](const RenderSettings& r) {
+        b.number("key", &RenderSettings::exposureKey, above(0.0))
+            .doc("number", "Reinhard key value, > 0: the picture is exposed so its log-average luminance is this grey, for every `view`").summarized([](const RenderSettings& r) {
             return "key " + human(r.exposureKey);
         });
         b.color("leaf_tint", &RenderSettings::leafTint, 0.0f, 2.0f)
@@ -754,6 +756,27 @@ const Table<RenderSettings>& renderTable()
                                 "each in [0, 2]; 1 = as modelled")
             .writtenIf([](const RenderSettings& r) { return r.leafTint != glm::vec3(1.0f); })
             .summarized([](const RenderSettings& r) { return r.leafTint != glm::vec3(1.0f) ? "leaf tint " + human3(r.leafTint) : std::string(); });
+        // Names, not checked here: the views a config offers depend on $OCIO; a render checks them before its work.
+        b.custom(
+             "view",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, RenderSettings& t) {
+                 t.view = r.string(v, p).toStdString();
+                 if (t.view.empty()) r.fail(p, "must name a view (\"" + std::string(kReinhardView) + "\": the seed's picture)");
+             },
+             [](JsonWriter& w, const RenderSettings& t, const KeyPath&, int) { w.string(t.view); })
+            .doc("string",
+                 "the picture's display transform: `\"Sylva Reinhard\"` (the seed's Reinhard curve with the key) or a view of the "
+                 "OpenColorIO config (bundled: `Standard`, `ACES 1.0 SDR-video`, `Sylva Filmic`; `$OCIO`'s when set), exposed with the "
+                 "key; `.exr` stays linear; `sylva render --list-views` ([RENDERING.md](RENDERING.md) \"Display transforms\")")
+            .writtenIf([](const RenderSettings& t) { return t.view != kReinhardView; })
+            .summarized([](const RenderSettings& r) { return r.view != kReinhardView ? "view " + r.view : std::string(); });
+        b.custom(
+             "display",
+             [](JsonReader& r, const QJsonValue& v, const KeyPath& p, RenderSettings& t) { t.display = r.string(v, p).toStdString(); },
+             [](JsonWriter& w, const RenderSettings& t, const KeyPath&, int) { w.string(t.display); })
+            .doc("string", "the OpenColorIO display of `view` (empty: the config's default display, `sRGB` in the bundled one)")
+            .writtenIf([](const RenderSettings& t) { return !t.display.empty(); })
+            .summarized([](const RenderSettings& r) { return r.display.empty() ? std::string() : "display " + r.display; });
         b.number("alpha_distance", &RenderSettings::alphaDistance, atLeast(0.0, " (metres; 0 = off)"))
             .doc("number",
                  "metres, >= 0; beyond it from the camera leaf cut-outs are not tested (cards opaque); 0 = off "

@@ -48,7 +48,9 @@ void writeRenderFilm(const std::string& path, const Film& film, const Scene& sce
         writeRenderPasses(path, renderPasses(film, scene.render.mode, composeSky(scene)));
     } else {
         const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, composeSky(scene));
-        writeRender(path, linear, film.width, film.height, scene.render.exposureKey);
+        const bool linearOut = lowerExtension(path) == ".exr";
+        writeRender(path, linear, film.width, film.height, scene.render.exposureKey,
+                    linearOut ? DisplayTransform() : displayTransformOf(scene.render));
     }
 }
 

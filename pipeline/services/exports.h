@@ -24,13 +24,13 @@ std::vector<std::string> speciesLogLines(const std::string& species, const JobLo
 
 // The picture of `scene` with the species' assets (in species order; with lighting grids when the
 // mode needs them) into `path`: buildRenderScene, the film on `backend`, composeMode, writeRender
-// (.png/.tif/.tiff tone-mapped 8-bit, .exr linear); with `passes`, renderPasses and writeRenderPasses
+// (.png/.tif/.tiff 8-bit through the scene's view, .exr linear); with `passes`, renderPasses and writeRenderPasses
 // instead (one multi-layer EXR: .exr only). Throws Error (bad extension, unwritable file) or Cancelled.
 void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, const std::string& path,
                   Backend* backend = nullptr, Progress* progress = nullptr, bool passes = false);
 
 // The file exportRender writes, for a film of `scene` already traced (the studio's render window saves
-// its finished render with it): `scene`'s mode, sky and exposure key; .png/.tif/.tiff tone-mapped 8-bit,
+// its finished render with it): `scene`'s mode, sky, exposure key and view; .png/.tif/.tiff 8-bit,
 // .exr linear, or with `passes` the multi-layer EXR. Throws Error (bad extension, unwritable file).
 void writeRenderFilm(const std::string& path, const Film& film, const Scene& scene, bool passes = false);
 

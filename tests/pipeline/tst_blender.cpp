@@ -225,7 +225,7 @@ print('LAYERS=%s' % ' '.join(o.name for o in n.outputs if o.enabled))
             QVERIFY2((" " + grids + " ").find(std::string(" ") + g + " ") != std::string::npos, qPrintable(QString::fromStdString(grids)));
         // Passes: a multi-layer image with the layers `--passes` writes.
         QCOMPARE(QString::fromStdString(valueAfter(out, "TYPE=")), QString("MULTILAYER"));
-        const std::string layers = " " + valueAfter(out, "LAYERS=") + " ";
+        const std::string layers = std::string(" ") + valueAfter(out, "LAYERS=") + " ";
         for (const char* l : {"Combined", "DiffDir", "DiffInd", "DiffCol", "Env", "Normal", "Depth", "Alpha"})
             QVERIFY2(layers.find(l) != std::string::npos, qPrintable(QString::fromStdString(layers)));
     }

@@ -59,7 +59,8 @@ private Q_SLOTS:
         for (const char* rel : {"bin/sylva", "bin/sylva-studio", "share/applications/sylva-studio.desktop",
                                 "share/icons/hicolor/scalable/apps/sylva-studio.svg", "share/mime/packages/sylva-scene.xml",
                                 "share/man/man1/sylva.1", "share/bash-completion/completions/sylva",
-                                "share/sylva/default_forest.sylva.json", "share/sylva/color/cie1931_2deg_xyz_cmf_360-830_1nm.csv"})
+                                "share/sylva/default_forest.sylva.json", "share/sylva/color/cie1931_2deg_xyz_cmf_360-830_1nm.csv",
+                                "share/sylva/ocio/config.ocio"})
             QVERIFY2(QFileInfo(installed(rel)).size() > 0, rel);
         QVERIFY(QFileInfo(installed("bin/sylva")).isExecutable());
         QVERIFY(QFileInfo(installed("bin/sylva-studio")).isExecutable());

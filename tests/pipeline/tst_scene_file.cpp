@@ -122,6 +122,8 @@ void compareScenes(const Scene& a, const Scene& b)
     QCOMPARE(a.render.exposureKey, b.render.exposureKey);
     QCOMPARE(a.render.alphaDistance, b.render.alphaDistance);
     QCOMPARE(a.render.pruneDistance, b.render.pruneDistance);
+    QCOMPARE(a.render.view, b.render.view);
+    QCOMPARE(a.render.display, b.render.display);
 }
 
 // Sets (or, with an undefined value, removes) the value at PATH ("instances", "0", "scale": keys and
@@ -230,7 +232,19 @@ Scene fullScene(const QString& sceneDir)
     s.sun = {{-0.2f, 0.9f, 0.1f}, 5200.5, 3.25f, {}};
     s.sky = {0.1f, 0.2f, 1.7f};
     s.camera = {{10.5, 3.25, -40.0}, {1.0, 4.0, 2.0}, {0.0f, 1.0f, 0.1f}, 33.3f};
-    s.render = {1920, 1080, 64, RenderMode::Lb, AccelKind::KdTree, false, 0.75f, 0.3f, {0.8f, 1.25f, 0.5f}, 87.5f, 33.25f};
+    s.render = {.width = 1920,
+                .height = 1080,
+                .spp = 64,
+                .mode = RenderMode::Lb,
+                .accel = AccelKind::KdTree,
+                .shadows = false,
+                .indirectScale = 0.75f,
+                .exposureKey = 0.3f,
+                .leafTint = {0.8f, 1.25f, 0.5f},
+                .alphaDistance = 87.5f,
+                .pruneDistance = 33.25f,
+                .view = "ACES 1.0 SDR-video",
+                .display = "sRGB"};
     return s;
 }
 
