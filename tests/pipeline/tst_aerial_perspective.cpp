@@ -21,6 +21,7 @@
 #include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
+#include "tests/common/pinhole.h"
 #include "tests/common/scenes.h"
 
 using namespace sylva;
@@ -62,18 +63,6 @@ Scene groundFromAbove(double height, double pitchDeg, float fovY, int w, int h)
     s.render.height = h;
     s.render.spp = 1;
     return s;
-}
-
-// The direction of pixel (px, py)'s centre for the camera of groundFromAbove (a pinhole, square pixels),
-// computed here from the camera's own definition.
-glm::dvec3 pixelDirection(const Scene& s, int px, int py)
-{
-    const glm::dvec3 f = glm::normalize(s.camera.target - s.camera.position);
-    const glm::dvec3 right = glm::normalize(glm::cross(f, glm::dvec3(0.0, 1.0, 0.0)));
-    const glm::dvec3 up = glm::cross(right, f);
-    const double ty = std::tan(double(s.camera.fovY) * kPi / 360.0), tx = ty * s.render.width / s.render.height;
-    const double sx = (2.0 * (px + 0.5) / s.render.width - 1.0) * tx, sy = (1.0 - 2.0 * (py + 0.5) / s.render.height) * ty;
-    return glm::normalize(f + sx * right + sy * up);
 }
 
 struct Rendered {
@@ -152,7 +141,7 @@ private Q_SLOTS:
         for (int py = 0; py < off.render.height; ++py)
             for (int px = 0; px < off.render.width; ++px) {
                 const size_t i = size_t(py) * size_t(off.render.width) + size_t(px);
-                const glm::dvec3 d = pixelDirection(off, px, py);
+                const glm::dvec3 d = test::pinholeDirection(off, px + 0.5, py + 0.5);
                 if (d.y >= -1e-3) {
                     if (a.film.pixels[i].skyCover == 1.0f) {
                         ++skyPixels;

@@ -27,6 +27,7 @@
 #include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
+#include "tests/common/pinhole.h"
 #include "tests/common/scenes.h"
 
 using namespace sylva;
@@ -134,16 +135,6 @@ glm::dvec3 bilinearMap(const sky::EnvMap& m, const glm::dvec3& d)
         return glm::dvec3(m.at(xi, yi));
     };
     return (at(x0, y0) * (1.0 - ax) + at(x0 + 1, y0) * ax) * (1.0 - ay) + (at(x0, y0 + 1) * (1.0 - ax) + at(x0 + 1, y0 + 1) * ax) * ay;
-}
-
-// The direction through image position (x, y) of the scene's pinhole camera (square pixels), computed here.
-glm::dvec3 imageDirection(const Scene& s, double x, double y)
-{
-    const glm::dvec3 f = glm::normalize(s.camera.target - s.camera.position);
-    const glm::dvec3 right = glm::normalize(glm::cross(f, glm::dvec3(0.0, 1.0, 0.0)));
-    const glm::dvec3 up = glm::cross(right, f);
-    const double ty = std::tan(double(s.camera.fovY) * kPi / 360.0), tx = ty * s.render.width / s.render.height;
-    return glm::normalize(f + (2.0 * x / s.render.width - 1.0) * tx * right + (1.0 - 2.0 * y / s.render.height) * ty * up);
 }
 
 } // namespace
@@ -637,10 +628,10 @@ private Q_SLOTS:
                 for (int px = 0; px < c.pixels; ++px) {
                     glm::dvec3 sum(0.0);
                     for (int j = 0; j < n; ++j)
-                        for (int i = 0; i < n; ++i) sum += bilinearMap(m, imageDirection(s, px + (i + 0.5) / n, py + (j + 0.5) / n));
+                        for (int i = 0; i < n; ++i) sum += bilinearMap(m, test::pinholeDirection(s, px + (i + 0.5) / n, py + (j + 0.5) / n));
                     want.push_back(glm::vec3(sum / double(n * n)));
                     got.push_back(f.pixels[size_t(py) * size_t(c.pixels) + size_t(px)].background);
-                    nearest.push_back(sky::envMapRadiance(view, glm::vec3(imageDirection(s, px + 0.5, py + 0.5))));
+                    nearest.push_back(sky::envMapRadiance(view, glm::vec3(test::pinholeDirection(s, px + 0.5, py + 0.5))));
                 }
             const double e = relativeError(got, want), en = relativeError(nearest, want);
             qInfo("%s: filtered background %.3f%% from the map integrated over each pixel, the pixel-centre texel %.1f%%", c.name, 100.0 * e,
