@@ -17,6 +17,7 @@
 #include <memory>
 #include <vector>
 
+#include "tests/common/pinhole.h"
 #include "core/render/tonemap.h"
 #include "core/render/tonemap_film.h"
 #include "core/scene/quality.h"
@@ -58,17 +59,11 @@ double displayLuminance(QRgb p)
     return 0.2126 * lin(qRed(p)) + 0.7152 * lin(qGreen(p)) + 0.0722 * lin(qBlue(p));
 }
 
-// Where world point p lands in a w x h picture of camera c (pixels, y down): a pinhole with the camera's
-// vertical field of view, from the camera's parameters alone.
+// Where world point p lands in a w x h picture of camera c (pixels, y down), from the camera's parameters alone.
 QPointF project(const CameraDesc& c, double w, double h, const glm::dvec3& p)
 {
-    const glm::dvec3 f = glm::normalize(c.target - c.position);
-    const glm::dvec3 r = glm::normalize(glm::cross(f, glm::dvec3(c.up)));
-    const glm::dvec3 u = glm::cross(r, f);
-    const glm::dvec3 q = p - c.position;
-    const double z = glm::dot(q, f);
-    const double tanY = std::tan(double(c.fovY) * 3.14159265358979323846 / 360.0), tanX = tanY * w / h;
-    return {(glm::dot(q, r) / (z * tanX) + 1.0) * 0.5 * w, (1.0 - glm::dot(q, u) / (z * tanY)) * 0.5 * h};
+    const glm::dvec2 q = test::pinholeProject(c, w, h, p);
+    return {q.x, q.y};
 }
 
 // Degrees between the horizontal parts of two view directions.
