@@ -72,12 +72,12 @@ namespace {
 QImage picture(const Film& film, const Film& exposure, const Scene& scene, const std::optional<RenderMode>& compare,
                float* scale)
 {
-    // The scene's view (view_transform.h): Sylva Reinhard at the held exposure; an OpenColorIO view exposed by
-    // its own film (its scale not reported).
-    if (!viewTransformOf(scene).isReinhard()) return scenePicture(film, scene, compare);
+    // The scene's view (view_transform.h), at the held exposure: Sylva Reinhard through the tone map's own
+    // reductions, an OpenColorIO view through scenePicture with the exposure film.
+    const Film& held = exposure.width > 0 ? exposure : film;
+    if (!viewTransformOf(scene).isReinhard()) return scenePicture(film, scene, compare, &held, scale);
     const RenderMode left = scene.render.mode, right = compare ? *compare : left;
-    return heldExposureImage(film, exposure.width > 0 ? exposure : film, left, right, composeSky(scene), scene.render.exposureKey,
-                             scale);
+    return heldExposureImage(film, held, left, right, composeSky(scene), scene.render.exposureKey, scale);
 }
 
 } // namespace

@@ -21,7 +21,8 @@ DisplayTransform viewTransformOf(const Scene& scene)
     }
 }
 
-QImage scenePicture(const Film& film, const Scene& scene, const std::optional<RenderMode>& compare)
+QImage scenePicture(const Film& film, const Scene& scene, const std::optional<RenderMode>& compare, const Film* exposure,
+                    float* scale)
 {
     const glm::vec3 sky = composeSky(scene);
     const float key = scene.render.exposureKey;
@@ -34,8 +35,17 @@ QImage scenePicture(const Film& film, const Scene& scene, const std::optional<Re
     std::vector<float> encoded(n * 3);
     const bool split = right != left;
     for (int side = 0; side < (split ? 2 : 1); ++side) {
-        const std::vector<glm::vec3> linear = composeMode(film, side == 0 ? left : right, sky);
-        displayEncode(&linear[0].x, n, encoded.data(), key, view);
+        const RenderMode mode = side == 0 ? left : right;
+        const std::vector<glm::vec3> linear = composeMode(film, mode, sky);
+        float s;
+        if (exposure && exposure->width > 0) {
+            const std::vector<glm::vec3> held = composeMode(*exposure, mode, sky);
+            s = displayExposureScale(&held[0].x, held.size(), key);
+        } else {
+            s = displayExposureScale(&linear[0].x, n, key);
+        }
+        if (side == 0 && scale) *scale = s;
+        view.apply(&linear[0].x, n, encoded.data(), s);
         // Each half is its mode's whole picture (exposed as that picture), as in compareImage.
         const int x0 = side == 0 ? 0 : film.width / 2, x1 = split && side == 0 ? film.width / 2 : film.width;
         for (int y = 0; y < film.height; ++y) {

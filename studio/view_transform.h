@@ -24,7 +24,10 @@ DisplayTransform viewTransformOf(const Scene& scene);
 
 // The picture of a film as the viewport shows it: compareImage (Reinhard) for Sylva Reinhard, else each mode's
 // composed picture exposed with the key through the view (the right half in `compare`'s mode when given).
-QImage scenePicture(const Film& film, const Scene& scene, const std::optional<RenderMode>& compare = std::nullopt);
+// `exposure` (not null): each mode exposed as that film's picture of the mode would be (the viewport's held
+// exposure: one scale over its passes), the left half's scale in *scale when given.
+QImage scenePicture(const Film& film, const Scene& scene, const std::optional<RenderMode>& compare = std::nullopt,
+                    const Film* exposure = nullptr, float* scale = nullptr);
 
 // View > View Transform: one checkable entry per view of each display of the config in use (a submenu per
 // display when the config has several), the scene's checked. Entries are named "viewTransform:DISPLAY/VIEW".

@@ -177,8 +177,12 @@ void displayEncode(const float* linearRgb, size_t pixels, float* outRgb01, float
         toneMapToSrgb(linearRgb, pixels, outRgb01, params);
         return;
     }
-    const float scale = toneMapScale(pixels > 0 && linearRgb ? logAverageLuminance(linearRgb, pixels, 3) : 0.0f, ToneMapParams{key});
-    view.apply(linearRgb, pixels, outRgb01, scale);
+    view.apply(linearRgb, pixels, outRgb01, displayExposureScale(linearRgb, pixels, key));
+}
+
+float displayExposureScale(const float* linearRgb, size_t pixels, float key)
+{
+    return toneMapScale(pixels > 0 && linearRgb ? logAverageLuminance(linearRgb, pixels, 3) : 0.0f, ToneMapParams{key});
 }
 
 } // namespace sylva

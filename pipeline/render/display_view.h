@@ -75,4 +75,8 @@ private:
 // kReinhardView exactly toneMapToSrgb. Throws Error on a bad key, as toneMapToSrgb does.
 void displayEncode(const float* linearRgb, size_t pixels, float* outRgb01, float key, const DisplayTransform& view);
 
+// The scale displayEncode exposes a picture of these pixels with (key / log-average luminance): held from
+// one picture and passed to DisplayTransform::apply for others, a series of pictures keeps one exposure.
+float displayExposureScale(const float* linearRgb, size_t pixels, float key);
+
 } // namespace sylva

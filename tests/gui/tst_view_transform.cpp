@@ -98,20 +98,40 @@ private Q_SLOTS:
         const QImage standard = scenePicture(film, s);
         const std::vector<glm::vec3> linear = composeMode(film, s.render.mode, sky);
         const float scale = toneMapScale(logAverageLuminance(&linear[0].x, linear.size(), 3), ToneMapParams{s.render.exposureKey});
-        int worst = 0;
-        for (int y = 0; y < film.height; ++y)
-            for (int x = 0; x < film.width; ++x) {
-                const QRgb p = standard.pixel(x, y);
-                const glm::vec3 v = linear[size_t(y) * size_t(film.width) + size_t(x)] * scale;
-                const int got[3] = {qRed(p), qGreen(p), qBlue(p)};
-                for (int c = 0; c < 3; ++c) {
-                    const double l = std::clamp(double(v[c]), 0.0, 1.0);
-                    const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
-                    worst = std::max(worst, std::abs(got[c] - int(std::lround(e * 255.0))));
+        // The largest 8-bit step between a picture and the sRGB formula of this film's values x scale.
+        auto worstStep = [&](const QImage& picture, float exposed) {
+            int worst = 0;
+            for (int y = 0; y < film.height; ++y)
+                for (int x = 0; x < film.width; ++x) {
+                    const QRgb p = picture.pixel(x, y);
+                    const glm::vec3 v = linear[size_t(y) * size_t(film.width) + size_t(x)] * exposed;
+                    const int got[3] = {qRed(p), qGreen(p), qBlue(p)};
+                    for (int c = 0; c < 3; ++c) {
+                        const double l = std::clamp(double(v[c]), 0.0, 1.0);
+                        const double e = l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
+                        worst = std::max(worst, std::abs(got[c] - int(std::lround(e * 255.0))));
+                    }
                 }
-            }
+            return worst;
+        };
+        const int worst = worstStep(standard, scale);
         QVERIFY2(worst <= 1, qPrintable(QString::number(worst)));
         QVERIFY(standard != filmImage(film, s.render.mode, sky, s.render.exposureKey));
+
+        // Held exposure (the viewport's passes): exposed with the scale of another film's picture (a sun four
+        // times as bright), reported, and the pixels the sRGB formula of this film's values at that scale.
+        Scene bright = s;
+        bright.sun.intensity *= 4.0f;
+        const Film brightFilm = renderScene(bright, nullptr).film;
+        const std::vector<glm::vec3> brightLinear = composeMode(brightFilm, s.render.mode, sky);
+        const float heldScale = toneMapScale(logAverageLuminance(&brightLinear[0].x, brightLinear.size(), 3), ToneMapParams{s.render.exposureKey});
+        QVERIFY2(heldScale < 0.8f * scale, qPrintable(QStringLiteral("%1 vs %2").arg(heldScale).arg(scale)));
+        float reported = 0.0f;
+        const QImage held = scenePicture(film, s, std::nullopt, &brightFilm, &reported);
+        QVERIFY2(std::abs(reported - heldScale) <= 1e-6f * heldScale, qPrintable(QStringLiteral("%1 vs %2").arg(reported).arg(heldScale)));
+        const int worstHeld = worstStep(held, heldScale);
+        QVERIFY2(worstHeld <= 1, qPrintable(QString::number(worstHeld)));
+        QVERIFY(held != standard);
         const QImage both = scenePicture(film, s, RenderMode::Local);
         Scene local = s;
         local.render.mode = RenderMode::Local;
