@@ -57,7 +57,7 @@ bool sameSkySettings(const SkyDesc& a, const SkyDesc& b)
 {
     return a.kind == b.kind && a.turbidity == b.turbidity && a.scale == b.scale && a.path == b.path && a.rotationDeg == b.rotationDeg &&
            a.intensity == b.intensity && a.lights == b.lights && a.interleave == b.interleave && a.sunFromMap == b.sunFromMap &&
-           a.built == b.built;
+           a.aerialPerspective == b.aerialPerspective && a.built == b.built;
 }
 
 bool sameSunPlace(const SunDesc& a, const SunDesc& b)

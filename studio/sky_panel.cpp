@@ -139,6 +139,13 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
         apply(m_lbSky, tr("Change LB boundary"), [&](Scene& s) { s.lighting.boundary = on ? LbBoundary::SunSky : LbBoundary::Sun; });
     });
     skyForm->addRow(m_lbSky);
+    m_aerial = new QCheckBox(tr("Haze in the distance"));
+    m_aerial->setObjectName("sky.aerial_perspective");
+    connect(m_aerial, &QCheckBox::toggled, this, [this](bool on) {
+        apply(m_aerial, on ? tr("Turn on distance haze") : tr("Turn off distance haze"),
+              [&](Scene& s) { s.skyModel.aerialPerspective = on; });
+    });
+    skyForm->addRow(m_aerial);
     layout->addWidget(skyBox);
 
     // The sun.
@@ -324,8 +331,9 @@ void SkyPanel::refresh()
     const SkyDesc& d = s.skyModel;
     {
         const QSignalBlocker b1(m_kind), b2(m_lights), b3(m_interleave), b4(m_sunMode), b5(m_dial), b6(m_date), b7(m_time),
-            b8(m_timeSlider), b9(m_lbSky);
+            b8(m_timeSlider), b9(m_lbSky), b10(m_aerial);
         m_lbSky->setChecked(s.lighting.boundary == LbBoundary::SunSky);
+        m_aerial->setChecked(d.aerialPerspective);
         m_kind->setCurrentIndex(m_kind->findData(int(d.kind)));
         m_lights->setValue(d.lights);
         m_interleave->setValue(d.interleave);
@@ -350,7 +358,7 @@ void SkyPanel::refresh()
     setValue(m_rotation, double(d.rotationDeg));
     setValue(m_intensity, double(d.intensity));
     m_path->setText(QString::fromStdString(d.path));
-    m_preethamRows->setVisible(d.kind == sky::SkyKind::Preetham);
+    m_preethamRows->setVisible(d.kind == sky::SkyKind::Preetham || d.aerialPerspective);   // the haze's turbidity
     m_mapRows->setVisible(d.kind == sky::SkyKind::Map);
     m_lightRows->setVisible(d.analytic());
     m_sunPages->setCurrentIndex(s.sun.place ? 1 : 0);

@@ -49,6 +49,7 @@ public:
     QSpinBox* lights() const { return m_lights; }
     QSpinBox* interleave() const { return m_interleave; }
     QCheckBox* lbSky() const { return m_lbSky; }
+    QCheckBox* aerialPerspective() const { return m_aerial; }
     QComboBox* sunMode() const { return m_sunMode; }
     QDoubleSpinBox* sunElevation() const { return m_elevation; }
     QDial* sunAzimuthDial() const { return m_dial; }
@@ -83,6 +84,7 @@ private:
     QDoubleSpinBox *m_rotation, *m_intensity;
     QSpinBox *m_lights, *m_interleave;
     QCheckBox* m_lbSky;
+    QCheckBox* m_aerial;
     QComboBox* m_sunMode;
     QStackedWidget* m_sunPages;
     QDoubleSpinBox *m_elevation, *m_azimuth;

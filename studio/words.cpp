@@ -68,6 +68,9 @@ const QHash<QString, QString>& tips()
                         "model that follows the sun, a photographed sky (HDR map), or an even sky light of one "
                         "colour that lights the plants from every direction")},
         {"sky.turbidity", tr("Haze of the atmosphere: 2 a very clear sky, 10 a hazy one")},
+        {"sky.aerial_perspective", tr("The air between the camera and the land: distant hills fade toward the sky's colour at "
+                                      "the horizon, more with a higher turbidity (seen over kilometres; the quality presets turn "
+                                      "it on for terrains)")},
         {"sky.path", tr("The HDR picture of the sky (.exr or .hdr)")},
         {"sky.choose", tr("Choose the HDR picture of the sky")},
         {"sky.rotation", tr("Turns the sky picture about the up axis, degrees")},

@@ -131,12 +131,30 @@ private Q_SLOTS:
         QCOMPARE(doc.scene().skyModel.rotationDeg, 0.0f);
         QCOMPARE(doc.scene().skyModel.lights, SkyDesc{}.lights);
         QVERIFY(skyPixels(*doc.scene().skyModel.built) == freshSky(doc.scene()));
-        // The scene file keeps the settings: save, read back, the same sky.
+        // Haze in the distance (aerial perspective) under the map: one step, its turbidity shown and edited.
+        QVERIFY(!panel.aerialPerspective()->isChecked());
+        QVERIFY(!panel.turbidity()->isVisibleTo(&panel));
+        const int hazeSteps = undo->index();
+        panel.aerialPerspective()->setChecked(true);
+        QVERIFY(doc.scene().skyModel.aerialPerspective);
+        QCOMPARE(undo->index(), hazeSteps + 1);
+        QCOMPARE(undo->undoText(), QStringLiteral("Turn on distance haze"));
+        QVERIFY(panel.turbidity()->isVisibleTo(&panel));
+        panel.turbidity()->setValue(5.0);
+        QCOMPARE(doc.scene().skyModel.turbidity, 5.0);
+        // The scene file keeps the settings: save, read back, the same sky and haze.
         const QString file = m_dir.filePath("sky.sylva.json");
         doc.saveAs(file);
         Scene back = readSceneFile(file.toStdString());
         QCOMPARE(int(back.skyModel.kind), int(sky::SkyKind::Map));
         QVERIFY(skyPixels(*back.skyModel.built) == skyPixels(*doc.scene().skyModel.built));
+        QVERIFY(back.skyModel.aerialPerspective);
+        QCOMPARE(back.skyModel.turbidity, 5.0);
+        undo->undo();
+        undo->undo();
+        QVERIFY(!doc.scene().skyModel.aerialPerspective);
+        QVERIFY(!panel.aerialPerspective()->isChecked());
+        QVERIFY(!panel.turbidity()->isVisibleTo(&panel));
     }
 
     // The time slider: the sun where NOAA's algorithm puts it; at solar noon of the June solstice at
