@@ -29,7 +29,7 @@ install(DIRECTORY ${CMAKE_SOURCE_DIR}/resources/color DESTINATION ${CMAKE_INSTAL
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/resources/ocio DESTINATION ${CMAKE_INSTALL_DATADIR}/sylva)
 # The user documents, which the studio's Help > Manual shows (from ../share/doc/sylva beside the program).
 install(FILES ${CMAKE_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/sylva)
-install(DIRECTORY ${CMAKE_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/sylva/docs FILES_MATCHING PATTERN "*.md")
+install(DIRECTORY ${CMAKE_SOURCE_DIR}/docs/ DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/sylva/docs FILES_MATCHING PATTERN "*.md" PATTERN "*.png")
 install(FILES ${CMAKE_SOURCE_DIR}/resources/desktop/sylva-studio.desktop DESTINATION ${CMAKE_INSTALL_DATADIR}/applications)
 install(FILES ${CMAKE_SOURCE_DIR}/resources/desktop/sylva-studio.svg DESTINATION ${CMAKE_INSTALL_DATADIR}/icons/hicolor/scalable/apps)
 install(FILES ${CMAKE_SOURCE_DIR}/resources/desktop/sylva-scene.xml DESTINATION ${CMAKE_INSTALL_DATADIR}/mime/packages)
