@@ -237,6 +237,32 @@ bool projectToView(const CameraDesc& camera, double width, double height, const 
     return true;
 }
 
+glm::dvec3 viewRayDirection(const CameraDesc& camera, double width, double height, const glm::dvec2& pixel)
+{
+    glm::dvec3 f = camera.target - camera.position;
+    if (!(glm::length(f) > 0.0) || !(width > 0.0) || !(height > 0.0)) return glm::dvec3(0.0);
+    f = glm::normalize(f);
+    glm::dvec3 right = glm::cross(f, glm::dvec3(camera.up));
+    if (!(glm::length(right) > 1e-9)) return glm::dvec3(0.0);
+    right = glm::normalize(right);
+    const glm::dvec3 up = glm::cross(right, f);
+    const double tanY = std::tan(double(camera.fovY) * 0.5 * kDegToRad), tanX = tanY * width / height;
+    const double sx = 2.0 * pixel.x / width - 1.0, sy = 1.0 - 2.0 * pixel.y / height;
+    return glm::normalize(f + sx * tanX * right + sy * tanY * up);
+}
+
+bool viewRayOnPlane(const CameraDesc& camera, double width, double height, const glm::dvec2& pixel, const glm::dvec3& planePoint,
+                    const glm::dvec3& planeNormal, glm::dvec3* point)
+{
+    const glm::dvec3 d = viewRayDirection(camera, width, height, pixel);
+    const double dn = glm::dot(d, planeNormal);
+    if (!(std::abs(dn) > 1e-12)) return false;
+    const double t = glm::dot(planePoint - camera.position, planeNormal) / dn;
+    if (!(t > 0.0)) return false;
+    *point = camera.position + t * d;
+    return true;
+}
+
 void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg)
 {
     const glm::dvec3 d = glm::normalize(glm::dvec3(direction));

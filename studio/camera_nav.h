@@ -72,6 +72,15 @@ CameraDesc frameBoxCamera(const CameraDesc& current, const Bounds3& b, double as
 // pinhole); false when p is not in front of the eye.
 bool projectToView(const CameraDesc& camera, double width, double height, const glm::dvec3& p, glm::dvec2* pixel);
 
+// The direction (unit) of the camera ray through `pixel` (x right, y down) of a width x height picture of
+// `camera`: the inverse of projectToView. Zero for a degenerate camera or picture.
+glm::dvec3 viewRayDirection(const CameraDesc& camera, double width, double height, const glm::dvec2& pixel);
+
+// Where that ray meets the plane through `planePoint` with normal `planeNormal`; false when it runs parallel
+// to the plane or meets it behind the eye.
+bool viewRayOnPlane(const CameraDesc& camera, double width, double height, const glm::dvec2& pixel, const glm::dvec3& planePoint,
+                    const glm::dvec3& planeNormal, glm::dvec3* point);
+
 // Elevation and azimuth (degrees, scene.h's convention) of a direction toward the sun.
 void sunAngles(const glm::vec3& direction, double* elevationDeg, double* azimuthDeg);
 

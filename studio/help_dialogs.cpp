@@ -142,7 +142,10 @@ ShortcutSheet::ShortcutSheet(QWidget* window, QWidget* parent) : QDialog(parent)
     }
     m_table->horizontalHeader()->setSectionResizeMode(0, QHeaderView::Stretch);
     m_table->horizontalHeader()->setSectionResizeMode(1, QHeaderView::ResizeToContents);
-    auto* note = new QLabel(tr("In the viewport: F switches fly navigation on and off (then W/S, A/D, Q/E move; Shift: faster)."));
+    auto* note = new QLabel(tr("In the viewport: drag to orbit, Shift + drag or the middle button to pan, the wheel to zoom; F switches "
+                              "fly navigation on and off (then W/S, A/D, Q/E move; Shift: faster). A click selects a tree; "
+                              "Ctrl + drag on a tree slides it over the ground, Ctrl + wheel turns the selected tree, "
+                              "Ctrl + Shift + wheel scales it."));
     note->setWordWrap(true);
     auto* buttons = new QDialogButtonBox(QDialogButtonBox::Close);
     connect(buttons, &QDialogButtonBox::rejected, this, &QDialog::reject);

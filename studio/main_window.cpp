@@ -138,10 +138,12 @@ MainWindow::MainWindow(QWidget* parent)
     });
     connect(m_compareToggle, &QCheckBox::toggled, this, [this] { updateCompare(); });
     connect(m_compareBox, &QComboBox::currentIndexChanged, this, [this] { updateCompare(); });
-    connect(m_viewport, &Viewport::cameraEdited, this, [this](const CameraDesc& camera, int key) {
+    connect(m_viewport, &Viewport::navigated, m_doc, &SceneDocument::navigate);
+    connect(m_viewport, &Viewport::instanceEdited, this, [this](int instance, const InstanceDesc& placed, const QString& text, int key) {
         Scene s = m_doc->scene();
-        s.camera = camera;
-        m_doc->edit(s, tr("Navigate"), key);
+        if (instance < 0 || size_t(instance) >= s.instances.size()) return;
+        s.instances[size_t(instance)] = placed;
+        m_doc->edit(s, text, key);
     });
     // A click in the viewport selects the instance under the cursor in the outliner (nothing: clears it).
     connect(m_viewport, &Viewport::instancePicked, this, [this](int instance) {

@@ -114,6 +114,16 @@ void SceneDocument::edit(const Scene& afterIn, const QString& text, int mergeKey
     m_pushing = false;
 }
 
+void SceneDocument::navigate(const CameraDesc& camera)
+{
+    if (camera.position == m_scene.camera.position && camera.target == m_scene.camera.target &&
+        camera.up == m_scene.camera.up && camera.fovY == m_scene.camera.fovY)
+        return;
+    m_scene.camera = camera;
+    ++m_revision;
+    Q_EMIT changed(ScenePart::Camera);
+}
+
 void SceneDocument::setState(const Scene& scene)
 {
     const ScenePart parts = changedParts(m_scene, scene);
@@ -158,17 +168,27 @@ SceneEditCommand::SceneEditCommand(SceneDocument* doc, Scene before, Scene after
     : QUndoCommand(text), m_doc(doc), m_before(std::move(before)), m_after(std::move(after)), m_mergeKey(mergeKey),
       m_epoch(doc->m_mergeEpoch)
 {
+    m_setsCamera = hasPart(changedParts(m_before, m_after), ScenePart::Camera);
 }
 
-void SceneEditCommand::undo() { m_doc->setState(m_before); }
+Scene SceneEditCommand::withCamera(const Scene& state) const
+{
+    if (m_setsCamera) return state;
+    Scene s = state;
+    s.camera = m_doc->m_scene.camera;
+    return s;
+}
 
-void SceneEditCommand::redo() { m_doc->setState(m_after); }
+void SceneEditCommand::undo() { m_doc->setState(withCamera(m_before)); }
+
+void SceneEditCommand::redo() { m_doc->setState(withCamera(m_after)); }
 
 bool SceneEditCommand::mergeWith(const QUndoCommand* other)
 {
     const auto* o = static_cast<const SceneEditCommand*>(other);
     if (m_mergeKey == 0 || o->m_mergeKey != m_mergeKey || o->m_epoch != m_epoch) return false;
     m_after = o->m_after;
+    m_setsCamera = hasPart(changedParts(m_before, m_after), ScenePart::Camera);
     // A gesture that ends where it began (a drag back to its start) leaves no step: the stack drops it
     // (and is clean again if it was before the gesture).
     setObsolete(changedParts(m_before, m_after) == ScenePart::None);

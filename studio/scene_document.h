@@ -55,6 +55,12 @@ public:
     // read); when that fails nothing is pushed and editRefused says why.
     void edit(const Scene& after, const QString& text, int mergeKey = 0);
 
+    // Navigation (the viewport's orbit, pan, zoom, fly and framing): sets the scene's camera with no undo
+    // step and without marking the document modified, as moving the view does in other 3D packages. The
+    // camera is the scene's (renders and the next save use it). Undo and redo of other edits keep it; an edit
+    // that set the camera itself (the camera's property page) puts its own camera back.
+    void navigate(const CameraDesc& camera);
+
     // Replaces the document (new or opened file): clears undo history, marks clean.
     void reset(const Scene& scene, const QString& filePath);
     // Reads a scene file; throws Error with the reader's message. The document is unchanged on error.
@@ -98,7 +104,11 @@ public:
 
 private:
     SceneDocument* m_doc;
+    // The state to apply: `state` with the document's current camera unless this edit set the camera.
+    Scene withCamera(const Scene& state) const;
+
     Scene m_before, m_after;
+    bool m_setsCamera;   // the edit changed the camera (else undo and redo keep the navigated one)
     int m_mergeKey;
     int m_epoch;
 };

@@ -19,6 +19,7 @@
 #include "core/backend/backend.h"
 #include "pipeline/backend_select.h"
 #include "pipeline/render/render_job.h"
+#include "pipeline/scene/scene_fields.h"
 #include "studio/camera_nav.h"
 #include "studio/render_worker.h"
 #include "studio/scene_document.h"
@@ -439,12 +440,35 @@ void Viewport::mousePressEvent(QMouseEvent* event)
 {
     const bool pan = event->button() == Qt::MiddleButton ||
                      (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ShiftModifier));
+    // Ctrl + drag on an instance slides it over the ground (selected first).
+    if (event->button() == Qt::LeftButton && (event->modifiers() & Qt::ControlModifier) && !pan) {
+        const std::optional<ViewPick> hit = pickAt(event->position());
+        if (hit && hit->instance >= 0 && size_t(hit->instance) < m_scene.instances.size()) {
+            m_drag = Drag::Move;
+            m_dragStart = event->position().toPoint();
+            m_dragMoved = false;
+            m_moveInstance = hit->instance;
+            m_moveFrom = m_scene.instances[size_t(hit->instance)];
+            m_moveGrab = hit->point;
+            // Looking down on the point by 3 degrees or more: its horizontal plane (the point follows the cursor
+            // exactly); nearer eye level the horizontal plane runs off toward the horizon, so the vertical plane
+            // facing the camera (the point follows the cursor sideways).
+            const CameraDesc eye = viewCamera();
+            const glm::dvec3 ray = glm::normalize(hit->point - eye.position);
+            glm::dvec3 facing(eye.target.x - eye.position.x, 0.0, eye.target.z - eye.position.z);
+            if (ray.y < -std::sin(3.0 * 3.14159265358979323846 / 180.0) || !(glm::length(facing) > 0.0)) m_movePlane = glm::dvec3(0.0, 1.0, 0.0);
+            else m_movePlane = glm::normalize(facing);
+            m_moveKey = SceneDocument::newMergeKey();
+            Q_EMIT instancePicked(hit->instance);
+            event->accept();
+            return;
+        }
+    }
     if (pan) m_drag = Drag::Pan;
     else if (event->button() == Qt::LeftButton) m_drag = m_fly ? Drag::Look : Drag::Orbit;
     else return;
     m_dragStart = event->position().toPoint();
     m_dragCamera = m_scene.camera;
-    m_dragKey = SceneDocument::newMergeKey();
     m_dragMoved = false;
     m_panDepth = 0.0;
     m_orbitPivot.reset();
@@ -470,6 +494,21 @@ void Viewport::mouseMoveEvent(QMouseEvent* event)
     // A press is a click until the cursor has moved the platform's drag distance: a click changes no camera.
     if (!m_dragMoved && d.manhattanLength() < QApplication::startDragDistance()) return;
     m_dragMoved = true;
+    if (m_drag == Drag::Move) {
+        // The grabbed point follows the cursor over the horizontal plane through it (m_movePlane; seen at eye
+        // level or above, the camera-facing vertical plane through it, its height change dropped): the instance
+        // keeps its height (on the ground plane, or its height above the terrain), only x and z change.
+        glm::dvec3 p;
+        if (viewRayOnPlane(viewCamera(), width(), height(), glm::dvec2(event->position().x(), event->position().y()), m_moveGrab,
+                           m_movePlane, &p)) {
+            InstanceDesc moved = m_moveFrom;
+            moved.position.x += p.x - m_moveGrab.x;
+            moved.position.z += p.z - m_moveGrab.z;
+            Q_EMIT instanceEdited(m_moveInstance, moved, tr("Move instance"), m_moveKey);
+        }
+        event->accept();
+        return;
+    }
     CameraDesc c;
     switch (m_drag) {
     case Drag::Orbit:
@@ -486,7 +525,7 @@ void Viewport::mouseMoveEvent(QMouseEvent* event)
         break;
     }
     }
-    Q_EMIT cameraEdited(c, m_dragKey);
+    Q_EMIT navigated(c);
     event->accept();
 }
 
@@ -496,7 +535,7 @@ void Viewport::mouseReleaseEvent(QMouseEvent* event)
     mouseMoveEvent(event);
     const Drag drag = m_drag;
     m_drag = Drag::None;
-    if (m_dragMoved || drag == Drag::Pan || event->button() != Qt::LeftButton) return;
+    if (m_dragMoved || drag == Drag::Pan || drag == Drag::Move || event->button() != Qt::LeftButton) return;
     // A click: select what is under the cursor (nothing: clear the selection).
     const std::optional<ViewPick> hit = pickAt(event->position());
     if (!hit) return;   // no frame yet to pick in
@@ -505,17 +544,35 @@ void Viewport::mouseReleaseEvent(QMouseEvent* event)
 
 void Viewport::wheelEvent(QWheelEvent* event)
 {
-    const double steps = event->angleDelta().y() / 120.0;
+    // Some platforms turn a wheel held with Shift into a horizontal one.
+    const QPoint angle = event->angleDelta();
+    const double steps = (angle.y() != 0 ? angle.y() : angle.x()) / 120.0;
     if (steps == 0.0) return;
-    // Wheel turns less than half a second apart are one undo step.
-    const qint64 now = QDateTime::currentMSecsSinceEpoch();
-    if (m_wheelKey == 0 || now - m_lastWheelMs > 500) m_wheelKey = SceneDocument::newMergeKey();
-    m_lastWheelMs = now;
+    if ((event->modifiers() & Qt::ControlModifier) && m_selected >= 0 && size_t(m_selected) < m_scene.instances.size()) {
+        // Ctrl + wheel turns the selected instance about the up axis (15 degrees a notch), Ctrl + Shift + wheel
+        // scales it (10% a notch); the turns of one burst (less than half a second apart) are one undo step.
+        const bool scale = (event->modifiers() & Qt::ShiftModifier) != 0;
+        const qint64 now = QDateTime::currentMSecsSinceEpoch();
+        if (m_wheelEditKey == 0 || m_wheelEditScale != scale || now - m_lastWheelEditMs > 500)
+            m_wheelEditKey = SceneDocument::newMergeKey();
+        m_wheelEditScale = scale;
+        m_lastWheelEditMs = now;
+        InstanceDesc in = m_scene.instances[size_t(m_selected)];
+        if (scale) {
+            const json::Bounds range = sceneFieldRange("instances[i].scale");
+            in.scale = float(std::clamp(double(in.scale) * std::pow(1.1, steps), std::max(range.lo, 1e-3), std::min(range.hi, 1e3)));
+        } else {
+            in.rotationDeg.y = float(std::fmod(double(in.rotationDeg.y) + 15.0 * steps + 360.0 * 8.0, 360.0));
+        }
+        Q_EMIT instanceEdited(m_selected, in, scale ? tr("Scale instance") : tr("Rotate instance"), m_wheelEditKey);
+        event->accept();
+        return;
+    }
     // Toward what is under the cursor (its distance sets the step), else toward the target.
     const std::optional<ViewPick> hit = pickAt(event->position(), kNavigationPickMs);
     const CameraDesc c = hit && hit->kind != SurfaceKind::None ? zoomCameraAbout(m_scene.camera, steps, hit->point)
                                                               : zoomCamera(m_scene.camera, steps);
-    Q_EMIT cameraEdited(c, m_wheelKey);
+    Q_EMIT navigated(c);
     event->accept();
 }
 
@@ -595,7 +652,7 @@ bool Viewport::frameBox(const Bounds3& box)
     const double aspect = m_cameraFrame ? double(std::max(1, m_scene.render.width)) / double(std::max(1, m_scene.render.height))
                                         : double(std::max(1, width())) / double(std::max(1, height()));
     const CameraDesc c = frameBoxCamera(m_scene.camera, box, aspect);
-    Q_EMIT cameraEdited(c, SceneDocument::newMergeKey());
+    Q_EMIT navigated(c);
     return true;
 }
 
@@ -675,7 +732,6 @@ void Viewport::setFlyMode(bool on)
 {
     if (m_fly == on) return;
     m_fly = on;
-    m_flyKey = 0;
     Q_EMIT flyModeChanged(on);
 }
 
@@ -711,11 +767,7 @@ void Viewport::keyPressEvent(QKeyEvent* event)
         return;
     }
     const double step = flyStep() * ((event->modifiers() & Qt::ShiftModifier) ? 5.0 : 1.0);
-    // Presses (and auto-repeats) less than half a second apart are one undo step.
-    const qint64 now = QDateTime::currentMSecsSinceEpoch();
-    if (m_flyKey == 0 || now - m_lastFlyMs > 500) m_flyKey = SceneDocument::newMergeKey();
-    m_lastFlyMs = now;
-    Q_EMIT cameraEdited(flyMove(m_scene.camera, right * step, up * step, forward * step), m_flyKey);
+    Q_EMIT navigated(flyMove(m_scene.camera, right * step, up * step, forward * step));
     event->accept();
 }
 

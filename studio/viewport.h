@@ -116,19 +116,22 @@ public:
     CameraDesc viewCamera() const;
 
     // View > Frame All / Frame Selected: the scene's box (sceneBounds) or the selected instance's, framed
-    // from the current view direction (frameBoxCamera); one camera edit. false (nothing edited) when there is
+    // from the current view direction (frameBoxCamera); a navigation (no undo step). false (nothing moved) when there is
     // nothing to frame.
     bool frameAll();
     bool frameSelected();
 
 Q_SIGNALS:
-    // Navigation changed the camera; consecutive events of one gesture share mergeKey.
-    void cameraEdited(const sylva::CameraDesc& camera, int mergeKey);
+    // Navigation moved the camera (SceneDocument::navigate: no undo step, the scene not marked modified).
+    void navigated(const sylva::CameraDesc& camera);
     void imageShown(int pass, bool last, double seconds);
     void renderFailed(const QString& message);
     void flyModeChanged(bool on);
     // A click picked this instance (index into Scene::instances), or -1: the sky, the ground, the terrain.
     void instancePicked(int instance);
+    // A drag or wheel placed instance `instance` anew (Ctrl + drag: moved over the ground; Ctrl + wheel: turned;
+    // Ctrl + Shift + wheel: scaled); `text` names the undo step, edits of one gesture share mergeKey.
+    void instanceEdited(int instance, const sylva::InstanceDesc& placed, const QString& text, int mergeKey);
     // The GPU path was switched off (why); rendering goes on on the CPU.
     void gpuDisabled(const QString& message);
 
@@ -176,21 +179,25 @@ private:
     double m_exposureShown = 0.0;
 
     // navigation
-    enum class Drag { None, Orbit, Pan, Look };
+    enum class Drag { None, Orbit, Pan, Look, Move };
     Drag m_drag = Drag::None;
     bool m_dragMoved = false;   // past the drag distance: a drag, not a click
     double m_panDepth = 0.0;    // metres along the view to what the pan grabbed (0: the target's distance)
     std::optional<glm::dvec3> m_orbitPivot;   // what the orbit drag turns about (none: the target)
     QPoint m_dragStart;
     CameraDesc m_dragCamera;
-    int m_dragKey = 0;
-    int m_wheelKey = 0;
-    qint64 m_lastWheelMs = 0;
+    // instance edits in the viewport
+    int m_moveInstance = -1;
+    InstanceDesc m_moveFrom;     // the instance as the move drag found it
+    glm::dvec3 m_moveGrab{0.0};  // the point of it the cursor grabbed (world metres)
+    glm::dvec3 m_movePlane{0.0, 1.0, 0.0};   // the normal of the plane through m_moveGrab the drag slides it over
+    int m_moveKey = 0;
+    int m_wheelEditKey = 0;
+    bool m_wheelEditScale = false;
+    qint64 m_lastWheelEditMs = 0;
     bool m_fly = false;
     bool m_cameraFrame = false;
     std::optional<RenderMode> m_compare;
-    int m_flyKey = 0;
-    qint64 m_lastFlyMs = 0;
 
     // GL (hellogl2 pattern: created in initializeGL, freed on aboutToBeDestroyed)
     QOpenGLShaderProgram* m_program = nullptr;

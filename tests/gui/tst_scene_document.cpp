@@ -286,6 +286,27 @@ private Q_SLOTS:
         glm::dvec2 behind;
         QVERIFY(!projectToView(c, w, h, c.position - (c.target - c.position), &behind));
 
+        // viewRayDirection is the renderer's ray; viewRayOnPlane: it meets the plane y = 0.5 (and the vertical
+        // plane x = 1) at a point on that ray, in the plane, projected back onto the pixel, and the plane y = 0.5
+        // not at all for a pixel above the horizon (the ray rises away from a plane below the eye).
+        for (const glm::dvec2 px : {glm::dvec2(10.5, 300.5), glm::dvec2(320.0, 340.0), glm::dvec2(600.25, 350.75)}) {
+            const glm::dvec3 dir = glm::normalize(glm::dvec3(cameraRay(v, float(px.x), float(px.y)).dir));
+            QVERIFY(glm::length(viewRayDirection(c, w, h, px) - dir) < 1e-6);
+            for (const auto& [point, normal] : {std::pair{glm::dvec3(0.0, 0.5, 0.0), glm::dvec3(0.0, 1.0, 0.0)},
+                                                std::pair{glm::dvec3(1.0, 0.0, 0.0), glm::dvec3(1.0, 0.0, 0.0)}}) {
+                glm::dvec3 onPlane;
+                if (normal.x > 0.0 && dir.x * (1.0 - c.position.x) <= 0.0) continue;   // that plane is behind this ray
+                QVERIFY(viewRayOnPlane(c, w, h, px, point, normal, &onPlane));
+                QVERIFY(std::abs(glm::dot(onPlane - point, normal)) < 1e-9);
+                QVERIFY(glm::length(glm::normalize(onPlane - c.position) - dir) < 1e-6);
+                glm::dvec2 back;
+                QVERIFY(projectToView(c, w, h, onPlane, &back));
+                QVERIFY(glm::length(back - px) < 1e-6);
+            }
+        }
+        glm::dvec3 none;
+        QVERIFY(!viewRayOnPlane(c, w, h, glm::dvec2(320.0, 2.0), glm::dvec3(0.0, 0.5, 0.0), glm::dvec3(0.0, 1.0, 0.0), &none));
+
         // Zoom about a point off the axis: it stays on its pixel, 0.85x as far; the view direction stays.
         const glm::dvec3 p(-2.0, 1.0, 3.0);
         glm::dvec2 before, after;

@@ -520,7 +520,8 @@ private Q_SLOTS:
         }
         doc()->undoStack()->undo();
 
-        // The dialog: the clearance and "frame the result", and a framed scatter moves the camera out (a second step).
+        // The dialog: the clearance and "frame the result", and a framed scatter moves the camera out (navigation:
+        // the scatter's one step, undone without moving the camera back).
         ScatterDialog d({QStringLiteral("Tree_1")}, m_win->scatterTool()->defaultScatter());
         QCOMPARE(d.clearanceBox()->value(), std::round(m_win->scatterTool()->defaultScatter().clearRadius * 10.0) / 10.0);
         QVERIFY(d.frameBox()->isChecked());
@@ -532,10 +533,13 @@ private Q_SLOTS:
         fromForm.max = {32.0, 27.0};
         const int steps2 = doc()->undoStack()->index();
         QVERIFY(m_win->scatterTool()->scatter(fromForm, d.frameResult()));
-        QCOMPARE(doc()->undoStack()->index(), steps2 + 2);
-        QVERIFY(scene().camera.position != camera.position);
+        QCOMPARE(doc()->undoStack()->index(), steps2 + 1);
+        const CameraDesc framed = scene().camera;
+        QVERIFY(framed.position != camera.position);
         doc()->undoStack()->undo();
-        doc()->undoStack()->undo();
+        QCOMPARE(scene().instances.size(), before);
+        QCOMPARE(scene().camera.position, framed.position);
+        doc()->navigate(camera);
         QCOMPARE(scene().camera.position, camera.position);
     }
 };
