@@ -31,6 +31,7 @@ import bpy, sys
 argv = sys.argv[sys.argv.index('--') + 1:]
 exr, out, layer, names, width, height = argv[0], argv[1], argv[2], argv[3], int(argv[4]), int(argv[5])
 img = bpy.data.images.load(exr)
+print('IMAGE=%s %dx%d' % (img.type, img.size[0], img.size[1]))   # reading the size loads the file's layers and header
 sc = bpy.context.scene
 sc.render.engine = 'BLENDER_WORKBENCH'
 sc.render.resolution_x = width
