@@ -136,6 +136,10 @@ void writeRenderPasses(const std::string& path, const RenderPasses& passes)
 {
     if (lowerExtension(path) != ".exr") throw Error(path + ": render passes are written as a multi-layer OpenEXR file (use .exr)");
     const size_t n = size_t(passes.width) * size_t(passes.height);
+    for (const CryptomatteLayer& c : passes.cryptomatte)
+        if (c.ranks.width != passes.width || c.ranks.height != passes.height)
+            throw Error(path + ": the " + c.name + " matte is " + std::to_string(c.ranks.width) + "x" + std::to_string(c.ranks.height) +
+                        ", the passes " + std::to_string(passes.width) + "x" + std::to_string(passes.height));
     const std::vector<std::string> names = renderPassChannels(passes);
     std::vector<float> data(n * names.size());
     for (size_t i = 0; i < n; ++i) {
@@ -156,9 +160,6 @@ void writeRenderPasses(const std::string& path, const RenderPasses& passes)
     }
     std::vector<std::string> header;
     for (const CryptomatteLayer& c : passes.cryptomatte) {
-        if (c.ranks.width != passes.width || c.ranks.height != passes.height)
-            throw Error(path + ": the " + c.name + " matte is " + std::to_string(c.ranks.width) + "x" + std::to_string(c.ranks.height) +
-                        ", the passes " + std::to_string(passes.width) + "x" + std::to_string(passes.height));
         const std::string key = "cryptomatte/" + cryptomatteKey(c.name) + "/";
         json::JsonWriter manifest;   // {"name":"hex8",...}
         manifest.raw("{");

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <random>
 
+#include "core/base/error.h"
 #include "core/render/cryptomatte.h"
 #include "core/render/render_cpu.h"
 #include "pipeline/grow/obj_writer.h"
@@ -299,6 +300,19 @@ private Q_SLOTS:
         for (const MatteFilm::Entry& e : film.entries) sum += e.coverage;
         QCOMPARE(merged.pairs[1], sum);
         QCOMPARE(merged.pairs[3], 0.0f);
+    }
+
+    // Mattes of another size than the passes are refused, writing nothing.
+    void mismatchedMatteRefused()
+    {
+        const Scene sc = test::matteScene(1, 8, 6), other = test::matteScene(1, 10, 6);
+        const RenderScene rs = buildRenderScene(sc, test::matteAssets(), sunRadiance(sc.sun));
+        const RenderScene rsOther = buildRenderScene(other, test::matteAssets(), sunRadiance(other.sun));
+        RenderPasses passes = renderPasses(renderFilm(rs.view()), RenderMode::Local, sc.sky);
+        passes.cryptomatte = cryptomatteLayers(renderMatteFilm(rsOther.view()), other);
+        const QString path = m_dir.filePath("mismatch.exr");
+        QVERIFY_THROWS_EXCEPTION(Error, writeRenderPasses(path.toStdString(), passes));
+        QVERIFY(!QFile::exists(path));
     }
 
     // sylva render --passes on a scene file (the cards as OBJ meshes): the same mattes in the EXR.
