@@ -236,10 +236,11 @@ int runRender(const Args& args)
             device = "cpu, " + std::to_string(bands) + " bands";
         } else {
             ProgressPrinter bar("render", args.has("--quiet"));
-            const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get(), tracer);
+            const RenderOutput result = renderScene(scene, cache.get(), &bar.progress(), &log, compute.get(), tracer, passes);
             bar.finish();
             if (passes) {
-                const RenderPasses layers = renderPasses(result.film, r.mode, composeSky(scene));
+                RenderPasses layers = renderPasses(result.film, r.mode, composeSky(scene));
+                layers.cryptomatte = cryptomatteLayers(result.mattes, scene);
                 writeRenderPasses(out, layers);
                 ambient = layers.ambient;
             } else {
@@ -330,7 +331,7 @@ Command renderCommand()
              {"--list-views", "", "print the OpenColorIO config's displays and their views (and where the config comes from), then exit"},
              kBackend,
              {"--band-rows", "N", "trace and write the frame in bands of N rows (default: only when the whole frame does not fit in memory)"},
-             {"--passes", "", "write one multi-layer EXR (32-bit float) of the render passes: Combined, DiffDir, DiffInd, DiffCol, Env, Normal, Depth, Alpha (docs/RENDERING.md); default output NAME.exr"},
+             {"--passes", "", "write one multi-layer EXR (32-bit float) of the render passes: Combined, DiffDir, DiffInd, DiffCol, Env, Normal, Depth, Alpha, and the Cryptomatte ID mattes CryptoObject, CryptoMaterial, CryptoAsset (docs/RENDERING.md); default output NAME.exr"},
              {"--stats", "", "print timings and acceleration structure sizes"},
              {"--mpi", "", "trace the frame across the ranks of an MPI job, tiles from a work queue on rank 0: mpirun -np N sylva render --mpi ... (docs/DISTRIBUTED.md)"},
              {"--mpi-timeout", "S", "with --mpi: end the job when a rank stays silent S seconds (default 10)"},

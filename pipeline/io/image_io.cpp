@@ -72,7 +72,7 @@ namespace {
 // The one whole-image writer: pixels from float `data` (channels interleaved), through a temporary file
 // beside the target (keeping the extension, so OIIO picks the same format), renamed at the end.
 void writePixels(const std::string& path, int width, int height, int channels, const std::vector<std::string>* names,
-                 image_module::SampleType stored, int alphaChannel, const float* data)
+                 image_module::SampleType stored, int alphaChannel, const float* data, const std::vector<std::string>* attributes = nullptr)
 {
     // Float files hold Sylva's scene-linear Rec.709 radiance (renders, passes, sky maps): the header says so.
     const bool isFloat = stored == image_module::SampleType::Half || stored == image_module::SampleType::Float;
@@ -80,7 +80,7 @@ void writePixels(const std::string& path, int width, int height, int channels, c
     AtomicFile file(path, AtomicFile::Sync::No, "image");
     const std::string& temp = file.pathForWriter();
     std::string error;
-    auto out = image_module::Writer::open(temp, width, height, channels, names, stored, alphaChannel, space, error);
+    auto out = image_module::Writer::open(temp, width, height, channels, names, stored, alphaChannel, space, error, attributes);
     if (!out) throw Error(path + ": " + error);
     if (!out->writeImage(data, error) || !out->close(error)) throw Error(path + ": cannot write image (" + error + ")");
     file.commit();
@@ -106,14 +106,15 @@ void writeImage(const std::string& path, const ImageRgba& image, int channels)
 }
 
 void writeImageChannels(const std::string& path, int width, int height, const std::vector<std::string>& channels,
-                        const std::vector<float>& interleaved)
+                        const std::vector<float>& interleaved, const std::vector<std::string>& attributes)
 {
     if (width < 1 || height < 1 || channels.empty()) throw Error(path + ": refusing to write an empty image");
     if (lowerExtension(path) != ".exr") throw Error(path + ": named channels are written to OpenEXR files only (use .exr)");
     if (interleaved.size() != size_t(width) * size_t(height) * channels.size())
         throw Error(path + ": " + std::to_string(interleaved.size()) + " values for " + std::to_string(channels.size()) +
                     " channels of " + std::to_string(width) + "x" + std::to_string(height) + " pixels");
-    writePixels(path, width, height, int(channels.size()), &channels, image_module::SampleType::Float, -1, interleaved.data());
+    if (attributes.size() % 2 != 0) throw Error(path + ": header attributes come as name, value pairs");
+    writePixels(path, width, height, int(channels.size()), &channels, image_module::SampleType::Float, -1, interleaved.data(), &attributes);
 }
 
 struct RowImageWriter::Impl {

@@ -23,10 +23,11 @@ void writeImage(const std::string& path, const ImageRgba& image, int channels = 
 // Named float channels, interleaved per pixel (width * height * channels.size() values, top row first),
 // written as 32-bit float: a multi-layer EXR when the names follow the "Layer.Channel" convention
 // ("Combined.R", "Depth.Z"), which Blender, Nuke and OpenImageIO read as layers. The file is written
-// as writeImage writes (same temporary file and rename). Throws Error naming the file (extension not
+// as writeImage writes (same temporary file and rename). attributes: string attributes for the header as
+// name, value, name, value, ... (Cryptomatte's metadata). Throws Error naming the file (extension not
 // .exr, size mismatch, write failure).
 void writeImageChannels(const std::string& path, int width, int height, const std::vector<std::string>& channels,
-                        const std::vector<float>& interleaved);
+                        const std::vector<float>& interleaved, const std::vector<std::string>& attributes = {});
 
 // An RGB image written a band of rows at a time, top row first (a frame too large to hold whole):
 // .png/.tif/.tiff 8-bit (values clamped to [0,1]), .exr half float. Like writeImage it writes a

@@ -137,16 +137,22 @@ bool Reader::read(int channels, std::vector<float>& out, std::string& error)
 }
 
 std::unique_ptr<Writer> Writer::open(const std::string& path, int width, int height, int channels, const std::vector<std::string>* names,
-                                     SampleType stored, int alphaChannel, ColorSpace colorSpace, std::string& error)
+                                     SampleType stored, int alphaChannel, ColorSpace colorSpace, std::string& error,
+                                     const std::vector<std::string>* attributes)
 {
     const Table& t = table();
     if (names && int(names->size()) != channels) {
         error = "channel names do not match the channel count";
         return nullptr;
     }
+    if (attributes && attributes->size() % 2 != 0) {
+        error = "header attributes come as name, value pairs";
+        return nullptr;
+    }
     std::unique_ptr<Writer> w(new Writer);
     w->m_table = &t;
-    w->m_output = t.openWrite(path.c_str(), width, height, channels, names ? names->data() : nullptr, stored, alphaChannel, colorSpace, &error);
+    w->m_output = t.openWrite(path.c_str(), width, height, channels, names ? names->data() : nullptr, stored, alphaChannel, colorSpace,
+                               attributes && !attributes->empty() ? attributes->data() : nullptr, attributes ? int(attributes->size() / 2) : 0, &error);
     if (!w->m_output) return nullptr;
     return w;
 }

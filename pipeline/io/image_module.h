@@ -36,13 +36,14 @@ struct Table {
     // names: null for the format's defaults, else `channels` names (alpha and depth then unnamed);
     // alphaChannel >= 0 marks that channel straight (unassociated) alpha. The message says which step
     // failed: "no image writer for this extension (...)" or "cannot write image (...)". colorSpace: named in the header.
+    // attributes: attributeCount (name, value) string pairs for the header, 2 x attributeCount strings (null when none).
     void* (*openWrite)(const char* path, int width, int height, int channels, const std::string* names, SampleType stored,
-                       int alphaChannel, ColorSpace colorSpace, std::string* error);
+                       int alphaChannel, ColorSpace colorSpace, const std::string* attributes, int attributeCount, std::string* error);
     int (*writeImage)(void* output, const float* data, std::string* error);             // every row
     int (*writeRows)(void* output, int y0, int y1, const float* data, std::string* error);
     int (*closeWrite)(void* output, std::string* error);   // frees the output, also when closing fails
 };
-constexpr int kAbi = 2;
+constexpr int kAbi = 3;
 
 // The module, loaded on the first call (thread-safe). Throws Error when it cannot be found or loaded:
 // SYLVA_IMAGE_MODULE names it, else it is looked for beside the executable, then installed (BINDIR/../LIBDIR/
@@ -78,8 +79,11 @@ private:
 // An image file open for writing (the format follows the path's extension).
 class Writer {
 public:
+    // attributes: (name, value) pairs for the header, name0, value0, name1, value1, ... (string attributes:
+    // OpenEXR's header keys, e.g. Cryptomatte's "cryptomatte/<key>/manifest").
     static std::unique_ptr<Writer> open(const std::string& path, int width, int height, int channels, const std::vector<std::string>* names,
-                                        SampleType stored, int alphaChannel, ColorSpace colorSpace, std::string& error);
+                                        SampleType stored, int alphaChannel, ColorSpace colorSpace, std::string& error,
+                                        const std::vector<std::string>* attributes = nullptr);
     ~Writer();   // closes a file not yet closed (its caller removes it)
     Writer(const Writer&) = delete;
     Writer& operator=(const Writer&) = delete;

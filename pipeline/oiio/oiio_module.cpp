@@ -88,7 +88,7 @@ void closeRead(void* input)
 }
 
 void* openWrite(const char* path, int width, int height, int channels, const std::string* names, SampleType stored, int alphaChannel,
-                ColorSpace colorSpace, std::string* error)
+                ColorSpace colorSpace, const std::string* attributes, int attributeCount, std::string* error)
 {
     try {
         auto out = OIIO::ImageOutput::create(path);
@@ -114,6 +114,7 @@ void* openWrite(const char* path, int width, int height, int channels, const std
             spec.attribute("colorInteropID", "lin_rec709_scene");
             spec.attribute("oiio:ColorSpace", "lin_rec709");
         }
+        for (int i = 0; i < attributeCount; ++i) spec.attribute(attributes[2 * i], OIIO::string_view(attributes[2 * i + 1]));
         if (!out->open(path, spec)) {
             *error = "cannot write image (" + out->geterror() + ")";
             return nullptr;

@@ -270,7 +270,7 @@ RenderScene prepareRenderScene(const Scene& scene, GridCache* cache, Progress* p
 }
 
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress, JobLog* log, Backend* backend,
-                         const FilmRowsTracer& tracer)
+                         const FilmRowsTracer& tracer, bool mattes)
 {
     checkFrameMemory(scene.render);
     RenderOutput out;
@@ -284,6 +284,7 @@ RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progres
     out.film = tracer    ? tracer(rs, 0, scene.render.height, &traceProgress)
                : backend ? backend->render(rs, &traceProgress)
                          : renderFilm(rs.view(), &traceProgress);
+    if (mattes) out.mattes = renderMatteFilm(rs.view());
     if (log) log->stages.push_back("trace");
     out.timings.trace = secondsSince(t0);
     return out;

@@ -8,6 +8,7 @@
 
 #include "core/base/progress.h"
 #include "core/color/color.h"
+#include "core/render/cryptomatte.h"
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/scene/scene.h"
@@ -78,6 +79,7 @@ struct RenderTimings {
 // Assets, acceleration structures and the film of a scene, with progress (assets 0-60%, build, trace).
 struct RenderOutput {
     Film film;
+    MatteFilm mattes;   // with `mattes`: the frame's camera samples by first hit (the Cryptomatte passes); else empty
     AccelStats stats;
     RenderTimings timings;
 };
@@ -86,13 +88,14 @@ struct RenderOutput {
 // picture; 16384 x 8192 about 9 GB): one that does not fit in 80% of the available memory is refused
 // up front (Error naming the size and the memory), before any asset is loaded.
 // tracer: traces the frame's rows in place of the backend (sylva render --mpi hands them to the ranks as tiles).
+// mattes: also renderMatteFilm of the frame on the CPU (its camera rays traced again to their first hits).
 inline constexpr size_t kFrameBytesPerPixel = sizeof(SampleParts) + sizeof(glm::vec3);
 // Rows y0 (inclusive) to y1 (exclusive) of scene.view() as a film: renderFilmRows's contract (the whole
 // scene, not only its view: render --mpi sends the built scene to the other ranks). A frame's rows are
 // traced once, top to bottom: the call whose rows end at the frame's last row is the frame's last.
 using FilmRowsTracer = std::function<Film(const RenderScene& scene, int y0, int y1, Progress* progress)>;
 RenderOutput renderScene(const Scene& scene, GridCache* cache, Progress* progress = nullptr, JobLog* log = nullptr,
-                         Backend* backend = nullptr, const FilmRowsTracer& tracer = {});
+                         Backend* backend = nullptr, const FilmRowsTracer& tracer = {}, bool mattes = false);
 
 // The assets (0-60% of progress) and the acceleration structures (60-70%) of the scene's frame, the
 // steps renderScene takes before tracing; timings.assets and timings.build are set.

@@ -1,9 +1,14 @@
 // Render passes (render_passes.h).
 #include "pipeline/render/render_passes.h"
 
+#include <algorithm>
+#include <cstdio>
+#include <map>
+
 #include "core/base/error.h"
 #include "pipeline/io/file_extension.h"
 #include "pipeline/io/image_io.h"
+#include "pipeline/scene/json_codec.h"
 
 namespace sylva {
 
@@ -18,7 +23,68 @@ glm::vec3 divideByColour(const glm::vec3& part, const glm::vec3& colour)
     return out;
 }
 
+std::string rankLayerName(const std::string& type, int layer)
+{
+    char digits[16];
+    std::snprintf(digits, sizeof digits, "%02d", layer);
+    return type + digits;
+}
+
 } // namespace
+
+MatteNames matteNames(const MatteHit& hit, const Scene& scene)
+{
+    const auto speciesName = [&](uint32_t s) { return s < scene.species.size() ? scene.species[s].name : "species " + std::to_string(s); };
+    MatteNames n;
+    switch (SurfaceKind(hit.kind)) {
+    case SurfaceKind::Ground: n.object = n.material = n.asset = "ground"; break;
+    case SurfaceKind::Terrain: n.object = n.material = n.asset = "terrain"; break;
+    case SurfaceKind::Spheres:
+        n.object = "sphere." + std::to_string(hit.object);
+        n.material = n.asset = "sphere";
+        break;
+    case SurfaceKind::Instances:
+    case SurfaceKind::Landscape: {
+        const std::string species = speciesName(hit.species);
+        if (SurfaceKind(hit.kind) == SurfaceKind::Landscape) {
+            n.object = species + ".landscape." + std::to_string(hit.object) + "." + std::to_string(hit.plant);
+        } else {
+            const bool group = hit.object < scene.instances.size() && scene.instances[hit.object].group != kNoGroup &&
+                               scene.instances[hit.object].group < scene.groups.size();
+            n.object = (group ? scene.groups[scene.instances[hit.object].group].name : species) + "." + std::to_string(hit.object);
+        }
+        n.material = species + (hit.leaf ? "/leaf" : "/bark");
+        n.asset = species;
+        break;
+    }
+    case SurfaceKind::None: break;
+    }
+    return n;
+}
+
+std::vector<CryptomatteLayer> cryptomatteLayers(const MatteFilm& film, const Scene& scene)
+{
+    std::vector<MatteNames> names;
+    names.reserve(film.hits.size());
+    for (const MatteHit& h : film.hits) names.push_back(matteNames(h, scene));
+    std::vector<CryptomatteLayer> out;
+    for (const auto& [type, member] : {std::pair{"CryptoObject", &MatteNames::object}, std::pair{"CryptoMaterial", &MatteNames::material},
+                                       std::pair{"CryptoAsset", &MatteNames::asset}}) {
+        CryptomatteLayer layer;
+        layer.name = type;
+        std::vector<float> idOf(names.size());
+        std::map<std::string, float> manifest;
+        for (size_t h = 0; h < names.size(); ++h) {
+            const std::string& name = names[h].*member;
+            idOf[h] = cryptomatteId(murmurHash3(name));
+            manifest.emplace(name, idOf[h]);
+        }
+        layer.ranks = rankCryptomatte(film, idOf);
+        layer.manifest.assign(manifest.begin(), manifest.end());
+        out.push_back(std::move(layer));
+    }
+    return out;
+}
 
 RenderPasses renderPasses(const Film& film, RenderMode mode, const glm::vec3& sky)
 {
@@ -57,11 +123,24 @@ const std::vector<std::string>& renderPassChannels()
     return names;
 }
 
+std::vector<std::string> renderPassChannels(const RenderPasses& passes)
+{
+    std::vector<std::string> names = renderPassChannels();
+    for (const CryptomatteLayer& c : passes.cryptomatte)
+        for (int layer = 0; layer < c.ranks.ranks / 2; ++layer)
+            for (const char* ch : {".R", ".G", ".B", ".A"}) names.push_back(rankLayerName(c.name, layer) + ch);
+    return names;
+}
+
 void writeRenderPasses(const std::string& path, const RenderPasses& passes)
 {
     if (lowerExtension(path) != ".exr") throw Error(path + ": render passes are written as a multi-layer OpenEXR file (use .exr)");
     const size_t n = size_t(passes.width) * size_t(passes.height);
-    const std::vector<std::string>& names = renderPassChannels();
+    for (const CryptomatteLayer& c : passes.cryptomatte)
+        if (c.ranks.width != passes.width || c.ranks.height != passes.height)
+            throw Error(path + ": the " + c.name + " matte is " + std::to_string(c.ranks.width) + "x" + std::to_string(c.ranks.height) +
+                        ", the passes " + std::to_string(passes.width) + "x" + std::to_string(passes.height));
+    const std::vector<std::string> names = renderPassChannels(passes);
     std::vector<float> data(n * names.size());
     for (size_t i = 0; i < n; ++i) {
         float* d = &data[i * names.size()];
@@ -72,8 +151,30 @@ void writeRenderPasses(const std::string& path, const RenderPasses& passes)
         }
         d[0] = passes.depth[i];
         d[1] = passes.alpha[i];
+        d += 2;
+        for (const CryptomatteLayer& c : passes.cryptomatte) {   // the ranks' (ID, coverage) pairs in order: 4 per layer
+            const size_t values = size_t(c.ranks.ranks) * 2;
+            std::copy_n(&c.ranks.pairs[i * values], values, d);
+            d += values;
+        }
     }
-    writeImageChannels(path, passes.width, passes.height, names, data);
+    std::vector<std::string> header;
+    for (const CryptomatteLayer& c : passes.cryptomatte) {
+        const std::string key = "cryptomatte/" + cryptomatteKey(c.name) + "/";
+        json::JsonWriter manifest;   // {"name":"hex8",...}
+        manifest.raw("{");
+        for (const auto& [name, id] : c.manifest) {
+            if (manifest.text.size() > 1) manifest.raw(",");
+            manifest.string(name);
+            manifest.raw(":");
+            manifest.string(cryptomatteHex(id));
+        }
+        manifest.raw("}");
+        for (const std::string& s : {key + "name", c.name, key + "hash", std::string("MurmurHash3_32"), key + "conversion",
+                                     std::string("uint32_to_float32"), key + "manifest", manifest.text})
+            header.push_back(s);
+    }
+    writeImageChannels(path, passes.width, passes.height, names, data, header);
 }
 
 } // namespace sylva

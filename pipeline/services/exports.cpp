@@ -35,17 +35,21 @@ void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, 
     Progress traceProgress([&](double f, const std::string& m) { tracePart.report(f, m); });
     if (progress && progress->isCancelled()) traceProgress.cancel();
     const Film film = backend ? backend->render(rs, &traceProgress) : renderFilm(rs.view(), &traceProgress);
+    MatteFilm mattes;
+    if (passes) mattes = renderMatteFilm(rs.view());
     if (progress) progress->report(0.96, "writing");
-    writeRenderFilm(path, film, scene, passes);
+    writeRenderFilm(path, film, scene, passes, passes ? &mattes : nullptr);
     if (progress) progress->report(1.0, "written");
 }
 
-void writeRenderFilm(const std::string& path, const Film& film, const Scene& scene, bool passes)
+void writeRenderFilm(const std::string& path, const Film& film, const Scene& scene, bool passes, const MatteFilm* mattes)
 {
     if (passes && lowerExtension(path) != ".exr")
         throw Error(path + ": render passes are written as a multi-layer OpenEXR file (use .exr)");
     if (passes) {
-        writeRenderPasses(path, renderPasses(film, scene.render.mode, composeSky(scene)));
+        RenderPasses layers = renderPasses(film, scene.render.mode, composeSky(scene));
+        if (mattes) layers.cryptomatte = cryptomatteLayers(*mattes, scene);
+        writeRenderPasses(path, layers);
     } else {
         const std::vector<glm::vec3> linear = composeMode(film, scene.render.mode, composeSky(scene));
         const bool linearOut = lowerExtension(path) == ".exr";

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/base/progress.h"
+#include "core/render/cryptomatte.h"
 #include "core/render/render_cpu.h"
 #include "core/render/render_scene.h"
 #include "core/scene/scene.h"
@@ -25,14 +26,15 @@ std::vector<std::string> speciesLogLines(const std::string& species, const JobLo
 // The picture of `scene` with the species' assets (in species order; with lighting grids when the
 // mode needs them) into `path`: buildRenderScene, the film on `backend`, composeMode, writeRender
 // (.png/.tif/.tiff 8-bit through the scene's view, .exr linear); with `passes`, renderPasses and writeRenderPasses
-// instead (one multi-layer EXR: .exr only). Throws Error (bad extension, unwritable file) or Cancelled.
+// instead (one multi-layer EXR: .exr only), with the Cryptomatte types of the frame's renderMatteFilm. Throws Error (bad extension, unwritable file) or Cancelled.
 void exportRender(const Scene& scene, const std::vector<SpeciesAssets>& assets, const std::string& path,
                   Backend* backend = nullptr, Progress* progress = nullptr, bool passes = false);
 
 // The file exportRender writes, for a film of `scene` already traced (the studio's render window saves
 // its finished render with it): `scene`'s mode, sky, exposure key and view; .png/.tif/.tiff 8-bit,
-// .exr linear, or with `passes` the multi-layer EXR. Throws Error (bad extension, unwritable file).
-void writeRenderFilm(const std::string& path, const Film& film, const Scene& scene, bool passes = false);
+// .exr linear, or with `passes` the multi-layer EXR (with mattes: its Cryptomatte types, cryptomatteLayers).
+// Throws Error (bad extension, unwritable file).
+void writeRenderFilm(const std::string& path, const Film& film, const Scene& scene, bool passes = false, const MatteFilm* mattes = nullptr);
 
 // A file name base for a species' grids: ASCII letters, digits, '.', '-' and '_' kept, any other
 // character '_' ("Tree 1 (2)/x" -> "Tree_1__2__x"); "species" for an empty name.

@@ -597,6 +597,11 @@ private Q_SLOTS:
             const OIIO::ImageSpec spec = in->spec();
             QCOMPARE(spec.width, size.width());
             QCOMPARE(spec.height, size.height());
+            // ... with the Cryptomatte types, each named in the header under its key (tst_cryptomatte checks their mattes) ...
+            for (const char* type : {"CryptoObject", "CryptoMaterial", "CryptoAsset"}) {
+                QCOMPARE(QString::fromStdString(spec.get_string_attribute("cryptomatte/" + cryptomatteKey(type) + "/name")), QString(type));
+                QVERIFY2(spec.channelindex(std::string(type) + "00.R") >= 0 && spec.channelindex(std::string(type) + "02.A") >= 0, type);
+            }
             std::vector<float> data(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
             QVERIFY(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, data.data()));
             const RenderPasses want = renderPasses(film, s.render.mode, composeSky(s));

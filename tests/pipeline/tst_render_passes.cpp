@@ -134,6 +134,17 @@ const std::vector<std::string> kExpectedChannels = {"Combined.R", "Combined.G", 
                                                     "DiffCol.G",  "DiffCol.B",  "Env.R",      "Env.G",     "Env.B",
                                                     "Normal.X",   "Normal.Y",   "Normal.Z",   "Depth.Z",   "Alpha.A"};
 
+// The Cryptomatte layers `--passes` and exportRender add (tst_cryptomatte checks what they hold): three
+// types of 6 ranks, 3 RGBA layers each.
+std::vector<std::string> cryptomatteChannels()
+{
+    std::vector<std::string> out;
+    for (const char* type : {"CryptoObject", "CryptoMaterial", "CryptoAsset"})
+        for (const char* layer : {"00", "01", "02"})
+            for (const char* c : {".R", ".G", ".B", ".A"}) out.push_back(std::string(type) + layer + c);
+    return out;
+}
+
 QString channelList(const ExrChannels& e)
 {
     QStringList names;
@@ -312,7 +323,9 @@ private Q_SLOTS:
         const QString path = m_dir.filePath("export.exr");
         exportRender(local, assets, path.toStdString(), nullptr, nullptr, true);
         const ExrChannels e = readExr(path);
+        QVERIFY2(e.channels.size() == kExpectedChannels.size() + cryptomatteChannels().size(), qPrintable(channelList(e)));
         for (const std::string& name : kExpectedChannels) QVERIFY(e.channels.count(name) == 1);
+        for (const std::string& name : cryptomatteChannels()) QVERIFY2(e.channels.count(name) == 1, name.c_str());
         const RenderPasses want = renderPasses(renderQuad(local, false), RenderMode::Local, local.sky);
         for (size_t p = 0; p < want.depth.size(); ++p) QCOMPARE(e["Depth.Z"][p], want.depth[p]);
         const QString png = m_dir.filePath("export.png");
@@ -334,8 +347,9 @@ private Q_SLOTS:
         const test::Run r = runCli({"render", scene, "--passes", "-o", out, "--quiet"});
         QVERIFY2(r.code == 0, qPrintable(r.err));
         const ExrChannels e = readExr(out);
-        QVERIFY2(e.channels.size() == kExpectedChannels.size(), qPrintable(channelList(e)));
+        QVERIFY2(e.channels.size() == kExpectedChannels.size() + cryptomatteChannels().size(), qPrintable(channelList(e)));
         for (const std::string& name : kExpectedChannels) QVERIFY(e.channels.count(name) == 1);
+        for (const std::string& name : cryptomatteChannels()) QVERIFY2(e.channels.count(name) == 1, name.c_str());
         int withDirect = 0, withIndirect = 0;
         checkComposition(e, sc.sky, &withDirect, &withIndirect);
         QVERIFY(withDirect > 0);
