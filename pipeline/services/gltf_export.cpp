@@ -173,7 +173,9 @@ TextureBytes textureFor(const SpeciesAssets& a, size_t s, size_t m, bool encode)
     const bool mask = !cutout.empty() && hasCutout(cutout);
     if (diffuse.empty() && !mask) return t;
     const std::string ext = lowerExtension(mat.diffuseTexture);
-    if (!diffuse.empty() && mat.alphaTexture.empty() && !mat.diffuseTexture.empty() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) {
+    // The file itself when its own alpha is the cut-out (no opacity map, or the same file read alike).
+    const bool ownAlpha = mat.alphaTexture.empty() || (mat.alphaTexture == mat.diffuseTexture && cutout.pixels == diffuse.pixels);
+    if (!diffuse.empty() && ownAlpha && !mat.diffuseTexture.empty() && (ext == ".png" || ext == ".jpg" || ext == ".jpeg")) {
         t.key = "file:" + mat.diffuseTexture;
         t.mime = ext == ".png" ? "image/png" : "image/jpeg";
         t.estimate = double(fs::file_size(mat.diffuseTexture));

@@ -29,6 +29,7 @@
 #include "core/render/surfaces/landscape_trace.h"
 #include "core/render/surfaces/mesh_trace.h"
 #include "core/terrain/height_field.h"
+#include "pipeline/io/image_io.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/scene/scene_file.h"
 #include "pipeline/services/gltf_export.h"
@@ -246,6 +247,82 @@ private Q_SLOTS:
         QVERIFY(ground);
     }
 
+    // An imported tree with textures (Tree_1 of resources/trees, OBJ_textured): the bark's JPEG and the leaves' PNG
+    // (its alpha the cut-out) embedded as the files' own bytes; with an opacity map of another file, the colour and
+    // the opacity merged into one PNG (the opacity read at the nearest texel), MASK.
+    void importedTextures()
+    {
+        const QString trees = QStringLiteral(SYLVA_RESOURCES "/trees/quaternius");
+        Scene scene;
+        scene.species.resize(1);
+        scene.species[0].name = "Tree_1";
+        scene.species[0].meshPath = (trees + "/OBJ_textured/Tree_1.obj").toStdString();
+        scene.instances.resize(1);
+        std::vector<SpeciesAssets> assets = geometryOf(scene);
+        const QString path = m_dir.filePath("textured.glb");
+        exportGltf(scene, assets, path.toStdString());
+        Glb g = readGlb(path);
+        QVERIFY2(structureProblems(g).isEmpty(), qPrintable(structureProblems(g)));
+        auto imageOf = [&](const QString& materialSuffix, QString* mime, QString* alphaMode) {
+            for (const QJsonValue& mv : g.json["materials"].toArray()) {
+                const QJsonObject m = mv.toObject();
+                if (!m["name"].toString().endsWith(materialSuffix)) continue;
+                *alphaMode = m["alphaMode"].toString("OPAQUE");
+                const int tex = m["pbrMetallicRoughness"].toObject()["baseColorTexture"].toObject()["index"].toInt(-1);
+                if (tex < 0) return QByteArray();
+                const QJsonObject image = g.json["images"].toArray()[g.json["textures"].toArray()[tex].toObject()["source"].toInt()].toObject();
+                *mime = image["mimeType"].toString();
+                const QJsonObject view = g.json["bufferViews"].toArray()[image["bufferView"].toInt()].toObject();
+                return g.bin.mid(qsizetype(view["byteOffset"].toDouble()), qsizetype(view["byteLength"].toDouble()));
+            }
+            return QByteArray();
+        };
+        auto fileBytes = [](const QString& f) {
+            QFile in(f);
+            return in.open(QIODevice::ReadOnly) ? in.readAll() : QByteArray();
+        };
+        QString mime, mode;
+        QCOMPARE(imageOf("/Bark", &mime, &mode), fileBytes(trees + "/Textures/Tree_Bark.jpg"));
+        QCOMPARE(mime, QStringLiteral("image/jpeg"));
+        QCOMPARE(mode, QStringLiteral("OPAQUE"));
+        QCOMPARE(imageOf("/Tree_Leaves", &mime, &mode), fileBytes(trees + "/Textures/Tree_Leaves.png"));
+        QCOMPARE(mime, QStringLiteral("image/png"));
+        QCOMPARE(mode, QStringLiteral("MASK"));
+
+        // The leaves coloured by the bark's JPEG and cut out by the leaves' PNG: one PNG of the JPEG's size.
+        QByteArray obj = fileBytes(trees + "/OBJ_textured/Tree_1.obj");
+        obj.replace("mtllib Tree_1.mtl", "mtllib merged.mtl");
+        QFile objOut(m_dir.filePath("merged.obj")), mtlOut(m_dir.filePath("merged.mtl"));
+        QVERIFY(objOut.open(QIODevice::WriteOnly) && mtlOut.open(QIODevice::WriteOnly));
+        objOut.write(obj);
+        mtlOut.write(("newmtl Bark\nKd 1 1 1\nmap_Kd " + trees + "/Textures/Tree_Bark.jpg\n\nnewmtl Tree_Leaves\nKd 1 1 1\nmap_Kd " + trees +
+                      "/Textures/Tree_Bark.jpg\nmap_d " + trees + "/Textures/Tree_Leaves.png\n").toUtf8());
+        objOut.close();
+        mtlOut.close();
+        scene.species[0].meshPath = m_dir.filePath("merged.obj").toStdString();
+        assets = geometryOf(scene);
+        exportGltf(scene, assets, path.toStdString());
+        g = readGlb(path);
+        QVERIFY2(structureProblems(g).isEmpty(), qPrintable(structureProblems(g)));
+        QImage merged;
+        QVERIFY(merged.loadFromData(imageOf("/Tree_Leaves", &mime, &mode), "PNG"));
+        QCOMPARE(mime, QStringLiteral("image/png"));
+        QCOMPARE(mode, QStringLiteral("MASK"));
+        const ImageRgba bark = readImage((trees + "/Textures/Tree_Bark.jpg").toStdString());   // as the renderer decodes it
+        const QImage leaves(trees + "/Textures/Tree_Leaves.png");
+        QCOMPARE(merged.size(), QSize(bark.width, bark.height));
+        QVERIFY(merged.hasAlphaChannel());
+        int wrong = 0;
+        for (int y = 0; y < merged.height(); y += 7)
+            for (int x = 0; x < merged.width(); x += 7) {
+                const int lx = std::min(leaves.width() - 1, int((x + 0.5) * leaves.width() / merged.width()));
+                const int ly = std::min(leaves.height() - 1, int((y + 0.5) * leaves.height() / merged.height()));
+                wrong += std::abs(qAlpha(merged.pixel(x, y)) - qAlpha(leaves.pixel(lx, ly))) > 1 ||
+                         qRed(merged.pixel(x, y)) != int(std::lround(bark.at(x, y)[0] * 255.0f));
+            }
+        QCOMPARE(wrong, 0);
+    }
+
     // A landscape: the on-terrain instances lifted as the renderer lifts them, the tile plants of a region exactly
     // those the renderer grows there (count) and placed as its landPlantInstance places them (box corners within
     // 2 mm: the renderer's float maps 1 km from the origin), the terrain as a mesh of its samples.
@@ -400,7 +477,7 @@ private Q_SLOTS:
                  "  console.log('errors ' + r.issues.numErrors + ' warnings ' + r.issues.numWarnings);\n"
                  "  process.exit(r.issues.numErrors > 0 ? 1 : 0); });\n");
         js.close();
-        for (const char* name : {"forest.glb", "land.glb"}) {
+        for (const char* name : {"forest.glb", "land.glb", "textured.glb"}) {
             const QString file = m_dir.filePath(name);
             if (!QFile::exists(file)) QSKIP("the files of the tests above are missing (run the whole test)");
             Run r = runProgram(QStringLiteral("node"), {script, validatorModule, file}, QProcessEnvironment::systemEnvironment(), 120000);
