@@ -234,7 +234,10 @@ void ExportController::exportGltfDialog()
     if (path.isEmpty()) return;
     if (!path.endsWith(QLatin1String(".glb"), Qt::CaseInsensitive)) path += QStringLiteral(".glb");
     rememberFolder(QStringLiteral("gltf"), QFileInfo(path).absolutePath());
-    Job* job = exportGltf(path);
+    GltfExportOptions options;
+    options.instanceLimit = m_gltfInstanceLimit;
+    options.byteLimit = m_gltfByteLimit;
+    Job* job = exportGltf(path, options);
     if (!job) return;
     // Over the limit the job fails without writing; the user may then export anyway.
     connect(job, &Job::finished, this, [this, path](Job* done) {

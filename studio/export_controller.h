@@ -67,8 +67,10 @@ public:
     // options.force. Null (and an error) for a path that is no .glb. lastGltfPlan() holds the last count.
     Job* exportGltf(const QString& path, const GltfExportOptions& options = {});
     const GltfPlan& lastGltfPlan() const { return *m_lastGltfPlan; }
-    // A save dialog for the .glb, then exportGltf; over the limit, asks whether to export anyway.
+    // A save dialog for the .glb, then exportGltf with the dialog's limits; over them, asks whether to export anyway.
     void exportGltfDialog();
+    // The limits exportGltfDialog exports under (the export's defaults, kGltfInstanceLimit and kGltfByteLimit, unless set).
+    void setGltfLimits(size_t instances, double bytes) { m_gltfInstanceLimit = instances, m_gltfByteLimit = bytes; }
 
     // The Export Render dialog (starting from the last export's settings), then exportRender.
     void exportDialog();
@@ -84,6 +86,8 @@ private:
     QWidget* m_window;
     ExportSettings m_lastExport;
     std::shared_ptr<GltfPlan> m_lastGltfPlan = std::make_shared<GltfPlan>();
+    size_t m_gltfInstanceLimit = kGltfInstanceLimit;
+    double m_gltfByteLimit = kGltfByteLimit;
 };
 
 } // namespace sylva

@@ -3,7 +3,9 @@
 // placed by the file's TRANSLATION / ROTATION / SCALE equals the studio's instanceBounds of that box; the count and
 // the size logged; above the limit the job fails with them and writes nothing.
 #include <QAction>
+#include <QAbstractButton>
 #include <QFileDialog>
+#include <QLineEdit>
 #include <QSignalSpy>
 #include <QTimer>
 
@@ -12,6 +14,19 @@
 
 using namespace sylva;
 using namespace sylva::test;
+
+namespace {
+
+// Names `path` in a save dialog and accepts it (the name typed as well: selectFile alone can lose to the dialog's
+// own initial name while its folder loads).
+void answerSaveDialog(QFileDialog* d, const QString& path)
+{
+    d->selectFile(path);
+    if (auto* name = d->findChild<QLineEdit*>("fileNameEdit")) name->setText(QFileInfo(path).fileName());
+    static_cast<QDialog*>(d)->accept();   // QFileDialog::accept, reached through the public slot
+}
+
+} // namespace
 
 class TstStudioGltf : public QObject {
     Q_OBJECT
@@ -49,8 +64,7 @@ private Q_SLOTS:
             auto* d = qobject_cast<QFileDialog*>(QApplication::activeModalWidget());
             if (!d || answered) return;
             answered = true;
-            d->selectFile(path);
-            static_cast<QDialog*>(d)->accept();   // QFileDialog::accept, reached through the public slot
+            answerSaveDialog(d, path);
         });
         poll.start(50);
         action->trigger();
@@ -108,6 +122,36 @@ private Q_SLOTS:
         QVERIFY(w->exporter()->lastGltfPlan().overLimit());
         // Not a .glb: refused before any job.
         QVERIFY(!w->exporter()->exportGltf(m_dir.filePath("scene.gltf")));
+
+        // Through the menu above the limit (lowered to 2): the job refuses, the window asks with the count and the
+        // size, and Yes writes the file anyway.
+        errors.clear();
+        lines.clear();
+        w->exporter()->setGltfLimits(2, kGltfByteLimit);
+        const QString forced = m_dir.filePath("forced.glb");
+        QString question;
+        answered = false;
+        QTimer answer;
+        connect(&answer, &QTimer::timeout, this, [&] {
+            QWidget* modal = QApplication::activeModalWidget();
+            if (auto* d = qobject_cast<QFileDialog*>(modal); d && !answered) {
+                answered = true;
+                answerSaveDialog(d, forced);
+            } else if (auto* ask = qobject_cast<QMessageBox*>(modal)) {
+                question = ask->text();
+                ask->button(QMessageBox::Yes)->click();
+            }
+        });
+        answer.start(50);
+        action->trigger();
+        QVERIFY2(QTest::qWaitFor(exported, 60000), qPrintable(errors.join('\n')));
+        answer.stop();
+        QVERIFY2(question.contains(QLatin1String("3 instances")) && question.contains(QLatin1String("MB")), qPrintable(question));
+        QVERIFY2(errors.size() == 1 && errors[0].contains(QLatin1String("limit")), qPrintable(errors.join('\n')));   // the refusal, reported
+        QStringList logged;
+        for (const QList<QVariant>& l : lines) logged << l[0].toString();
+        QVERIFY2(QFile::exists(forced), qPrintable(logged.join('\n')));
+        QCOMPARE(w->exporter()->lastGltfPlan().instances, size_t(3));
     }
 };
 
