@@ -14,6 +14,7 @@
 
 #include "core/base/error.h"
 #include "core/base/version.h"
+#include "core/render/surfaces/terrain.h"
 #include "core/terrain/height_field.h"
 #include "core/terrain/landscape.h"
 #include "pipeline/io/atomic_file.h"
@@ -156,13 +157,6 @@ struct TextureBytes {
     double estimate = 0.0;     // bytes, before encoding
 };
 
-bool hasCutout(const ImageRgba& img)   // the renderer's test (an alpha mask only where some texel is clear)
-{
-    for (size_t p = 0; p < size_t(img.width) * size_t(img.height); ++p)
-        if (img.pixels[p * 4 + 3] < 0.5f) return true;
-    return false;
-}
-
 TextureBytes textureFor(const SpeciesAssets& a, size_t s, size_t m, bool encode)
 {
     TextureBytes t;
@@ -170,7 +164,7 @@ TextureBytes textureFor(const SpeciesAssets& a, size_t s, size_t m, bool encode)
     static const ImageRgba kNone;
     const ImageRgba& diffuse = m < a.diffuse.size() ? a.diffuse[m] : kNone;
     const ImageRgba& cutout = m < a.cutout.size() ? a.cutout[m] : kNone;
-    const bool mask = !cutout.empty() && hasCutout(cutout);
+    const bool mask = !cutout.empty() && hasClearTexels(cutout);
     if (diffuse.empty() && !mask) return t;
     const std::string ext = lowerExtension(mat.diffuseTexture);
     // The file itself when its own alpha is the cut-out (no opacity map, or the same file read alike).
@@ -293,9 +287,9 @@ int addSpeciesMesh(GlbBuilder& g, const SpeciesDesc& sp, const SpeciesAssets& a,
                         it = textures.emplace(tex.key, addTo(g, "textures", QJsonObject{{"source", image}, {"sampler", 0}})).first;
                     }
                     pbr.insert("baseColorTexture", QJsonObject{{"index", it->second}});
-                    if (m < a.cutout.size() && !a.cutout[m].empty() && hasCutout(a.cutout[m])) {
+                    if (m < a.cutout.size() && !a.cutout[m].empty() && hasClearTexels(a.cutout[m])) {
                         material.insert("alphaMode", "MASK");
-                        material.insert("alphaCutoff", 0.5);   // the renderer's cut-out threshold
+                        material.insert("alphaCutoff", double(kCutoutThreshold));   // the renderer's cut-out threshold
                     }
                 }
             }
@@ -353,8 +347,7 @@ int addTerrainMesh(GlbBuilder& g, const Scene& scene, const GltfExportOptions& o
             const glm::dvec3 ddz = at(a, std::min(b + 1, nz - 1)) - at(a, b > 0 ? b - 1 : 0);
             const glm::vec3 n = unitNormal(glm::vec3(glm::cross(ddz, ddx)));
             nrm[b * nx + a] = n;
-            const glm::vec3 c = float(p.y) > snowY ? t.snow : (n.y < rockCos ? t.rock : scene.ground.color);
-            col[b * nx + a] = glm::vec4(c, 1.0f);
+            col[b * nx + a] = glm::vec4(terrainAlbedo(float(p.y), n.y, snowY, rockCos, t.snow, t.rock, scene.ground.color), 1.0f);
         }
     std::vector<uint32_t> idx;
     idx.reserve((nx - 1) * (nz - 1) * 6);
