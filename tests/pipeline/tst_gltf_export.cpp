@@ -463,7 +463,7 @@ private Q_SLOTS:
         if (!QDir(validatorModule).exists() || !QFile::exists(transform)) {
             if (QStandardPaths::findExecutable("npm").isEmpty()) QSKIP("npm is not installed: it installs gltf-validator and @gltf-transform/cli");
             QDir().mkpath(prefix);
-            const Run r = runProgram(QStringLiteral("npm"), {"install", "--no-audit", "--no-fund", "--prefix", prefix, "gltf-validator", "@gltf-transform/cli"},
+            const Run r = runProgram(QStringLiteral("npm"), {"install", "--no-audit", "--no-fund", "--fetch-retries=1", "--fetch-timeout=20000", "--prefix", prefix, "gltf-validator", "@gltf-transform/cli"},
                                      QProcessEnvironment::systemEnvironment(), 300000);
             if (r.code != 0 || !QDir(validatorModule).exists() || !QFile::exists(transform))
                 QSKIP(qPrintable("npm could not install gltf-validator and @gltf-transform/cli (no registry?): " + r.err.right(300)));
