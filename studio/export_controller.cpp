@@ -6,12 +6,14 @@
 #include <QDir>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QMessageBox>
 
 #include "core/backend/backend.h"
 #include "core/base/error.h"
 #include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_job.h"
 #include "pipeline/services/exports.h"
+#include "pipeline/services/gltf_export.h"
 #include "studio/asset_store.h"
 #include "studio/job_manager.h"
 #include "studio/recent_files.h"
@@ -181,6 +183,72 @@ Job* ExportController::exportSpeciesGrids(int species, const QString& folder, Gr
                              else if (job->state() == Job::State::Failed) fail(tr("Export failed"), job->error());
                              else log(tr("grid export cancelled"));
                          });
+}
+
+Job* ExportController::exportGltf(const QString& path, const GltfExportOptions& options)
+{
+    if (!path.endsWith(QLatin1String(".glb"), Qt::CaseInsensitive)) {
+        fail(tr("Export failed"), tr("A glTF export is a .glb file: %1").arg(path));
+        return nullptr;
+    }
+    const Scene scene = m_doc->scene();
+    const std::string file = path.toStdString();
+    AssetStore* store = m_assets;
+    GridCache* cache = m_cache;
+    Backend* backend = m_backend;
+    auto plan = std::make_shared<GltfPlan>();
+    m_lastGltfPlan = plan;
+    log(tr("exporting the scene as glTF to %1").arg(QDir::toNativeSeparators(path)));
+    return m_jobs->start(tr("Export %1").arg(QFileInfo(path).fileName()),
+                         [scene, file, store, cache, backend, options, plan](Job& job, Progress& progress) {
+                             SubProgress assetsPart(&progress, 0.0, 0.5);
+                             Progress assetsProgress([&](double f, const std::string& m) { assetsPart.report(f, m); });
+                             const std::vector<AssetsPtr> shared = ensureAssets(
+                                 scene, false, *store, cache, &assetsProgress, [&job](const std::string& line) { job.log(QString::fromStdString(line)); },
+                                 backend);
+                             std::vector<SpeciesAssets> assets;
+                             for (const AssetsPtr& a : shared) assets.push_back(*a);
+                             *plan = planGltfExport(scene, assets, options);
+                             job.log(QString::fromStdString("glTF: " + plan->summary()));
+                             SubProgress writePart(&progress, 0.5, 1.0);
+                             Progress writeProgress([&](double f, const std::string& m) { writePart.report(f, m); });
+                             *plan = sylva::exportGltf(scene, assets, file, options, &writeProgress);   // refuses above the limit
+                         },
+                         [this, path, plan](Job* job) {
+                             if (job->state() == Job::State::Succeeded)
+                                 log(tr("exported %1: %2 (%3 bytes)")
+                                         .arg(QDir::toNativeSeparators(path), QString::fromStdString(std::to_string(plan->instances) + " instances"))
+                                         .arg(qint64(plan->estimatedBytes)));
+                             else if (job->state() == Job::State::Failed) fail(tr("Export failed"), job->error());
+                             else log(tr("glTF export cancelled"));
+                         });
+}
+
+void ExportController::exportGltfDialog()
+{
+    const QString start = !lastFolder(QStringLiteral("gltf")).isEmpty() ? lastFolder(QStringLiteral("gltf"))
+                          : m_doc->filePath().isEmpty()                  ? QString()
+                                                                         : QFileInfo(m_doc->filePath()).absolutePath();
+    QString path = QFileDialog::getSaveFileName(m_window, tr("Export Scene as glTF"), start + QStringLiteral("/scene.glb"),
+                                                tr("Binary glTF (*.glb)"));
+    if (path.isEmpty()) return;
+    if (!path.endsWith(QLatin1String(".glb"), Qt::CaseInsensitive)) path += QStringLiteral(".glb");
+    rememberFolder(QStringLiteral("gltf"), QFileInfo(path).absolutePath());
+    GltfExportOptions options;
+    options.instanceLimit = m_gltfInstanceLimit;
+    options.byteLimit = m_gltfByteLimit;
+    Job* job = exportGltf(path, options);
+    if (!job) return;
+    // Over the limit the job fails without writing; the user may then export anyway.
+    connect(job, &Job::finished, this, [this, path](Job* done) {
+        if (done->state() != Job::State::Failed || !m_lastGltfPlan->overLimit()) return;
+        const auto answer = QMessageBox::question(m_window, tr("Export Scene as glTF"),
+                                                  tr("The export holds %1.\nWrite it anyway?").arg(QString::fromStdString(m_lastGltfPlan->summary())));
+        if (answer != QMessageBox::Yes) return;
+        GltfExportOptions forced;
+        forced.force = true;
+        exportGltf(path, forced);
+    });
 }
 
 void ExportController::exportDialog()

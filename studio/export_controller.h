@@ -1,9 +1,11 @@
 // Exports: File > Export Render (a picture of the scene, the pipeline's exportRender) and File > Export
 // Species Grids (a species' density and lighting grids as .npy with sidecars, or as one OpenVDB file:
-// exportSpeciesGrids), each a background job on the studio's backend, with their dialogs.
+// exportSpeciesGrids), each a background job on the studio's backend, with their dialogs; File > Export Scene
+// as glTF (the scene's meshes, materials and instances as one .glb: exportGltf).
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include <QString>
@@ -11,6 +13,7 @@
 #include "core/render/render_cpu.h"
 
 #include "pipeline/io/grid_file.h"
+#include "pipeline/services/gltf_export.h"
 #include "studio/dialogs.h"
 #include "studio/studio_controller.h"
 
@@ -57,6 +60,18 @@ public:
     // (the pipeline's gridFileBase).
     static QString gridFileBase(const QString& speciesName);
 
+    // Writes the scene as binary glTF (pipeline/services/gltf_export.h) into path (.glb): the species' meshes
+    // (from the store, or grown / imported), their materials and instances, the ground or the terrain. The job
+    // first logs the count and the estimated size ("glTF: N instances ..., about X MB"); above the export's limit
+    // (kGltfInstanceLimit instances or kGltfByteLimit bytes) it fails with that message and writes nothing, unless
+    // options.force. Null (and an error) for a path that is no .glb. lastGltfPlan() holds the last count.
+    Job* exportGltf(const QString& path, const GltfExportOptions& options = {});
+    const GltfPlan& lastGltfPlan() const { return *m_lastGltfPlan; }
+    // A save dialog for the .glb, then exportGltf with the dialog's limits; over them, asks whether to export anyway.
+    void exportGltfDialog();
+    // The limits exportGltfDialog exports under (the export's defaults, kGltfInstanceLimit and kGltfByteLimit, unless set).
+    void setGltfLimits(size_t instances, double bytes) { m_gltfInstanceLimit = instances, m_gltfByteLimit = bytes; }
+
     // The Export Render dialog (starting from the last export's settings), then exportRender.
     void exportDialog();
     // A folder dialog for the species' grids (an error without a species), then exportSpeciesGrids.
@@ -70,6 +85,9 @@ private:
     Backend* m_backend;
     QWidget* m_window;
     ExportSettings m_lastExport;
+    std::shared_ptr<GltfPlan> m_lastGltfPlan = std::make_shared<GltfPlan>();
+    size_t m_gltfInstanceLimit = kGltfInstanceLimit;
+    double m_gltfByteLimit = kGltfByteLimit;
 };
 
 } // namespace sylva

@@ -383,6 +383,7 @@ void MainWindow::buildActions()
     add(file, tr("Export Species &Grids..."), "actionExportGrids", QKeySequence(), [this] { m_export->exportGridsDialog(selectedSpecies()); });
     add(file, tr("Export Species Grids as &OpenVDB..."), "actionExportGridsVdb", QKeySequence(),
         [this] { m_export->exportGridsDialog(selectedSpecies(), GridFileFormat::Vdb); });
+    add(file, tr("Export Scene as g&lTF..."), "actionExportGltf", QKeySequence(), [this] { m_export->exportGltfDialog(); });
     file->addSeparator();
     add(file, tr("&Quit"), "actionQuit", QKeySequence::Quit, [this] { close(); });
 

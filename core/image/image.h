@@ -26,4 +26,14 @@ struct ImageRgba {
     const float* at(int x, int y) const { return &pixels[(size_t(y) * size_t(width) + size_t(x)) * 4]; }
 };
 
+// Cut-outs: a texel whose alpha (coverage) is below kCutoutThreshold lets rays through (the renderer's 1-bit alpha
+// masks); a cut-out image with no such texel is opaque and gets no mask. The glTF export's alphaCutoff.
+inline constexpr float kCutoutThreshold = 0.5f;
+inline bool hasClearTexels(const ImageRgba& img)
+{
+    for (size_t p = 0; p < size_t(img.width) * size_t(img.height); ++p)
+        if (img.pixels[p * 4 + 3] < kCutoutThreshold) return true;
+    return false;
+}
+
 } // namespace sylva

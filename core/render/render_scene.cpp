@@ -142,12 +142,7 @@ RenderView RenderScene::view() const
     return v;
 }
 
-namespace {
-
-// `scene` with its on-terrain instances standing on the terrain (world y = the surface's height at their
-// x, z + their y): `storage` holds that copy, or `scene` itself is returned when no instance stands on
-// the terrain. Throws Error naming an on-terrain instance without a terrain or off its footprint.
-const Scene& onTerrain(const Scene& scene, Scene& storage)
+const Scene& sceneOnTerrain(const Scene& scene, Scene& storage)
 {
     bool any = false;
     for (const InstanceDesc& d : scene.instances) any = any || d.onTerrain;
@@ -167,8 +162,6 @@ const Scene& onTerrain(const Scene& scene, Scene& storage)
     }
     return storage;
 }
-
-} // namespace
 
 void placeLights(RenderScene& rs, const FrameSun& sun)
 {
@@ -319,7 +312,7 @@ std::vector<uint32_t> checkSceneInput(const Scene& scene, const std::vector<Spec
 RenderScene buildSceneGeometry(const Scene& sceneIn, const std::vector<SpeciesAssets>& assets, LodLevels lod, Progress* progress)
 {
     Scene lifted;
-    const Scene& scene = onTerrain(sceneIn, lifted);
+    const Scene& scene = sceneOnTerrain(sceneIn, lifted);
     const std::vector<uint32_t> groupOrder = checkSceneInput(scene, assets);
     RenderScene rs;
     rs.accel = scene.render.accel;
@@ -349,7 +342,7 @@ bool hasLevelsFor(const RenderScene& rs, const Scene& sceneIn)
 {
     if (!(sceneIn.render.pruneDistance > 0.0)) return true;
     Scene lifted;
-    const Scene& scene = onTerrain(sceneIn, lifted);
+    const Scene& scene = sceneOnTerrain(sceneIn, lifted);
     if (rs.meshLevels.size() != scene.species.size()) return false;
     for (const RenderScene::MeshLevels& m : rs.meshLevels)
         if (m.levels == 0) return false;   // built without pruning: the levels were never made
@@ -364,7 +357,7 @@ bool hasLevelsFor(const RenderScene& rs, const Scene& sceneIn)
 void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRadiance, int width, int height, int spp)
 {
     Scene lifted;
-    const Scene& scene = onTerrain(sceneIn, lifted);
+    const Scene& scene = sceneOnTerrain(sceneIn, lifted);
     const size_t ni = scene.instances.size();
     if (scene.terrain.enabled() != !rs.terrainHeights.empty())
         throw Error("render: the scene's terrain differs from the one the frame was built with");

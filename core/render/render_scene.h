@@ -201,6 +201,12 @@ glm::dmat3 rotationDeg(const glm::vec3& deg);
 
 CameraRecord makeCamera(const CameraDesc& camera, int width, int height);
 
+// `scene` with its on-terrain instances (InstanceDesc::onTerrain, the scene's own instances) standing on the
+// terrain, world y = the surface's height at their x, z + their y, as every frame places them: `storage` holds
+// that copy, or `scene` itself is returned when no instance stands on the terrain. Throws Error naming an
+// on-terrain instance without a terrain or off its footprint.
+const Scene& sceneOnTerrain(const Scene& scene, Scene& storage);
+
 // The instance's parent -> geometry map in the frame whose origin is `frameOrigin` (parent-frame metres).
 // geometry = the species (placeTopLevel picks a pruned level or the group's record).
 InstanceRecord makeInstance(const InstanceDesc& inst, const glm::dvec3& frameOrigin);

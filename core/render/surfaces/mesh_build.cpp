@@ -20,15 +20,12 @@ namespace {
 
 void addCutout(const ImageRgba& img, RenderScene& rs, MaterialRecord& m)
 {
-    if (img.empty()) return;
-    bool anyClear = false;
-    for (size_t p = 0; p < size_t(img.width) * size_t(img.height) && !anyClear; ++p) anyClear = img.pixels[p * 4 + 3] < 0.5f;
-    if (!anyClear) return;
+    if (img.empty() || !hasClearTexels(img)) return;
     AlphaMaskRecord rec{img.width, img.height, uint32_t(rs.alphaBits.size()), 0};
     const size_t bits = size_t(img.width) * size_t(img.height);
     rs.alphaBits.resize(rs.alphaBits.size() + (bits + 31) / 32, 0u);
     for (size_t b = 0; b < bits; ++b)
-        if (img.pixels[b * 4 + 3] >= 0.5f) rs.alphaBits[rec.offset + b / 32] |= 1u << (b % 32);
+        if (img.pixels[b * 4 + 3] >= kCutoutThreshold) rs.alphaBits[rec.offset + b / 32] |= 1u << (b % 32);
     m.alphaMask = int32_t(rs.alphaMasks.size());
     rs.alphaMasks.push_back(rec);
 }

@@ -21,4 +21,13 @@ struct TerrainRecord {
     int32_t baseI, baseJ;        // field is traced relative to it (precise near the camera anywhere)
 };
 
+// The terrain's colour rule: at terrain-frame height y on a surface whose unit normal has y component ny, snow above
+// snowY, rock where ny < rockCos (steeper than the rock slope), else the ground's colour. The shader's (shadeTerrain)
+// and the glTF export's vertex colours.
+SYLVA_HD SYLVA_INLINE glm::vec3 terrainAlbedo(float y, float ny, float snowY, float rockCos, const glm::vec3& snow, const glm::vec3& rock,
+                                              const glm::vec3& ground)
+{
+    return y > snowY ? snow : (ny < rockCos ? rock : ground);
+}
+
 } // namespace sylva

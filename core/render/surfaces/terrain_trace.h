@@ -40,7 +40,7 @@ SYLVA_HD inline void shadeTerrain(const RenderView& v, const Ray&, const Hit& hi
     const glm::vec3 n = heightFieldNormal(HeightFieldView{tr.layout, v.terrainHeights, v.terrainRanges}, hit.prim);
     s.ng = glm::dot(n, s.viewDir) < 0.0f ? -n : n;
     const float y = (s.p - tr.origin).y;
-    s.albedo = y > tr.snowY ? tr.snow : (n.y < tr.rockCos ? tr.rock : v.ground.color);
+    s.albedo = terrainAlbedo(y, n.y, tr.snowY, tr.rockCos, tr.snow, tr.rock, v.ground.color);
     // The hit was computed in the height field's rebased frame, whose heights keep their magnitude.
     const glm::vec3 lp = s.p - tr.base;
     s.extent = fmaxf(fmaxf(fabsf(lp.x), fabsf(lp.y)), fabsf(lp.z));
