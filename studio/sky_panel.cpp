@@ -1,6 +1,7 @@
 // SkyPanel: the sky block and the sun of the scene as controls; each change one SceneDocument edit.
 #include "studio/sky_panel.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <QCheckBox>
@@ -124,12 +125,16 @@ SkyPanel::SkyPanel(SceneDocument* doc, QWidget* parent) : QWidget(parent), m_doc
     QFormLayout* lightForm = form(m_lightRows);
     m_lights = sceneIntSpin("sky.lights", "sky.lights");
     connect(m_lights, &QSpinBox::valueChanged, this, [this](int v) {
-        apply(m_lights, tr("Change sky lights"), [&](Scene& s) { s.skyModel.lights = v; });
+        apply(m_lights, tr("Change sky lights"), [&](Scene& s) {
+            s.skyModel.lights = v;
+            // The groups split the lights: no more groups than lights (what the scene file requires).
+            s.skyModel.interleave = std::min(s.skyModel.interleave, v);
+        });
     });
     lightForm->addRow(tr("Sky samples"), m_lights);
     m_interleave = sceneIntSpin("sky.interleave", "sky.interleave");
     connect(m_interleave, &QSpinBox::valueChanged, this, [this](int v) {
-        apply(m_interleave, tr("Change sky interleave"), [&](Scene& s) { s.skyModel.interleave = v; });
+        apply(m_interleave, tr("Change sky interleave"), [&](Scene& s) { s.skyModel.interleave = std::min(v, s.skyModel.lights); });
     });
     lightForm->addRow(tr("Sky sample groups"), m_interleave);
     skyForm->addRow(m_lightRows);
@@ -336,6 +341,7 @@ void SkyPanel::refresh()
         m_aerial->setChecked(d.aerialPerspective);
         m_kind->setCurrentIndex(m_kind->findData(int(d.kind)));
         m_lights->setValue(d.lights);
+        m_interleave->setMaximum(std::max(1, d.lights));   // at most one group a light
         m_interleave->setValue(d.interleave);
         m_sunMode->setCurrentIndex(s.sun.place ? 1 : 0);
         double el = 0.0, az = 0.0;
