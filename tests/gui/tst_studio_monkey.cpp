@@ -42,6 +42,8 @@
 #include <memory>
 #include <random>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include <unistd.h>
 
@@ -62,7 +64,7 @@ namespace {
 
 // The seeds CI runs (deterministic); the regression seeds of bugs the monkey found come first.
 const QList<quint64> kSeeds = {20261207, 4242};
-const QList<quint64> kKillSeeds = {77, 1009};
+const QList<quint64> kKillSeeds = {13, 77, 1009};
 constexpr int kActions = 1000;       // a seed (SYLVA_MONKEY_ACTIONS)
 constexpr int kKillActions = 240;    // the child's actions before its kill (at most)
 constexpr int kCheckEvery = 250;     // actions between the undo-to-the-start checks
@@ -140,6 +142,10 @@ public:
         });
         m_sinceStep.start();
         m_watchdog.start();
+        // Every save: the file is read back after the action and must hold the scene saved.
+        QObject::connect(&m_w, &MainWindow::logLineAdded, &m_modal, [this](const QString& line) {
+            if (line.startsWith(QLatin1String("saved "))) m_saved.emplace_back(doc()->filePath(), json(doc()->scene()));
+        });
         m_modal.setInterval(5);
         QObject::connect(&m_modal, &QTimer::timeout, [this] { handleModal(); });
         m_modal.start();
@@ -188,7 +194,7 @@ public:
         static const Choice choices[] = {
             {10, &Monkey::undo},          {6, &Monkey::redo},          {8, &Monkey::clickOutliner}, {16, &Monkey::editPanel},
             {5, &Monkey::clickViewport},  {5, &Monkey::dragViewport},  {3, &Monkey::wheelViewport}, {3, &Monkey::keyViewport},
-            {14, &Monkey::menuAction},    {2, &Monkey::saveKey},       {1, &Monkey::closeTools},
+            {14, &Monkey::menuAction},    {2, &Monkey::saveKey},       {1, &Monkey::closeTools},    {1, &Monkey::quit},
         };
         int total = 0;
         for (const Choice& c : choices) total += c.weight;
@@ -205,6 +211,15 @@ public:
         QCoreApplication::processEvents();
         if (m_sinceStep.elapsed() > 300) note(QStringLiteral("  (%1 ms)").arg(m_sinceStep.elapsed()));
         if (doc()->undoStack()->count() == 0) m_base = json(doc()->scene());   // New, Open, the example: a new start
+        for (const auto& [path, saved] : std::exchange(m_saved, {})) {
+            std::string read;
+            try {
+                read = json(readSceneFile(path.toStdString()));
+            } catch (const std::exception& e) {
+                return QStringLiteral("the scene saved to %1 cannot be read back: %2").arg(path, QString::fromUtf8(e.what()));
+            }
+            if (read != saved) return QStringLiteral("the scene saved to %1 reads back as another scene").arg(path);
+        }
         const QStringList w = takeWarnings();
         if (!w.isEmpty()) return QStringLiteral("Qt warned: ") + w.join(QStringLiteral("\n  "));
         return {};
@@ -214,6 +229,11 @@ public:
     // to where it was: the scene before. Empty when both hold.
     QString checkUndo()
     {
+        m_w.jobs()->cancelAll();   // a job that ends during the check would push an edit between its steps
+        if (!QTest::qWaitFor([&] { return !m_w.jobs()->isBusy(); }, 60000)) return QStringLiteral("a cancelled job did not end within 60 s");
+        m_carry = 0;
+        QCoreApplication::processEvents();
+        if (doc()->undoStack()->count() == 0) m_base = json(doc()->scene());
         QUndoStack* stack = doc()->undoStack();
         const std::string now = json(doc()->scene());
         const int index = stack->index();
@@ -303,8 +323,10 @@ private:
     std::vector<QWidget*> editors() const
     {
         std::vector<QWidget*> out;
+        // The main window's and those of the tool windows it opened (the render window, the help).
         for (QWidget* w : m_w.findChildren<QWidget*>()) {
-            if (!w->isVisible() || !w->isEnabled() || w->window() != &m_w) continue;
+            if (w->window() != &m_w && (w->window()->parentWidget() != &m_w || w->window()->isModal())) continue;
+            if (!w->isVisible() || !w->isEnabled()) continue;
             if (qobject_cast<QAbstractSpinBox*>(w) || qobject_cast<QComboBox*>(w) || qobject_cast<QCheckBox*>(w) ||
                 qobject_cast<QSlider*>(w) || qobject_cast<QDial*>(w) || qobject_cast<QPushButton*>(w) ||
                 (qobject_cast<QLineEdit*>(w) && !qobject_cast<QAbstractSpinBox*>(w->parentWidget()) && !qobject_cast<QComboBox*>(w->parentWidget()) &&
@@ -556,6 +578,17 @@ private:
         m_w.findChild<QAction*>("actionSave")->trigger();
     }
 
+    // File > Quit: the unsaved-changes question may cancel it; a closed window is opened again (as the next start would).
+    void quit()
+    {
+        note(QStringLiteral("menu: Quit"));
+        m_w.findChild<QAction*>("actionQuit")->trigger();
+        if (m_w.isVisible()) return;
+        note(QStringLiteral("  closed: shown again"));
+        m_w.show();
+        (void)QTest::qWaitForWindowExposed(&m_w);
+    }
+
     // Closes the tool windows (render window, manual, shortcut sheet) a user left open.
     void closeTools()
     {
@@ -571,10 +604,20 @@ private:
     QString settleJobs()
     {
         JobManager* jobs = m_w.jobs();
-        if (!jobs->isBusy()) return {};
+        if (!jobs->isBusy()) {
+            m_carry = 0;
+            return {};
+        }
         const QList<Job*> running = jobs->running();
         QStringList names;
         for (Job* j : running) names << j->title();
+        // Now and then the next few actions come while the jobs run (what a user does while the lighting runs).
+        if (m_carry > 0 || chance(0.2)) {
+            if (m_carry == 0) m_carry = 1 + below(3);
+            --m_carry;
+            note(QStringLiteral("  jobs: %1 (left running)").arg(names.join(", ")));
+            return {};
+        }
         const bool letRun = chance(0.15);
         note(QStringLiteral("  jobs: %1 (%2)").arg(names.join(", "), letRun ? "let run up to 1 s" : "cancel half-way"));
         if (letRun) {
@@ -732,6 +775,8 @@ private:
     QFile m_log;
     std::deque<QString> m_recent;
     int m_count = 0;
+    int m_carry = 0;
+    std::vector<std::pair<QString, std::string>> m_saved;   // files saved during the action, with the scene saved   // actions still to come while the jobs run
     std::string m_base;
     QTimer m_modal;
     QTimer m_watchdog;
@@ -871,6 +916,8 @@ private Q_SLOTS:
                                                                                       .arg(run.code)
                                                                                       .arg(run.out.right(6000), run.err.right(3000))));
         QVERIFY2(run.out.contains("monkey child: kill"), qPrintable(run.out.right(6000)));
+        for (const QString& line : run.out.split('\n'))
+            if (line.startsWith("monkey child: kill")) qInfo("%s", qPrintable(line));
         const QString rec = AutosaveController::recoveryFilePath();
         QFile f(want);
         const bool autosaved = f.open(QIODevice::ReadOnly);
