@@ -14,6 +14,7 @@
 #include <QSpinBox>
 #include <QVBoxLayout>
 
+#include "pipeline/scene/scene_fields.h"
 #include "pipeline/services/exports.h"
 #include "studio/export_controller.h"
 #include "studio/job_manager.h"
@@ -40,7 +41,8 @@ RenderWindow::RenderWindow(SceneDocument* doc, ExportController* exporter, QWidg
     };
     m_width = spin("renderWidth", 1, 16384, tr("Width of the rendered picture in pixels (saved with the scene)"));
     m_height = spin("renderHeight", 1, 16384, tr("Height of the rendered picture in pixels (saved with the scene)"));
-    m_spp = spin("renderSamples", 1, 65536,
+    // The scene file's range (render.spp): the samples are saved with the scene, and the reader refuses more.
+    m_spp = spin("renderSamples", 1, int(sceneFieldRange("render.spp").hi),
                  tr("Samples per pixel: more is smoother and slower (saved with the scene; the picture refines as they add up)"));
     auto* size = new QHBoxLayout;
     size->addWidget(m_width);
