@@ -30,6 +30,17 @@ namespace sylva {
 using namespace widgets;
 namespace {
 
+// The scene file's rule for a camera (camera.target, camera.up): the target away from the eye, the view not along up.
+bool usableCamera(const CameraDesc& c)
+{
+    const glm::dvec3 view = c.target - c.position;
+    const double length = glm::length(view);
+    const glm::dvec3 up(c.up);
+    const double upLength = glm::length(up);
+    if (!(length > 0.0) || !std::isfinite(length) || !(upLength >= 1e-12)) return false;
+    return glm::length(glm::cross(view / length, up / upLength)) >= 1e-6;
+}
+
 const char* kAxis[3] = {"x", "y", "z"};
 
 
@@ -208,12 +219,22 @@ QWidget* PropertyPanel::buildCameraPage()
     for (int a = 0; a < 3; ++a) {
         m_camPos[size_t(a)] = spin(QStringLiteral("camera.position.%1").arg(kAxis[a]), -1e7, 1e7, 3, 0.5);
         m_camTarget[size_t(a)] = spin(QStringLiteral("camera.target.%1").arg(kAxis[a]), -1e7, 1e7, 3, 0.5);
-        connect(m_camPos[size_t(a)], &QDoubleSpinBox::valueChanged, this, [this, a](double v) {
-            apply(m_camPos[size_t(a)], tr("Move camera"), [&](Scene& s) { s.camera.position[a] = v; });
-        });
-        connect(m_camTarget[size_t(a)], &QDoubleSpinBox::valueChanged, this, [this, a](double v) {
-            apply(m_camTarget[size_t(a)], tr("Aim camera"), [&](Scene& s) { s.camera.target[a] = v; });
-        });
+        // A camera the scene file refuses (the eye on its target, the view straight along up) is not applied: the
+        // box shows the scene's value again.
+        auto moveCamera = [this, a](QDoubleSpinBox* box, const QString& text, bool target, double v) {
+            const CameraDesc& now = m_doc->scene().camera;
+            CameraDesc c = now;
+            (target ? c.target : c.position)[a] = v;
+            if (!usableCamera(c)) {
+                setValue(box, (target ? now.target : now.position)[a]);
+                return;
+            }
+            apply(box, text, [&](Scene& s) { s.camera = c; });
+        };
+        connect(m_camPos[size_t(a)], &QDoubleSpinBox::valueChanged, this,
+                [this, a, moveCamera](double v) { moveCamera(m_camPos[size_t(a)], tr("Move camera"), false, v); });
+        connect(m_camTarget[size_t(a)], &QDoubleSpinBox::valueChanged, this,
+                [this, a, moveCamera](double v) { moveCamera(m_camTarget[size_t(a)], tr("Aim camera"), true, v); });
     }
     m_camFov = sceneSpin("camera.fov", "camera.fov", 1, 1.0);
     connect(m_camFov, &QDoubleSpinBox::valueChanged, this, [this](double v) {
