@@ -25,6 +25,16 @@ glm::dvec3 turned(const glm::dvec3& v, double yawDeg, double pitchDeg)
 
 } // namespace
 
+bool cameraUsable(const CameraDesc& camera)
+{
+    const glm::dvec3 view = camera.target - camera.position;
+    const double length = glm::length(view);
+    const glm::dvec3 up(camera.up);
+    const double upLength = glm::length(up);
+    if (!(length > 0.0) || !std::isfinite(length) || !(upLength >= 1e-12)) return false;
+    return glm::length(glm::cross(view / length, up / upLength)) >= 1e-6;
+}
+
 CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg)
 {
     CameraDesc c = camera;

@@ -8,6 +8,10 @@
 
 namespace sylva {
 
+// Whether the scene file accepts the camera (camera.target, camera.up): the target away from the eye, a finite view
+// direction, not along a non-zero up. A navigation or an edit that gives any other camera is not applied.
+bool cameraUsable(const CameraDesc& camera);
+
 // Rotates the eye about the target: yaw about world +Y, pitch about the camera's right axis (degrees),
 // pitch kept within 1 degree of the poles. The target stays put.
 CameraDesc orbitCamera(const CameraDesc& camera, double yawDeg, double pitchDeg);

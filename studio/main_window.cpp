@@ -34,6 +34,7 @@
 #include "pipeline/io/env_map_io.h"
 #include "pipeline/render/render_job.h"
 #include "studio/autosave_controller.h"
+#include "studio/camera_nav.h"
 #include "studio/background_priority.h"
 #include "studio/export_controller.h"
 #include "studio/help_dialogs.h"
@@ -138,7 +139,11 @@ MainWindow::MainWindow(QWidget* parent)
     });
     connect(m_compareToggle, &QCheckBox::toggled, this, [this] { updateCompare(); });
     connect(m_compareBox, &QComboBox::currentIndexChanged, this, [this] { updateCompare(); });
-    connect(m_viewport, &Viewport::navigated, m_doc, &SceneDocument::navigate);
+    // A zoom or pan far enough leaves no distance between the eye and the target in double (1e20 m out): a camera
+    // the scene file refuses is not applied.
+    connect(m_viewport, &Viewport::navigated, m_doc, [this](const CameraDesc& camera) {
+        if (cameraUsable(camera)) m_doc->navigate(camera);
+    });
     connect(m_viewport, &Viewport::instanceEdited, this, [this](int instance, const InstanceDesc& placed, const QString& text, int key) {
         Scene s = m_doc->scene();
         if (instance < 0 || size_t(instance) >= s.instances.size()) return;

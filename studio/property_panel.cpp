@@ -30,17 +30,6 @@ namespace sylva {
 using namespace widgets;
 namespace {
 
-// The scene file's rule for a camera (camera.target, camera.up): the target away from the eye, the view not along up.
-bool usableCamera(const CameraDesc& c)
-{
-    const glm::dvec3 view = c.target - c.position;
-    const double length = glm::length(view);
-    const glm::dvec3 up(c.up);
-    const double upLength = glm::length(up);
-    if (!(length > 0.0) || !std::isfinite(length) || !(upLength >= 1e-12)) return false;
-    return glm::length(glm::cross(view / length, up / upLength)) >= 1e-6;
-}
-
 const char* kAxis[3] = {"x", "y", "z"};
 
 
@@ -225,7 +214,7 @@ QWidget* PropertyPanel::buildCameraPage()
             const CameraDesc& now = m_doc->scene().camera;
             CameraDesc c = now;
             (target ? c.target : c.position)[a] = v;
-            if (!usableCamera(c)) {
+            if (!cameraUsable(c)) {
                 setValue(box, (target ? now.target : now.position)[a]);
                 return;
             }
