@@ -2,9 +2,9 @@
 // with random and extreme values and accepted or cancelled, the outliner, the property and sky panels, the
 // toolbar, clicks, drags, the wheel and keys in the viewport, undo and redo, save and open in a temporary
 // folder, lighting, render and export jobs cancelled half-way), driven through Qt's event API under Xvfb.
-// It asserts that the studio survives without a warning that means a bug, that undoing to the start gives
-// the starting scene back (sceneToJson), and that a kill at a random point followed by a new window
-// recovers the last autosave.
+// It asserts that the studio survives without a warning that means a bug, that every scene it saves reads
+// back as the scene saved, that undoing to the start gives the starting scene back (sceneToJson), and that a
+// kill at a random point followed by a new window recovers the last autosave.
 //
 // SYLVA_MONKEY_SEED=<n>[,<n>...] runs those seeds instead of the fixed list, SYLVA_MONKEY_ACTIONS=<n> that
 // many actions a seed. Every action goes to test-output/monkey/seed-<n>.log (flushed, so a crash leaves it);
@@ -16,7 +16,6 @@
 #include <QComboBox>
 #include <QDial>
 #include <QDialogButtonBox>
-#include <QDockWidget>
 #include <QDoubleSpinBox>
 #include <QFile>
 #include <QFileDialog>
@@ -349,7 +348,7 @@ private:
         static const std::map<QString, double> caps = {
             {"species.grid", 24},  {"viewportSamples", 8}, {"sky.lights", 64},    {"cloud.resolution", 20},
             {"smoke.cells.x", 12}, {"smoke.cells.y", 12},  {"smoke.cells.z", 12}, {"smoke.steps", 50},
-            {"tiles.size", 64},    {"sky.interleave", 8},
+            {"tiles.size", 64},    {"sky.interleave", 8},   {"renderWidth", 320},   {"renderHeight", 320},
         };
         const auto it = caps.find(name);
         return it == caps.end() ? hi : std::min(hi, it->second);
@@ -399,6 +398,11 @@ private:
                                          QStringLiteral("abc")};
                 QString text = texts[below(chance(0.8) ? 2 : 5)];
                 if (text == "1e308" && hi < 1e308) text = QString::number(hi);
+                // Sizes that take memory: the number itself (a typed "12.5" is 125 in an integer box). Two renders of
+                // 16384 x 16384 at once take more than 23 GB.
+                static const std::set<QString> memory = {"renderWidth", "renderHeight", "species.grid", "cloud.resolution",
+                                                         "smoke.cells.x", "smoke.cells.y", "smoke.cells.z", "tiles.size"};
+                if (memory.count(name)) text = QString::number(std::llround(v));
                 note(QStringLiteral("%1: %2 typed \"%3\" + Enter").arg(where, name, text));
                 QTest::keyClick(spin, Qt::Key_A, Qt::ControlModifier);
                 typeText(spin, text);
