@@ -503,9 +503,12 @@ private:
         Viewport* v = m_w.viewport();
         QPoint p = viewportPoint();
         const Qt::MouseButton b = chance(0.75) ? Qt::LeftButton : Qt::MiddleButton;
-        const Qt::KeyboardModifiers mods = chance(0.3) ? Qt::ShiftModifier : Qt::NoModifier;
+        // Shift pans, Ctrl slides the tree under the cursor over the ground.
+        const int m = below(10);
+        const Qt::KeyboardModifiers mods = m < 3 ? Qt::ShiftModifier : m < 5 ? Qt::ControlModifier : Qt::NoModifier;
         const int moves = 1 + below(6);
-        note(QStringLiteral("viewport: drag button %1 from %2,%3, %4 moves%5").arg(int(b)).arg(p.x()).arg(p.y()).arg(moves).arg(mods ? " +Shift" : ""));
+        note(QStringLiteral("viewport: drag button %1 from %2,%3, %4 moves%5")
+                 .arg(int(b)).arg(p.x()).arg(p.y()).arg(moves).arg(m < 3 ? " +Shift" : m < 5 ? " +Ctrl" : ""));
         QTest::mousePress(v, b, mods, p);
         for (int i = 0; i < moves; ++i) {
             // Mostly small steps; now and then far outside the widget.
@@ -520,10 +523,13 @@ private:
         const QPoint p = viewportPoint();
         const int deltas[] = {120, -120, 360, -720, 1, 12000, -12000};
         const int n = 1 + below(3);
+        // Plain: zoom; Ctrl: turn the selected tree; Ctrl + Shift: scale it.
+        const int m = below(10);
+        const Qt::KeyboardModifiers mods = m < 2 ? Qt::ControlModifier : m < 3 ? (Qt::ControlModifier | Qt::ShiftModifier) : Qt::NoModifier;
         for (int i = 0; i < n; ++i) {
             const int d = deltas[below(7)];
-            note(QStringLiteral("viewport: wheel %1 at %2,%3").arg(d).arg(p.x()).arg(p.y()));
-            QWheelEvent e(QPointF(p), m_w.viewport()->mapToGlobal(QPointF(p)), QPoint(), QPoint(0, d), Qt::NoButton, Qt::NoModifier,
+            note(QStringLiteral("viewport: wheel %1 at %2,%3%4").arg(d).arg(p.x()).arg(p.y()).arg(m < 2 ? " +Ctrl" : m < 3 ? " +Ctrl+Shift" : ""));
+            QWheelEvent e(QPointF(p), m_w.viewport()->mapToGlobal(QPointF(p)), QPoint(), QPoint(0, d), Qt::NoButton, mods,
                           Qt::NoScrollPhase, false);
             QApplication::sendEvent(m_w.viewport(), &e);
         }
