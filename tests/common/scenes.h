@@ -58,6 +58,19 @@ inline std::vector<SpeciesAssets> oneShrub()
     return assets;
 }
 
+// A scene of the ground alone as the renderer sees it with oneShrub's assets: species "shrub" placed once, 1000 m
+// under the ground plane (never seen, never in a shadow ray's way: those all go up). The caller sets the rest.
+inline Scene shrubUnderGround()
+{
+    Scene s;
+    s.species.resize(1);
+    s.species[0].name = "shrub";
+    InstanceDesc d;
+    d.position = {0.0, -1000.0, 0.0};
+    s.instances.push_back(d);
+    return s;
+}
+
 // A grown shrub species (the leaf preset's optics) lit on a grid of `grid` nodes: small and quick to grow.
 inline SpeciesDesc shrubSpecies(int grid, uint64_t seed = 7, uint64_t triangles = 3000, float height = 0.0f)
 {

@@ -47,12 +47,7 @@ double columnByQuadrature(double y0, double dy, double t, double H)
 // the renderer needs 1000 m under the ground (never seen, never in a shadow ray's way).
 Scene groundFromAbove(double height, double pitchDeg, float fovY, int w, int h)
 {
-    Scene s;
-    s.species.resize(1);
-    s.species[0].name = "shrub";
-    InstanceDesc d;
-    d.position = {0.0, -1000.0, 0.0};
-    s.instances.push_back(d);
+    Scene s = test::shrubUnderGround();
     s.ground.color = glm::vec3(0.6f, 0.5f, 0.4f);
     s.camera.position = {0.0, height, 0.0};
     const double p = pitchDeg * kPi / 180.0;

@@ -42,12 +42,7 @@ using test::oneShrub;
 // never in a shadow ray's way: those all go up); the sun off. The sky is set by the caller.
 Scene openGround()
 {
-    Scene s;
-    s.species.resize(1);
-    s.species[0].name = "shrub";
-    InstanceDesc d;
-    d.position = {0.0, -1000.0, 0.0};
-    s.instances.push_back(d);
+    Scene s = test::shrubUnderGround();
     s.ground.color = glm::vec3(1.0f);
     s.camera.position = {0.0, 5.0, -2.0};
     s.camera.target = {0.0, 0.0, 2.0};
