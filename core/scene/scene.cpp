@@ -1,6 +1,8 @@
 // Names of render modes and acceleration structures; sun direction from angles.
 #include "core/scene/scene.h"
 
+#include "core/scene/quality.h"
+
 #include <cmath>
 
 namespace sylva {
@@ -97,7 +99,12 @@ Scene newSceneDefaults()
 {
     Scene s;
     s.skyModel.kind = sky::SkyKind::Uniform;
-    s.lighting.direct = DirectLight::Once;
+    // The lighting of the `final` preset (docs/ACCURACY.md "Ground truth"): direct light once, the sky in the LB
+    // boundary, the grid as a radiance cache after its bounces.
+    const QualityPreset* final = findQualityPreset("final");
+    s.lighting.direct = final->direct;
+    s.lighting.boundary = final->boundary;
+    s.lighting.bounces = final->bounces;
     return s;
 }
 

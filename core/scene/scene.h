@@ -241,9 +241,9 @@ struct Scene {
 // constant sky, 0 for the others (their background is in SampleParts::background).
 inline glm::vec3 composeSky(const Scene& s) { return s.skyModel.analytic() ? glm::vec3(0.0f) : s.sky; }
 
-// What a scene started from nothing (the studio's File > New) holds: Scene's defaults with the lighting the
-// ground truth against Cycles finds closest on every scene it measures, `sky.kind` uniform and
-// `lighting.direct` once (docs/ACCURACY.md "Ground truth"). Scene{} keeps the defaults old files were
+// What a scene started from nothing (the studio's File > New) holds: Scene's defaults with `sky.kind` uniform and
+// the `final` quality preset's lighting, the closest to Cycles on every scene the ground truth measures
+// (`lighting.direct` once, `lighting.boundary` sun_sky, `lighting.bounces` 2; docs/ACCURACY.md "Ground truth"). Scene{} keeps the defaults old files were
 // written against, so they render the picture they always did. The sky is not built (loadSceneSky).
 Scene newSceneDefaults();
 

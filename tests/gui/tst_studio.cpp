@@ -33,6 +33,7 @@
 #include "pipeline/io/npy.h"
 #include "pipeline/render/frame_build.h"
 #include "pipeline/render/render_passes.h"
+#include "core/scene/quality.h"
 #include "pipeline/scene/scene_file.h"
 #include "studio/job_panel.h"
 #include "studio/outliner_model.h"
@@ -517,7 +518,13 @@ private Q_SLOTS:
         QVERIFY(scene().species.empty());
         // A new scene starts on the lighting closest to Cycles (newSceneDefaults), its sky built.
         QCOMPARE(scene().skyModel.kind, sky::SkyKind::Uniform);
-        QCOMPARE(scene().lighting.direct, DirectLight::Once);
+        const QualityPreset* final = findQualityPreset("final");
+        QVERIFY(final);
+        QCOMPARE(scene().lighting.direct, final->direct);
+        QCOMPARE(scene().lighting.boundary, final->boundary);
+        QCOMPARE(scene().lighting.bounces, final->bounces);
+        QCOMPARE(scene().lighting.boundary, LbBoundary::SunSky);
+        QCOMPARE(scene().lighting.bounces, 2);
         QVERIFY(scene().skyModel.built != nullptr);
         QVERIFY(m_win->openFile(path));
         QCOMPARE(m_prompts, 0);
