@@ -434,30 +434,31 @@ void MainWindow::buildActions()
     add(m_viewMenu, tr("Frame &All"), "actionFrameAll", QKeySequence(Qt::Key_Home), [this] { m_viewport->frameAll(); });
     add(m_viewMenu, tr("Frame &Selected"), "actionFrameSelected", QKeySequence(Qt::KeypadModifier | Qt::Key_Period),
         [this] { m_viewport->frameSelected(); });
-    // The render's frame over the viewport (remembered across sessions; on at first).
-    QAction* cameraFrame = m_viewMenu->addAction(tr("&Camera Frame"));
-    cameraFrame->setObjectName("actionCameraFrame");
-    cameraFrame->setCheckable(true);
-    cameraFrame->setToolTip(tr("Show the render's frame in the viewport (its size's proportions; outside it darkened): "
-                               "what lies inside is what Render Image and Export Render show"));
-    connect(cameraFrame, &QAction::toggled, this, [this](bool on) {
-        m_viewport->setCameraFrame(on);
-        QSettings().setValue(QStringLiteral("view/cameraFrame"), on);
-    });
-    cameraFrame->setChecked(QSettings().value(QStringLiteral("view/cameraFrame"), true).toBool());
-    m_viewport->setCameraFrame(cameraFrame->isChecked());
-    // The refinement's sample counter and progress bar over the picture (remembered; on at first).
-    QAction* counter = m_viewMenu->addAction(tr("&Sample Counter"));
-    counter->setObjectName("actionSampleCounter");
-    counter->setCheckable(true);
-    counter->setToolTip(tr("Show how many samples the viewport has added up, and a progress bar toward its limit, at the "
-                           "bottom of the picture"));
-    connect(counter, &QAction::toggled, this, [this](bool on) {
-        m_viewport->setSampleCounter(on);
-        QSettings().setValue(QStringLiteral("view/sampleCounter"), on);
-    });
-    counter->setChecked(QSettings().value(QStringLiteral("view/sampleCounter"), true).toBool());
-    m_viewport->setSampleCounter(counter->isChecked());
+    // A view toggle remembered across sessions (on at first): the viewport's setter called with its state.
+    auto rememberedToggle = [this](const QString& text, const char* name, const QString& tip, const char* key,
+                                   void (Viewport::*set)(bool)) {
+        QAction* a = m_viewMenu->addAction(text);
+        a->setObjectName(QString::fromLatin1(name));
+        a->setCheckable(true);
+        a->setToolTip(tip);
+        const QString settingsKey = QString::fromLatin1(key);
+        connect(a, &QAction::toggled, this, [this, set, settingsKey](bool on) {
+            (m_viewport->*set)(on);
+            QSettings().setValue(settingsKey, on);
+        });
+        a->setChecked(QSettings().value(settingsKey, true).toBool());
+        (m_viewport->*set)(a->isChecked());
+    };
+    // The render's frame over the viewport.
+    rememberedToggle(tr("&Camera Frame"), "actionCameraFrame",
+                     tr("Show the render's frame in the viewport (its size's proportions; outside it darkened): "
+                        "what lies inside is what Render Image and Export Render show"),
+                     "view/cameraFrame", &Viewport::setCameraFrame);
+    // The refinement's sample counter and progress bar over the picture.
+    rememberedToggle(tr("&Sample Counter"), "actionSampleCounter",
+                     tr("Show how many samples the viewport has added up, and a progress bar toward its limit, at the "
+                        "bottom of the picture"),
+                     "view/sampleCounter", &Viewport::setSampleCounter);
     // F in the viewport toggles it too (a window-wide F shortcut would eat the key in text fields).
     QAction* fly = m_viewMenu->addAction(tr("&Fly Navigation (F in the viewport)"));
     fly->setObjectName("actionFly");
