@@ -140,19 +140,21 @@ SpeciesGrids gridsForMesh(const Scene& scene, const SpeciesDesc& sp, const Trian
     g.density = densityForTriangles(mesh, vs, cache, &densityProgress, log);
     g.params = sp.lighting;
     g.params.sun = lbSunDirection(scene);
-    SubProgress lightPart(progress, 0.2, 1.0);
-    Progress lightProgress([&](double f, const std::string& msg) { lightPart.report(f, msg); });
-    if (progress && progress->isCancelled()) lightProgress.cancel();
     const std::optional<lb::BoundaryWeights> weights = speciesBoundary(scene, g.params);
-    auto solve = [&](const lb::LbParams& p) {
-        return weights ? lightingForWeights(g.density, p, *weights, cache, &lightProgress, log, backend)
-                       : lightingFor(g.density, p, cache, &lightProgress, log, backend);
+    // Progress 20-100% over the solves: one, or with direct light once two of equal size (so it never runs back).
+    const bool once = gridDirectLight(scene.lighting) == DirectLight::Once;
+    auto solve = [&](const lb::LbParams& p, double begin, double end) {
+        SubProgress part(progress, begin, end);
+        Progress sub([&](double f, const std::string& msg) { part.report(f, msg); });
+        if (progress && progress->isCancelled()) sub.cancel();
+        return weights ? lightingForWeights(g.density, p, *weights, cache, &sub, log, backend)
+                       : lightingFor(g.density, p, cache, &sub, log, backend);
     };
-    g.lighting = solve(g.params);
-    if (gridDirectLight(scene.lighting) == DirectLight::Once) {
+    g.lighting = solve(g.params, 0.2, once ? 0.6 : 1.0);
+    if (once) {
         // Direct light counted once: the same LB with scattering off is the uncollided sunlight the
         // renderer's shadow rays already draw; the grid keeps the scattered rest (cached like any solve).
-        g.lighting = lb::scatteredPart(g.lighting, solve(lb::uncollidedParams(g.params)));
+        g.lighting = lb::scatteredPart(g.lighting, solve(lb::uncollidedParams(g.params), 0.6, 1.0));
     }
     g.lightingNorm = sunFreeField(g.params);
     return g;
