@@ -9,9 +9,9 @@
 #include <QFileInfo>
 #include <QSettings>
 
-#include "core/lb/lb_params.h"
 #include "pipeline/grow/tree_grower.h"
 #include "pipeline/import/mesh_import.h"
+#include "pipeline/scene/scene_species.h"
 #include "studio/camera_nav.h"
 #include "studio/dialogs.h"
 #include "studio/job_manager.h"
@@ -26,27 +26,10 @@ QString meshFilter()
     return QObject::tr("Meshes (*.obj *.fbx *.gltf *.glb *.ply *.dae *.3ds *.stl);;All files (*)");
 }
 
-// A unique species name from a wish ("Tree_1", then "Tree_1 (2)", ...).
-std::string uniqueSpeciesName(const Scene& s, const std::string& wish)
-{
-    auto taken = [&](const std::string& n) {
-        for (const SpeciesDesc& sp : s.species)
-            if (sp.name == n) return true;
-        return false;
-    };
-    const std::string base = wish.empty() ? std::string("species") : wish;
-    if (!taken(base)) return base;
-    for (int i = 2;; ++i) {
-        const std::string n = base + " (" + std::to_string(i) + ")";
-        if (!taken(n)) return n;
-    }
-}
-
+// The scene file's species defaults (the measured front's solve), on the grid the artist chose last.
 SpeciesDesc newSpeciesDesc()
 {
-    SpeciesDesc sp;
-    sp.preset = "leaf";
-    sp.lighting = lb::paramsFromPreset(*lb::findPreset("leaf"));
+    SpeciesDesc sp = defaultSpecies();
     sp.grid = QSettings().value("import/grid", 64).toInt();
     return sp;
 }

@@ -146,6 +146,21 @@ SpeciesDesc defaultSpecies()
     return d;
 }
 
+std::string uniqueSpeciesName(const Scene& scene, const std::string& wish)
+{
+    auto taken = [&](const std::string& n) {
+        for (const SpeciesDesc& sp : scene.species)
+            if (sp.name == n) return true;
+        return false;
+    };
+    const std::string base = wish.empty() ? std::string("species") : wish;
+    if (!taken(base)) return base;
+    for (int i = 2;; ++i) {
+        const std::string n = base + " (" + std::to_string(i) + ")";
+        if (!taken(n)) return n;
+    }
+}
+
 // ---- instances ----
 
 void readInstanceSpecies(SceneReadContext& r, const QJsonValue& v, const KeyPath& path, InstanceDesc& inst)

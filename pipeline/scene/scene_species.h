@@ -36,6 +36,9 @@ void readLightingPreset(SceneReadContext& r, const QJsonValue& v, const json::Ke
 void checkLighting(SceneReadContext& r, const json::KeyPath& path, const SpeciesDesc& d);
 // The species record documented defaults are written from (the default preset's lighting).
 SpeciesDesc defaultSpecies();
+// A species name not taken in `scene`, from a wish: the wish, else "WISH (2)", "WISH (3)", ... ("species" for an
+// empty wish). The studio's import and grow and the Python module's add_species name species with it.
+std::string uniqueSpeciesName(const Scene& scene, const std::string& wish);
 // A per-channel LB parameter of a record with `lighting` (a species, a volume): one number for all
 // channels or [r, g, b], read into and written from lighting.channels[c].*member.
 template <class T>
