@@ -23,7 +23,9 @@ PACKAGES=(cmake ninja-build ccache g++ pkg-config
   # sylva render --mpi and its tests, see docs/DISTRIBUTED.md
   libopenmpi-dev openmpi-bin
   # OpenColorIO's display transforms (render --view); its tools check them in the tests
-  libopencolorio-dev opencolorio-tools)
+  libopencolorio-dev opencolorio-tools
+  # the Python module (docs/PYTHON.md) and its test
+  pybind11-dev python3-dev python3-numpy)
 
 install_missing() {
   local missing=()

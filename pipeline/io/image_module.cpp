@@ -30,6 +30,13 @@ std::string executableFolder()
     return ec ? std::string() : exe.parent_path().string();
 }
 
+// addSearchPath's places (guarded by the state's mutex, as candidates() is called under it).
+std::vector<std::string>& extraPaths()
+{
+    static std::vector<std::string> paths;
+    return paths;
+}
+
 // Where the module is looked for, in order.
 std::vector<std::string> candidates()
 {
@@ -40,6 +47,7 @@ std::vector<std::string> candidates()
         out.push_back(folder + "/" + kModuleName);
         out.push_back(folder + "/" + SYLVA_IMAGE_MODULE_INSTALLED);
     }
+    for (const std::string& p : extraPaths()) out.push_back(p);
     if (*SYLVA_IMAGE_MODULE_BUILD_PATH) out.push_back(SYLVA_IMAGE_MODULE_BUILD_PATH);
     return out;
 }
@@ -89,6 +97,13 @@ void loadLocked(State& s)
 }
 
 } // namespace
+
+void addSearchPath(const std::string& path)
+{
+    State& s = state();
+    std::lock_guard<std::mutex> lock(s.mutex);
+    extraPaths().push_back(path);
+}
 
 const Table& table()
 {

@@ -47,8 +47,12 @@ constexpr int kAbi = 3;
 
 // The module, loaded on the first call (thread-safe). Throws Error when it cannot be found or loaded:
 // SYLVA_IMAGE_MODULE names it, else it is looked for beside the executable, then installed (BINDIR/../LIBDIR/
-// sylva), then where the build put it.
+// sylva), then at the places addSearchPath gave, then where the build put it.
 const Table& table();
+
+// One more place to look for the module file, after the executable's: a library loaded into another program (the
+// Python module) names the installed module relative to its own file.
+void addSearchPath(const std::string& path);
 
 // Throws table()'s Error at once when no module file exists where table() looks (nothing is loaded): for
 // a command that writes an image at its end, so a missing module fails it before its work. The module is

@@ -104,6 +104,48 @@ private Q_SLOTS:
         QVERIFY2(lit > 0.0f, "the triangle should be lit");
     }
 
+    // The installed Python module: found by its interpreter with PYTHONPATH on the installed folder only, it renders
+    // the one-triangle scene to the picture the build tree's sylva draws, writing it through the OpenImageIO module it
+    // finds relative to its own file.
+    void installedPythonModuleRenders()
+    {
+#ifndef SYLVA_PYTHON
+        QSKIP("this build has no Python module (pybind11 not found)");
+#else
+        const QString folder = installed(SYLVA_PYTHON_INSTALL_DIR);
+        QVERIFY2(!QDir(folder).entryList({"sylva*.so"}, QDir::Files).isEmpty(), qPrintable(folder));
+        QVERIFY2(QFileInfo(folder + "/" + SYLVA_PYTHON_TO_IMAGE_MODULE).isFile(), SYLVA_PYTHON_TO_IMAGE_MODULE);
+        QTemporaryDir work;
+        QFile obj(work.filePath("tri.obj"));
+        QVERIFY(obj.open(QIODevice::WriteOnly));
+        obj.write("v -1 0 -1\nv 1 0 -1\nv 0 0 1\nf 1 2 3\n");
+        obj.close();
+        QFile scene(work.filePath("tri.sylva.json"));
+        QVERIFY(scene.open(QIODevice::WriteOnly));
+        scene.write(R"({"version": 1, "species": [{"name": "tri", "mesh": "tri.obj"}],
+                        "instances": [{"species": "tri", "position": [0, 0.5, 0]}],
+                        "camera": {"position": [0, 3, -3], "target": [0, 0, 0]},
+                        "render": {"width": 16, "height": 8, "mode": "local"}})");
+        scene.close();
+        QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
+        env.insert("PYTHONPATH", folder);
+        env.insert("PYTHONDONTWRITEBYTECODE", "1");
+        const char* script = "import sylva, os\n"
+                             "print(os.path.dirname(sylva.__file__))\n"
+                             "sylva.render(sylva.Scene.load('tri.sylva.json'), cache=False).save('py.exr')\n";
+        const sylva::test::Run p = sylva::test::runProgram(SYLVA_PYTHON, {"-c", script}, env, 120000, work.path());
+        QVERIFY2(p.code == 0, qPrintable(p.out + p.err));
+        QCOMPARE(QDir(p.out.trimmed()).canonicalPath(), QDir(folder).canonicalPath());
+        const Run b = run(QStringLiteral(SYLVA_BUILD_DIR "/pipeline/sylva"),
+                          {"render", "tri.sylva.json", "-o", "built.exr", "--quiet", "--no-cache"}, work.path());
+        QVERIFY2(b.code == 0, qPrintable(b.out + b.err));
+        const sylva::ImageRgba mine = sylva::readImage(work.filePath("py.exr").toStdString());
+        const sylva::ImageRgba built = sylva::readImage(work.filePath("built.exr").toStdString());
+        QCOMPARE(mine.width, 16);
+        QVERIFY(mine.pixels == built.pixels);
+#endif
+    }
+
     // Every command and every option of the binary's --help pages in sylva(1); groff reads it without warnings.
     void manPageNamesEverything()
     {
