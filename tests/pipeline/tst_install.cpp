@@ -31,6 +31,22 @@ Run run(const QString& program, const QStringList& args, const QString& cwd = QS
     return sylva::test::runProgram(program, args, QProcessEnvironment::systemEnvironment(), timeoutMs, cwd);
 }
 
+// A one-triangle scene, tri.sylva.json with its mesh tri.obj, in `dir`: 16 x 8 pixels, local mode.
+bool writeTriangleScene(const QTemporaryDir& dir)
+{
+    QFile obj(dir.filePath("tri.obj"));
+    if (!obj.open(QIODevice::WriteOnly)) return false;
+    obj.write("v -1 0 -1\nv 1 0 -1\nv 0 0 1\nf 1 2 3\n");
+    obj.close();
+    QFile scene(dir.filePath("tri.sylva.json"));
+    if (!scene.open(QIODevice::WriteOnly)) return false;
+    scene.write(R"({"version": 1, "species": [{"name": "tri", "mesh": "tri.obj"}],
+                    "instances": [{"species": "tri", "position": [0, 0.5, 0]}],
+                    "camera": {"position": [0, 3, -3], "target": [0, 0, 0]},
+                    "render": {"width": 16, "height": 8, "mode": "local"}})");
+    return true;
+}
+
 } // namespace
 
 class TestInstall : public QObject {
@@ -77,17 +93,7 @@ private Q_SLOTS:
         QCOMPARE(v.code, 0);
         QVERIFY2(v.out.startsWith(QString("sylva ") + SYLVA_VERSION), qPrintable(v.out));
         // A one-triangle scene: the sun's colour comes from the bundled CIE table (a resource).
-        QFile obj(work.filePath("tri.obj"));
-        QVERIFY(obj.open(QIODevice::WriteOnly));
-        obj.write("v -1 0 -1\nv 1 0 -1\nv 0 0 1\nf 1 2 3\n");
-        obj.close();
-        QFile scene(work.filePath("tri.sylva.json"));
-        QVERIFY(scene.open(QIODevice::WriteOnly));
-        scene.write(R"({"version": 1, "species": [{"name": "tri", "mesh": "tri.obj"}],
-                        "instances": [{"species": "tri", "position": [0, 0.5, 0]}],
-                        "camera": {"position": [0, 3, -3], "target": [0, 0, 0]},
-                        "render": {"width": 16, "height": 8, "mode": "local"}})");
-        scene.close();
+        QVERIFY(writeTriangleScene(work));
         // The installed program draws the picture the build tree's draws (the same linear values: a missing or
         // other colour table would change the sun's colour).
         const Run r = run(m_sylva, {"render", "tri.sylva.json", "-o", "tri.exr", "--quiet", "--no-cache"}, work.path());
@@ -116,17 +122,7 @@ private Q_SLOTS:
         QVERIFY2(!QDir(folder).entryList({"sylva*.so"}, QDir::Files).isEmpty(), qPrintable(folder));
         QVERIFY2(QFileInfo(folder + "/" + SYLVA_PYTHON_TO_IMAGE_MODULE).isFile(), SYLVA_PYTHON_TO_IMAGE_MODULE);
         QTemporaryDir work;
-        QFile obj(work.filePath("tri.obj"));
-        QVERIFY(obj.open(QIODevice::WriteOnly));
-        obj.write("v -1 0 -1\nv 1 0 -1\nv 0 0 1\nf 1 2 3\n");
-        obj.close();
-        QFile scene(work.filePath("tri.sylva.json"));
-        QVERIFY(scene.open(QIODevice::WriteOnly));
-        scene.write(R"({"version": 1, "species": [{"name": "tri", "mesh": "tri.obj"}],
-                        "instances": [{"species": "tri", "position": [0, 0.5, 0]}],
-                        "camera": {"position": [0, 3, -3], "target": [0, 0, 0]},
-                        "render": {"width": 16, "height": 8, "mode": "local"}})");
-        scene.close();
+        QVERIFY(writeTriangleScene(work));
         QProcessEnvironment env = QProcessEnvironment::systemEnvironment();
         env.insert("PYTHONPATH", folder);
         env.insert("PYTHONDONTWRITEBYTECODE", "1");
