@@ -22,7 +22,7 @@ namespace sylva::study {
 namespace {
 
 // Sections of ACCURACY.md written by hand: carried over word for word from the existing file.
-const char* const kKeptSections[] = {"The reference solver", "Normalization", "Volumes"};
+const char* const kKeptSections[] = {"The reference solver", "Normalization", "Volumes", "Tried and not kept"};
 
 std::string f(const char* format, double v)
 {
@@ -681,8 +681,8 @@ void writeReport(const Options& options, const ReportInput& in, Result& result)
           "grid with the same optics, is slow, and is exact in the limit of many paths, with a standard error per node.\n\n";
     md << "**This file is generated** by `sylva study all` (`pipeline/study/`; `sylva study lb|voxel|render|scene` reruns one part and "
           "rewrites the file from the stored numbers of the others, `accuracy/*.json`; `--quick` is the small version CI runs). "
-          "The sections \"The reference solver\" and \"Normalization\" are written by hand and carried over word for word; edit "
-          "them here, everything else in the code.\n\n";
+          "The sections \"The reference solver\", \"Normalization\", \"Volumes\" and \"Tried and not kept\" are written by hand "
+          "and carried over word for word; edit them here, everything else in the code.\n\n";
     md << "| part | measured | on | took | load average (start, end) |\n| --- | --- | --- | --- | --- |\n";
     auto runLine = [&](const char* name, const RunInfo& r) {
         md << "| " << name << " | " << r.date << (r.quick ? " (--quick)" : "") << " | " << r.machine << " | " << minutes(r.seconds) << " | "
