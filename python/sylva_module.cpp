@@ -274,6 +274,7 @@ PYBIND11_MODULE(sylva, m)
         .def_readwrite("view", &RenderSettings::view)
         .def_readwrite("display", &RenderSettings::display)
         .def_readwrite("max_bounces", &RenderSettings::maxBounces)
+        .def_readwrite("bounce_samples", &RenderSettings::bounceSamples)
         .def_readwrite("shadows", &RenderSettings::shadows)
         .def_property("mode", [](const RenderSettings& r) { return std::string(renderModeName(r.mode)); },
                       [](RenderSettings& r, const std::string& v) {

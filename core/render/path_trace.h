@@ -99,7 +99,10 @@ struct PathLight {
 // whole; with `endInCache` that vertex also adds its own indirect light (SurfacePoint::indirect: the LB grid's
 // scattered light on meshes), the radiance cache standing for every bounce the path does not trace
 // (lighting.bounces). The reference path tracer is bounces = render.max_bounces without the cache.
-SYLVA_HD inline PathLight pathRadiance(const RenderView& v, const SurfacePoint& first, int px, int py, int sample, int bounces, bool endInCache)
+// firstOnly: the first surface's lights alone, weighted as on a path that goes on (bounces > 0), so that its
+// `direct` is exactly the part of a whole path's light that `indirect` leaves out (render.bounce_samples).
+SYLVA_HD inline PathLight pathRadiance(const RenderView& v, const SurfacePoint& first, int px, int py, int sample, int bounces, bool endInCache,
+                                       bool firstOnly = false)
 {
     path_detail::Rng rng{lds::mix(uint32_t(px), uint32_t(py)), uint32_t(sample), 0u};
     glm::vec3 L(0.0f), beta(1.0f), direct(0.0f);
@@ -121,6 +124,7 @@ SYLVA_HD inline PathLight pathRadiance(const RenderView& v, const SurfacePoint& 
             if (depth == 0) direct += c;
             else L += c;
         }
+        if (firstOnly) break;
         if (last) {
             if (endInCache) L += beta * s.indirect;
             break;

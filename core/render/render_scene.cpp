@@ -446,6 +446,8 @@ void placeTopLevel(RenderScene& rs, const Scene& sceneIn, const glm::vec3& sunRa
     b.integrator = scene.render.integrator;
     b.maxBounces = scene.render.maxBounces;
     b.lightingBounces = scene.lighting.bounces;
+    const int bounceSamples = scene.render.bounceSamples;
+    b.bounceStride = bounceSamples > 0 && bounceSamples < spp ? spp / bounceSamples : 1;
     b.atmosphere = scene.skyModel.aerialPerspective ? makeAtmosphere(scene.skyModel.turbidity, origin.y) : AtmosphereRecord{};
     placeVolumes(rs, scene, scene.camera.position);
     countFrameBytes(rs);

@@ -251,6 +251,8 @@ struct RenderView {
     Integrator integrator;           // Lb: the stages of shade.h; Path: path_trace.h from the camera's hit on
     int maxBounces;                  // Path: bounces after the camera's hit
     int lightingBounces = 0;         // Lb: bounces traced before the LB grid's light ends a path (0: the grid at the camera's hit)
+    int bounceStride = 1;            // Lb with bounces: every bounceStride-th sample traces them (render.bounce_samples;
+                                     // shade.h shadeDecoupledPixel); 1: every sample
 };
 
 // Does the frame shade its camera hits along paths (shade.h pathStage): the path tracer, or the LB integrator

@@ -74,10 +74,11 @@ SYLVA_HD inline SampleParts lightStage(const RenderView& v, const SurfacePoint& 
 // render.max_bounces) or the LB integrator's radiance cache (lighting.bounces > 0: that many bounces, then the
 // LB grid's scattered light), core/render/path_trace.h. The first surface's direct light is `local`, the rest
 // `indirect`; its albedo, normal and depth as lightStage gives them.
-SYLVA_HD inline SampleParts pathStage(const RenderView& v, const SurfacePoint& s, int px, int py, int sample)
+// bounces false: the first surface's direct light alone (render.bounce_samples: shadePixel adds its bounced light).
+SYLVA_HD inline SampleParts pathStage(const RenderView& v, const SurfacePoint& s, int px, int py, int sample, bool bounces = true)
 {
     const bool path = v.integrator == Integrator::Path;
-    const PathLight l = pathRadiance(v, s, px, py, sample, path ? v.maxBounces : v.lightingBounces, !path);
+    const PathLight l = pathRadiance(v, s, px, py, sample, path ? v.maxBounces : v.lightingBounces, !path, !bounces);
     return SampleParts{l.direct, l.indirect, s.albedo, 0.0f, s.ng, glm::dot(s.p, v.camera.forward), glm::vec3(0.0f)};
 }
 
@@ -163,9 +164,52 @@ SYLVA_HD SYLVA_INLINE Ray sampleRay(const RenderView& v, int px, int py, int s)
     return cameraRay(v, pos.x, pos.y);
 }
 
+// Does sample s trace the bounces (render.bounce_samples)? Every bounceStride-th sample of the frame, and the
+// first of each pass (a progressive pass always has one).
+SYLVA_HD SYLVA_INLINE bool sampleTracesBounces(const RenderView& v, int s) { return s % v.bounceStride == 0 || s == v.sampleBegin; }
+
+// The pixel's samples with render.bounce_samples (the LB integrator's radiance cache, bounceStride > 1): the
+// samples that trace the bounces first, then the others with their first surface's direct light only and, as their
+// bounced light, their albedo times the traced samples' bounced light over those samples' albedo per channel (a
+// ratio estimate: a pixel's surfaces get much the same indirect light, while which leaf a sample meets, and whether
+// the sun reaches it, changes from sample to sample). A sample that meets a surface while no traced one has traces
+// its bounces too. The media act on each sample after its surface's light, as in shadeRay.
+SYLVA_HD inline SampleParts shadeDecoupledPixel(const RenderView& v, int px, int py)
+{
+    SampleParts sum = pixelSumStart();
+    const int sBegin = v.sampleBegin, sEnd = sampleEndOf(v);
+    glm::vec3 bounced(0.0f), albedo(0.0f);
+    for (int pass = 0; pass < 2; ++pass)
+        for (int s = sBegin; s < sEnd; ++s) {
+            if (sampleTracesBounces(v, s) != (pass == 0)) continue;
+            const Ray ray = sampleRay(v, px, py, s);
+            Hit hit{};
+            const bool found = intersectStage(v, ray, hit);
+            SampleParts p;
+            if (!found) {
+                p = backgroundStage(v, ray);
+            } else {
+                const bool known = albedo.x > 0.0f || albedo.y > 0.0f || albedo.z > 0.0f;
+                const bool traces = pass == 0 || !known;
+                p = pathStage(v, surfaceStage(v, ray, hit), px, py, s, traces);
+                if (traces) {
+                    bounced += p.indirect;
+                    albedo += p.albedo;
+                } else {
+                    for (int c = 0; c < 3; ++c) p.indirect[c] = albedo[c] > 0.0f ? p.albedo[c] * bounced[c] / albedo[c] : 0.0f;
+                }
+            }
+            volumeStage(v, ray, found ? hit.t : ray.tmax, p);
+            pixelSumAdd(sum, p);
+        }
+    pixelSumAverage(sum, sEnd - sBegin);
+    return sum;
+}
+
 // All samples of one pixel (or those of v.sampleBegin .. sampleEnd), box-filtered.
 SYLVA_HD inline SampleParts shadePixel(const RenderView& v, int px, int py)
 {
+    if (v.bounceStride > 1 && v.integrator == Integrator::Lb && v.lightingBounces > 0) return shadeDecoupledPixel(v, px, py);
     SampleParts sum = pixelSumStart();
     const int sBegin = v.sampleBegin, sEnd = sampleEndOf(v);
     for (int s = sBegin; s < sEnd; ++s) pixelSumAdd(sum, shadeRay(v, sampleRay(v, px, py, s), px, py, s));

@@ -13,11 +13,14 @@ const std::vector<QualityPreset>& qualityPresets()
     // front; pruning is on no front there: it costs trace time on this forest); the lighting from the ground
     // truth against Cycles ("Ground truth"): the LB grid as a radiance cache after 2 bounces with the sky in its
     // boundary is within the references' noise of converged Cycles on all four scenes, at 64 spp 1.5-3.8% from
-    // it; after 1 bounce the same at 1 spp (the noise dominates there); reference: the path tracer.
+    // it; after 1 bounce the same at 1 spp (the noise dominates there); reference: the path tracer. final's samples
+    // share the bounces four to one (render.bounce_samples, tests/bench/bench_bounce_samples.py): 100 samples of which
+    // 25 trace the bounces err as little as 64 whole ones on the default forest and 6% less on a single tree, in
+    // 0.85x their time (docs/PERFORMANCE.md "Bounce samples").
     static const std::vector<QualityPreset> presets{
-        {"preview", 32, "half", true, 1, 25.0f, 0.0f, Integrator::Lb, 1, DirectLight::Once, LbBoundary::SunSky, true},
-        {"final", 64, "half", true, 64, 0.0f, 0.0f, Integrator::Lb, 2, DirectLight::Once, LbBoundary::SunSky, true},
-        {"reference", 128, "half", true, 256, 0.0f, 0.0f, Integrator::Path, 0, DirectLight::Once, LbBoundary::SunSky, true},
+        {"preview", 32, "half", true, 1, 25.0f, 0.0f, Integrator::Lb, 1, DirectLight::Once, LbBoundary::SunSky, true, 0},
+        {"final", 64, "half", true, 100, 0.0f, 0.0f, Integrator::Lb, 2, DirectLight::Once, LbBoundary::SunSky, true, 25},
+        {"reference", 128, "half", true, 256, 0.0f, 0.0f, Integrator::Path, 0, DirectLight::Once, LbBoundary::SunSky, true, 0},
     };
     return presets;
 }
@@ -35,7 +38,8 @@ std::string qualityPresetSettings(const QualityPreset& q)
     return "grid " + std::to_string(q.grid) + ", " + q.steps + ", " + (q.fp16 ? "fp16" : "fp32") + ", " + std::to_string(q.spp) +
            " spp, alpha " + dist(q.alphaDistance) + ", prune " + dist(q.pruneDistance) + ", " + integratorName(q.integrator) + ", " +
            std::to_string(q.bounces) + " bounces, direct " + directLightName(q.direct) + ", boundary " + lbBoundaryName(q.boundary) +
-           (q.aerialPerspective ? ", aerial perspective on terrains" : "");
+           (q.aerialPerspective ? ", aerial perspective on terrains" : "") +
+           (q.bounceSamples > 0 ? ", " + std::to_string(q.bounceSamples) + " bounce samples" : std::string());
 }
 
 void applyQualityLighting(const QualityPreset& preset, lb::LbParams& params)
@@ -58,6 +62,7 @@ void applyQuality(Scene& scene, const QualityPreset& preset)
         applyQualityLighting(preset, sp.lighting);
     }
     scene.render.spp = preset.spp;
+    scene.render.bounceSamples = preset.bounceSamples;
     scene.render.alphaDistance = preset.alphaDistance;
     scene.render.pruneDistance = preset.pruneDistance;
     scene.render.integrator = preset.integrator;

@@ -24,6 +24,7 @@ struct QualityPreset {
     DirectLight direct;                 // lighting.direct
     LbBoundary boundary;                // lighting.boundary
     bool aerialPerspective;             // sky.aerial_perspective on scenes with a terrain (elsewhere the air is too thin to see)
+    int bounceSamples;                  // render.bounce_samples: samples of a pixel that trace the bounces (0: all)
 };
 const std::vector<QualityPreset>& qualityPresets();
 const QualityPreset* findQualityPreset(const std::string& name);
@@ -34,7 +35,7 @@ std::string qualityPresetSettings(const QualityPreset& preset);
 // The preset's steps/tolerance and storage on LB parameters (optics untouched). Throws Error on an
 // unknown steps label.
 void applyQualityLighting(const QualityPreset& preset, lb::LbParams& params);
-// The preset on a whole scene: every species' grid, steps and storage; spp, alpha and prune distances; the
+// The preset on a whole scene: every species' grid, steps and storage; spp, bounce samples, alpha and prune distances; the
 // integrator and the lighting block's direct light, boundary and bounces, and the aerial perspective of a scene with
 // a terrain (whatever the scene file held).
 void applyQuality(Scene& scene, const QualityPreset& preset);

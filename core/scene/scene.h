@@ -215,6 +215,8 @@ struct RenderSettings {
                                          // instance at distance d keeps about start / d of them; 0 = off
     Integrator integrator = Integrator::Lb;
     int maxBounces = 64;                 // path: bounces after the camera's hit, 0 .. kMaxPathBounces (Russian roulette from the 4th)
+    int bounceSamples = 0;               // lb with lighting.bounces: samples of a pixel that trace the bounces (every
+                                         // spp / bounceSamples-th); the others share their light by albedo; 0 = all
     // The picture's display transform (pipeline/render/display_view.h): a view of an OpenColorIO display,
     // or the in-house Reinhard curve, "Sylva Reinhard", the picture of files written without the key.
     std::string view = "Sylva Reinhard";

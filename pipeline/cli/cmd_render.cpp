@@ -56,6 +56,7 @@ Scene sceneForArgs(const Args& args, std::string* stem)
     if (args.has("--integrator") && !parseIntegrator(args.get("--integrator"), &r.integrator))
         throw UsageError("option --integrator: expected lb or path, got '" + args.get("--integrator") + "'");
     if (args.has("--max-bounces")) r.maxBounces = int(parseInteger("--max-bounces", args.get("--max-bounces"), 0, kMaxPathBounces));
+    if (args.has("--bounce-samples")) r.bounceSamples = int(parseInteger("--bounce-samples", args.get("--bounce-samples"), 0, 4096));
     if (args.has("--direct") && !parseDirectLight(args.get("--direct"), &scene.lighting.direct))
         throw UsageError("option --direct: expected once or seed, got '" + args.get("--direct") + "'");
     if (args.has("--bounces")) scene.lighting.bounces = int(parseInteger("--bounces", args.get("--bounces"), 0, kMaxPathBounces));
@@ -307,6 +308,8 @@ Command renderCommand()
              {"--integrator", "lb|path", "lb: the LB model (default: the scene's render.integrator); path: the reference path tracer, "
                                          "every bounce with next-event estimation to the sun and sky (docs/RENDERING.md \"The path tracer\")"},
              {"--max-bounces", "N", "path: bounces after the camera's hit, 0 .. 100 (default: the scene's render.max_bounces, 64)"},
+             {"--bounce-samples", "N", "lb with --bounces > 0: samples of a pixel that trace the bounces, the others sharing their light by "
+                                      "albedo; 0 = all (default: the scene's render.bounce_samples; docs/RENDERING.md \"Bounce samples\")"},
              {"--direct", "once|seed", "once: the LB grids add only scattered light to the shadow-rayed sun; seed: the seed's sum "
                                    "(grid as solved, direct light counted twice in crowns); default: the scene's lighting.direct"},
              {"--bounces", "N", "lb: bounces a camera path traces before the LB grid's scattered light ends it, 0 .. 100 "

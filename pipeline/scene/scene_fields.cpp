@@ -799,6 +799,14 @@ const Table<RenderSettings>& renderTable()
         b.integer("max_bounces", &RenderSettings::maxBounces, 0, kMaxPathBounces)
             .doc("integer", "`path`: bounces after the camera's hit, 0 .. " + std::to_string(kMaxPathBounces) +
                                 " (0: direct light only; Russian roulette from the 4th)");
+        b.integer("bounce_samples", &RenderSettings::bounceSamples, 0, 4096)
+            .doc("integer", "`lb` with `lighting.bounces` > 0: how many of a pixel's `spp` samples trace the bounces (every "
+                            "spp / N-th); the others take their surface's direct light and the traced samples' bounced light in "
+                            "proportion to their albedo ([RENDERING.md](RENDERING.md) \"Bounce samples\"); 0 = every sample")
+            .writtenIf([](const RenderSettings& r) { return r.bounceSamples != 0; })
+            .summarized([](const RenderSettings& r) {
+                return r.bounceSamples > 0 ? std::to_string(r.bounceSamples) + " bounce samples" : std::string();
+            });
         return b.table;
     }();
     return table;

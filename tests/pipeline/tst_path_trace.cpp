@@ -5,7 +5,8 @@
 // picture), a leaf lit from behind (its transmission, closed form), more light with every bounce and the sum
 // converged by 8 bounces, the bits the same on every run, and the settings refused. The LB integrator's radiance
 // cache (lighting.bounces) against the same oracles: the ground's closed form, the path tracer's direct light,
-// and the path tracer's picture as the traced bounces grow.
+// and the path tracer's picture as the traced bounces grow; with bounce samples (render.bounce_samples) the ground's
+// closed form, whole paths' direct light and a picture between 4 and 16 whole samples'.
 #include <QTest>
 
 #include <algorithm>
@@ -204,6 +205,49 @@ private Q_SLOTS:
             QVERIFY(cut.pixels[i].local == short_.pixels[i].local);
             QVERIFY(cut.pixels[i].indirect == short_.pixels[i].indirect);
         }
+    }
+
+    // render.bounce_samples: the ground's closed form still holds (its albedo is one colour, so the shared bounced
+    // light is exact in expectation); every sample still gets a whole path's direct light (the same numbers, to float
+    // rounding of the sum's order); bounce_samples = spp is the picture bit for bit; on a small forest at 16 spp with 4
+    // bounce samples the picture is closer to the converged one than 4 whole samples (the same paths, 4x the pixel's
+    // geometry), its mean within 1%.
+    void bounceSamplesShareTheBouncedLight()
+    {
+        Scene g = groundScene();
+        g.render.integrator = Integrator::Lb;
+        g.lighting.bounces = 2;
+        g.render.bounceSamples = 4;
+        checkGround(g, "lb, 2 bounces on 4 of 64 samples");
+
+        Scene s = test::smallForest();
+        s.render.width = 60;
+        s.render.height = 40;
+        s.lighting.direct = DirectLight::Once;
+        s.lighting.bounces = 2;
+        const std::vector<SpeciesAssets> assets = loadSpeciesAssets(s, nullptr, false);
+        auto film = [&](int spp, int bounceSamples) {
+            Scene sc = s;
+            sc.render.spp = spp;
+            sc.render.bounceSamples = bounceSamples;
+            return renderFilm(buildRenderScene(sc, assets, sunRadiance(sc.sun)).view());
+        };
+        const Film whole = film(16, 0), all = film(16, 16), shared = film(16, 4);
+        for (size_t i = 0; i < whole.pixels.size(); ++i) {
+            QVERIFY(all.pixels[i].local == whole.pixels[i].local && all.pixels[i].indirect == whole.pixels[i].indirect);
+            const glm::vec3 a = shared.pixels[i].local, b = whole.pixels[i].local;
+            for (int c = 0; c < 3; ++c)
+                QVERIFY2(std::fabs(a[c] - b[c]) <= 1e-5f * std::max(1.0f, std::fabs(b[c])),
+                         qPrintable(QString("pixel %1's direct light: %2 against %3").arg(i).arg(a[c]).arg(b[c])));
+        }
+        const std::vector<glm::vec3> truth = composeMode(film(256, 0), RenderMode::Full, s.sky);
+        const std::vector<glm::vec3> four = composeMode(film(4, 0), RenderMode::Full, s.sky);
+        const std::vector<glm::vec3> pic = composeMode(shared, RenderMode::Full, s.sky);
+        const double eFour = relativeL2(four, truth), eShared = relativeL2(pic, truth), eWhole = relativeL2(composeMode(whole, RenderMode::Full, s.sky), truth);
+        qInfo("relative L2 from 256 whole samples: 4 whole %.4f, 16 with 4 bounce samples %.4f, 16 whole %.4f", eFour, eShared, eWhole);
+        QVERIFY2(eShared < eFour, qPrintable(QString("%1 against %2").arg(eShared).arg(eFour)));
+        QVERIFY(eWhole < eShared);
+        QVERIFY2(std::fabs(mean(pic) / mean(truth) - 1.0) < 0.01, qPrintable(QString::number(mean(pic) / mean(truth))));
     }
 
     // The white furnace: with every albedo 1 under a sky of radiance 1 and no sun, whatever the paths do the

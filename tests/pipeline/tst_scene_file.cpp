@@ -405,6 +405,7 @@ private Q_SLOTS:
                 QCOMPARE(sp.lighting.channels[1].sigmaS, before.channels[1].sigmaS);
             }
             QCOMPARE(s.render.spp, q->spp);
+            QCOMPARE(s.render.bounceSamples, q->bounceSamples);
             QCOMPARE(s.render.alphaDistance, q->alphaDistance);
             QCOMPARE(s.render.pruneDistance, q->pruneDistance);
             QVERIFY(s.render.integrator == q->integrator);
