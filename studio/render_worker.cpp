@@ -353,7 +353,6 @@ void RenderWorker::process(const Request& req, Progress& progress)
     int done = 0;
     for (int f = 0; f < refine.frames; ++f) {
         RenderView view = m_frame->rs.view();
-        view.bounceStride = refinementBounceStride(scene, refine.samples, view.bounceStride);
         view.sampleBegin = done;
         view.sampleEnd = std::min(refine.samples, done + refine.perFrame);
         const Film part = renderFilm(view, &progress);
@@ -396,13 +395,6 @@ std::optional<ViewPick> RenderWorker::pick(const CameraDesc& camera, QSize size,
     }
     m_frameLock.unlock();
     return hit;
-}
-
-int refinementBounceStride(const Scene& scene, int samples, int sceneStride)
-{
-    if (scene.render.bounceSamples > 0 || samples <= scene.render.spp) return sceneStride;
-    const QualityPreset* q = findQualityPreset("final");
-    return q && q->bounceSamples > 0 ? std::max(1, q->spp / q->bounceSamples) : sceneStride;
 }
 
 Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp, int sampleLimit)

@@ -42,11 +42,6 @@ struct Refinement {
     int samples = 0, perFrame = 0, frames = 0;
 };
 Refinement refinementFor(const RenderView& view, int sceneSpp, int lastPassSpp, int sampleLimit = 0);
-// The bounce stride of the refinement's frames (RenderView::bounceStride): the scene's own when it sets
-// render.bounce_samples or the refinement stops at its spp (the picture `sylva render` draws); else, refining past
-// the scene's samples toward the limit, the `final` preset's share (its spp over its bounce samples), so the
-// viewport refines to the preset's picture at the preset's cost.
-int refinementBounceStride(const Scene& scene, int samples, int sceneStride);
 inline constexpr int kMaxViewportSamples = 4096;   // render.spp's bound
 
 // How the viewport refines a view that stays still (RenderWorker::setRefineSettings).

@@ -13,13 +13,13 @@ const std::vector<QualityPreset>& qualityPresets()
     // front; pruning is on no front there: it costs trace time on this forest); the lighting from the ground
     // truth against Cycles ("Ground truth"): the LB grid as a radiance cache after 2 bounces with the sky in its
     // boundary is within the references' noise of converged Cycles on all four scenes, at 64 spp 1.5-3.8% from
-    // it; after 1 bounce the same at 1 spp (the noise dominates there); reference: the path tracer. final's samples
-    // share the bounces four to one (render.bounce_samples, tests/bench/bench_bounce_samples.py): 100 samples of which
-    // 25 trace the bounces err as little as 64 whole ones on the default forest and 6% less on a single tree, in
-    // 0.85x their time (docs/PERFORMANCE.md "Bounce samples").
+    // it; after 1 bounce the same at 1 spp (the noise dominates there); reference: the path tracer. No preset shares
+    // the bounces (render.bounce_samples): a quarter of 100 samples tracing them errs as little as 64 whole samples on
+    // the stand and the forest crop in 0.8-0.86x their time, but 1.8x as much on the study's close single tree, where
+    // the bounced light's own noise, not the pixels' geometry, is the error (docs/RENDERING.md "Bounce samples").
     static const std::vector<QualityPreset> presets{
         {"preview", 32, "half", true, 1, 25.0f, 0.0f, Integrator::Lb, 1, DirectLight::Once, LbBoundary::SunSky, true, 0},
-        {"final", 64, "half", true, 100, 0.0f, 0.0f, Integrator::Lb, 2, DirectLight::Once, LbBoundary::SunSky, true, 25},
+        {"final", 64, "half", true, 64, 0.0f, 0.0f, Integrator::Lb, 2, DirectLight::Once, LbBoundary::SunSky, true, 0},
         {"reference", 128, "half", true, 256, 0.0f, 0.0f, Integrator::Path, 0, DirectLight::Once, LbBoundary::SunSky, true, 0},
     };
     return presets;

@@ -53,18 +53,11 @@ inline QImage settledPicture(Scene scene, const std::vector<SpeciesAssets>& asse
     scene.render.spp = lastPass;
     RenderScene rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
     const Refinement r = refinementFor(rs.view(), sceneSpp, lastPass, sampleLimit);
-    const Scene asGiven = [&] {
-        Scene g = scene;
-        g.render.spp = sceneSpp;
-        return g;
-    }();
     if (r.frames > 0 && r.samples != lastPass) {
         scene.render.spp = r.samples;
         rs = buildRenderScene(scene, assets, sunRadiance(scene.sun));
     }
-    RenderView view = rs.view();
-    if (r.frames > 0) view.bounceStride = refinementBounceStride(asGiven, r.samples, view.bounceStride);   // the final preset's share
-    return heldExposureImage(renderFilm(view), exposure, scene.render.mode, scene.render.mode, composeSky(scene),
+    return heldExposureImage(renderFilm(rs.view()), exposure, scene.render.mode, scene.render.mode, composeSky(scene),
                              scene.render.exposureKey);
 }
 

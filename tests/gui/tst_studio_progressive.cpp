@@ -174,7 +174,7 @@ private Q_SLOTS:
         {
             Viewport fresh;
             QCOMPARE(fresh.sampleLimit(), findQualityPreset("final")->spp);
-            QCOMPARE(fresh.sampleLimit(), 100);
+            QCOMPARE(fresh.sampleLimit(), 64);
         }
         QSettings().setValue("viewport/sampleLimit", kept);
         QSpinBox* box = m_win->sampleLimitBox();
