@@ -277,25 +277,19 @@ private:
 
     // ---- the actions ----
 
-    void undo()
-    {
-        if (chance(0.5)) {
-            note(QStringLiteral("undo (Ctrl+Z to %1)").arg(focusName()));
-            QTest::keySequence(focusTarget(), QKeySequence::Undo);
-        } else {
-            note(QStringLiteral("undo (Edit > Undo)"));
-            m_w.findChild<QAction*>("actionUndo")->trigger();
-        }
-    }
+    void undo() { history(false); }
+    void redo() { history(true); }
 
-    void redo()
+    // An undo or a redo, by its key sequence to the focused widget or by its Edit menu action.
+    void history(bool forward)
     {
+        const QString word = forward ? QStringLiteral("redo") : QStringLiteral("undo");
         if (chance(0.5)) {
-            note(QStringLiteral("redo (Ctrl+Shift+Z to %1)").arg(focusName()));
-            QTest::keySequence(focusTarget(), QKeySequence::Redo);
+            note(QStringLiteral("%1 (%2 to %3)").arg(word, forward ? QStringLiteral("Ctrl+Shift+Z") : QStringLiteral("Ctrl+Z"), focusName()));
+            QTest::keySequence(focusTarget(), forward ? QKeySequence::Redo : QKeySequence::Undo);
         } else {
-            note(QStringLiteral("redo (Edit > Redo)"));
-            m_w.findChild<QAction*>("actionRedo")->trigger();
+            note(QStringLiteral("%1 (Edit > %2)").arg(word, forward ? QStringLiteral("Redo") : QStringLiteral("Undo")));
+            m_w.findChild<QAction*>(forward ? "actionRedo" : "actionUndo")->trigger();
         }
     }
 
